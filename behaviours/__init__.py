@@ -1,0 +1,1 @@
+"""pmnav_bt.behaviours."""

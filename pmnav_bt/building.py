@@ -1,0 +1,400 @@
+"""The building file: rooms, doors, signs, corridor key waypoints and edges, landmarks.
+
+One YAML file describes a functional building for both the priori-map (planning)
+and the simulator (the world). Loading validates the structure (pydantic: unknown
+keys, bad numbers) and then the meaning (duplicate IDs, edges to unknown
+waypoints, rooms no corridor reaches, disconnected corridors), and reports every
+problem with its file and field.
+
+Coordinates are metres in the map frame (x east, y north).
+"""
+
+from __future__ import annotations
+
+import math
+from enum import Enum
+from pathlib import Path
+from typing import Annotated, Any
+
+import networkx as nx
+import numpy as np
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from pmnav_bt.errors import BuildingFileError, Problem
+from pmnav_bt.geometry import project_points_to_segments
+
+SCHEMA_VERSION = 1
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Point = tuple[Finite, Finite]
+
+# A door may be this far beyond the corridor wall and still count as reached.
+DOOR_REACH_SLACK = 1.0
+
+
+class WaypointKind(str, Enum):
+    """Key waypoint kinds of the paper: start, turn, branch (fork), end."""
+
+    START = "start"
+    TURN = "turn"
+    BRANCH = "branch"
+    END = "end"
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Waypoint(_Strict):
+    """A key waypoint on the corridor centre line."""
+
+    id: str = Field(min_length=1)
+    kind: WaypointKind
+    pos: Point
+
+
+class Edge(_Strict):
+    """A straight corridor between two key waypoints; ``width`` overrides the building default."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+
+    a: str = Field(alias="from", min_length=1)
+    b: str = Field(alias="to", min_length=1)
+    width: Finite | None = Field(default=None, gt=0)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _from_pair(cls, data: Any) -> Any:
+        # Shorthand in YAML: "- [start, turn1]".
+        if isinstance(data, (list, tuple)):
+            if len(data) != 2:
+                raise ValueError("an edge is [from, to] or {from: ..., to: ..., width: ...}")
+            return {"from": data[0], "to": data[1]}
+        return data
+
+
+class Room(_Strict):
+    """A room behind a door on a corridor. ``door`` is the door centre, in the corridor wall."""
+
+    id: str = Field(min_length=1)
+    name: str = ""
+    aliases: tuple[str, ...] = ()
+    door: Point
+    sign: str = ""
+
+    @property
+    def display_name(self) -> str:
+        return self.name or self.id
+
+    @property
+    def sign_text(self) -> str:
+        """The text on the sign plate beside the door (defaults to the display name)."""
+        return self.sign or self.display_name
+
+
+class Landmark(_Strict):
+    """A non-room landmark (elevator, stairs, reception desk, a named sign ...)."""
+
+    id: str = Field(min_length=1)
+    kind: str = Field(min_length=1)
+    name: str = ""
+    aliases: tuple[str, ...] = ()
+    pos: Point
+    sign: str = ""
+
+    @property
+    def display_name(self) -> str:
+        return self.name or self.id
+
+
+class FloorPlan(_Strict):
+    """An optional floor plan: an image with its scale, or a ROS map_server YAML.
+
+    ``origin`` is the map-frame position of the image's bottom-left corner (the ROS
+    map_server convention). Paths are relative to the building file.
+    """
+
+    image: str | None = None
+    metres_per_pixel: Finite | None = Field(default=None, gt=0)
+    origin: Point = (0.0, 0.0)
+    ros_map: str | None = None
+
+    @model_validator(mode="after")
+    def _one_source(self) -> FloorPlan:
+        if (self.image is None) == (self.ros_map is None):
+            raise ValueError("give either 'image' (with 'metres_per_pixel') or 'ros_map'")
+        if self.image is not None and self.metres_per_pixel is None:
+            raise ValueError("'image' needs 'metres_per_pixel'")
+        return self
+
+
+class Building(_Strict):
+    """A functional building: the content of one building file."""
+
+    schema_version: int
+    name: str = Field(min_length=1)
+    kind: str = "building"
+    description: str = ""
+    corridor_width: Finite = Field(default=2.4, gt=0)
+    wall_height: Finite = Field(default=3.0, gt=0)
+    floor_plan: FloorPlan | None = None
+    waypoints: tuple[Waypoint, ...] = Field(min_length=2)
+    edges: tuple[Edge, ...] = Field(min_length=1)
+    rooms: tuple[Room, ...] = ()
+    landmarks: tuple[Landmark, ...] = ()
+
+    @field_validator("schema_version")
+    @classmethod
+    def _known_version(cls, v: int) -> int:
+        if v != SCHEMA_VERSION:
+            raise ValueError(f"this version of pmnav reads schema_version {SCHEMA_VERSION}, not {v}")
+        return v
+
+    # -- lookups ------------------------------------------------------------------------
+
+    def waypoint(self, wid: str) -> Waypoint:
+        return self._waypoint_index()[wid]
+
+    def room(self, rid: str) -> Room:
+        return self._room_index()[rid]
+
+    def landmark(self, lid: str) -> Landmark:
+        return {lm.id: lm for lm in self.landmarks}[lid]
+
+    def edge_width(self, edge: Edge) -> float:
+        return edge.width if edge.width is not None else self.corridor_width
+
+    def _waypoint_index(self) -> dict[str, Waypoint]:
+        return {w.id: w for w in self.waypoints}
+
+    def _room_index(self) -> dict[str, Room]:
+        return {r.id: r for r in self.rooms}
+
+    def corridor_graph(self) -> nx.Graph:
+        """Key waypoints as nodes, corridors as edges weighted by length (metres)."""
+        g = nx.Graph()
+        pos = {w.id: w.pos for w in self.waypoints}
+        for w in self.waypoints:
+            g.add_node(w.id, kind=w.kind)
+        for e in self.edges:
+            if e.a in pos and e.b in pos:
+                g.add_edge(e.a, e.b, length=math.dist(pos[e.a], pos[e.b]))
+        return g
+
+    # -- serialisation ------------------------------------------------------------------
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data in the file's layout (edges as {from, to[, width]})."""
+        d = self.model_dump(mode="json", by_alias=True, exclude_defaults=True)
+        d["schema_version"] = self.schema_version
+        d["edges"] = [
+            [e.a, e.b] if e.width is None else {"from": e.a, "to": e.b, "width": e.width}
+            for e in self.edges
+        ]
+        return d
+
+
+# -- loading ---------------------------------------------------------------------------
+
+
+def _loc(loc: tuple) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif part in ("function-before[_from_pair()]", "function-after[_one_source()]"):
+            continue
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def _pydantic_problems(err: ValidationError) -> list[Problem]:
+    problems = []
+    for e in err.errors():
+        msg = e["msg"]
+        if e["type"] == "extra_forbidden":
+            msg = "unknown key (check the spelling; see docs/building-format.md)"
+        elif e["type"] == "missing":
+            msg = "required key is missing"
+        elif msg.startswith("Value error, "):
+            msg = msg[len("Value error, ") :]
+        got = e.get("input")
+        if e["type"] not in ("missing", "extra_forbidden") and not isinstance(got, (dict, list)):
+            msg += f" (got {got!r})"
+        problems.append(Problem(_loc(e["loc"]), msg))
+    return problems
+
+
+def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem]:
+    """Problems of meaning in a structurally valid building."""
+    problems: list[Problem] = []
+    # IDs share one namespace: plan steps name waypoints, rooms and landmarks alike.
+    where: dict[str, list[str]] = {}
+    for group, items in (("waypoints", b.waypoints), ("rooms", b.rooms), ("landmarks", b.landmarks)):
+        for i, item in enumerate(items):
+            where.setdefault(item.id, []).append(f"{group}[{i}]")
+    for ident, places in where.items():
+        if len(places) > 1:
+            problems.append(
+                Problem(f"{places[1]}.id", f"duplicate id {ident!r} (also at {places[0]})")
+            )
+
+    wps = b._waypoint_index()
+    seen_edges: dict[frozenset, int] = {}
+    for i, e in enumerate(b.edges):
+        for end, field in ((e.a, "from"), (e.b, "to")):
+            if end not in wps:
+                problems.append(Problem(f"edges[{i}].{field}", f"unknown waypoint {end!r}"))
+        if e.a == e.b:
+            problems.append(Problem(f"edges[{i}]", f"edge joins {e.a!r} to itself"))
+            continue
+        key = frozenset((e.a, e.b))
+        if key in seen_edges:
+            problems.append(
+                Problem(f"edges[{i}]", f"duplicate edge {e.a}-{e.b} (also edges[{seen_edges[key]}])")
+            )
+        seen_edges.setdefault(key, i)
+        if e.a in wps and e.b in wps and math.dist(wps[e.a].pos, wps[e.b].pos) < 0.05:
+            problems.append(Problem(f"edges[{i}]", f"{e.a!r} and {e.b!r} are at the same position"))
+
+    g = b.corridor_graph()
+    for i, w in enumerate(b.waypoints):
+        deg = g.degree(w.id)
+        want = {
+            WaypointKind.START: "exactly 1",
+            WaypointKind.END: "exactly 1",
+            WaypointKind.TURN: "exactly 2",
+            WaypointKind.BRANCH: "3 or more",
+        }[w.kind]
+        ok = {
+            WaypointKind.START: deg == 1,
+            WaypointKind.END: deg == 1,
+            WaypointKind.TURN: deg == 2,
+            WaypointKind.BRANCH: deg >= 3,
+        }[w.kind]
+        if not ok:
+            hint = "branch" if deg >= 3 else ("turn" if deg == 2 else "start or end")
+            problems.append(
+                Problem(
+                    f"waypoints[{i}].kind",
+                    f"{w.id!r} is a {w.kind.value} waypoint, which needs {want} corridor edges, "
+                    f"but has {deg}" + (f"; use kind '{hint}'" if deg else ""),
+                )
+            )
+    comps = [c for c in nx.connected_components(g) if c]
+    if len(comps) > 1:
+        comps.sort(key=len, reverse=True)
+        parts = "; ".join("{" + ", ".join(sorted(c)[:6]) + ("..." if len(c) > 6 else "") + "}"
+                          for c in comps)
+        problems.append(
+            Problem("edges", f"the corridors fall into {len(comps)} disconnected parts: {parts}")
+        )
+
+    # Every door and landmark must be reachable from a corridor.
+    valid_edges = [e for e in b.edges if e.a in wps and e.b in wps and e.a != e.b]
+    if valid_edges:
+        seg_a = np.array([wps[e.a].pos for e in valid_edges])
+        seg_b = np.array([wps[e.b].pos for e in valid_edges])
+        half = np.array([b.edge_width(e) / 2.0 for e in valid_edges])
+        for group, items, attr in (("rooms", b.rooms, "door"), ("landmarks", b.landmarks, "pos")):
+            if not items:
+                continue
+            pts = np.array([getattr(it, attr) for it in items])
+            j, _, dist = project_points_to_segments(pts, seg_a, seg_b)
+            for i, it in enumerate(items):
+                limit = half[j[i]] + DOOR_REACH_SLACK
+                if dist[i] > limit:
+                    problems.append(
+                        Problem(
+                            f"{group}[{i}].{attr}",
+                            f"{it.id!r} is {dist[i]:.2f} m from the nearest corridor centre line "
+                            f"({valid_edges[j[i]].a}-{valid_edges[j[i]].b}); at most {limit:.2f} m "
+                            "is reachable: move it next to a corridor or add a corridor edge",
+                        )
+                    )
+
+    if b.floor_plan is not None and base_dir is not None:
+        for field in ("image", "ros_map"):
+            rel = getattr(b.floor_plan, field)
+            if rel is not None and not (base_dir / rel).is_file():
+                problems.append(
+                    Problem(f"floor_plan.{field}", f"file not found: {base_dir / rel}")
+                )
+    return problems
+
+
+def building_from_data(data: Any, source: str = "<data>", base_dir: Path | None = None) -> Building:
+    """Validate plain data (as read from YAML) into a Building, or raise BuildingFileError."""
+    if not isinstance(data, dict):
+        raise BuildingFileError(
+            source, [Problem("", f"expected a mapping at the top level, got {type(data).__name__}")]
+        )
+    try:
+        b = Building.model_validate(data)
+    except ValidationError as err:
+        raise BuildingFileError(source, _pydantic_problems(err)) from None
+    problems = semantic_problems(b, base_dir)
+    if problems:
+        raise BuildingFileError(source, problems)
+    return b
+
+
+def _yaml_loader():
+    return getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def load_building(path: str | Path) -> Building:
+    """Read and validate a building file (or a built-in building's name)."""
+    path = resolve_building_path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise BuildingFileError(str(path), [Problem("", f"cannot read file: {err.strerror}")]) from None
+    try:
+        data = yaml.load(text, Loader=_yaml_loader())  # noqa: S506 - a safe loader
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(err, "problem", None) or str(err)
+        raise BuildingFileError(str(path), [Problem(where, f"not valid YAML: {problem}")]) from None
+    return building_from_data(data, str(path), path.parent)
+
+
+def save_building(b: Building, path: str | Path) -> Path:
+    """Write a building file that loads back to an equal Building."""
+    path = Path(path)
+    path.write_text(dump_building(b), encoding="utf-8")
+    return path
+
+
+def dump_building(b: Building) -> str:
+    """The building as YAML text."""
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+    return yaml.dump(b.to_dict(), Dumper=dumper, sort_keys=False, allow_unicode=True, width=100)
+
+
+# -- built-in buildings ---------------------------------------------------------------
+
+BUILTIN_DIR = Path(__file__).parent / "data" / "buildings"
+
+
+def builtin_buildings() -> list[str]:
+    """Names of the buildings shipped with the package."""
+    return sorted(p.stem for p in BUILTIN_DIR.glob("*.yaml"))
+
+
+def resolve_building_path(name_or_path: str | Path) -> Path:
+    """A path as given, or the file of a built-in building of that name."""
+    p = Path(name_or_path)
+    if p.exists() or p.suffix in (".yaml", ".yml") or len(p.parts) > 1:
+        return p
+    builtin = BUILTIN_DIR / f"{name_or_path}.yaml"
+    if builtin.is_file():
+        return builtin
+    raise BuildingFileError(
+        str(name_or_path),
+        [Problem("", f"no such file, and no built-in building of that name "
+                     f"(built-in: {', '.join(builtin_buildings()) or 'none'})")],
+    )
