@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from enum import Enum
+from functools import cached_property
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -139,8 +140,8 @@ class Building(_Strict):
     corridor_width: Finite = Field(default=2.4, gt=0)
     wall_height: Finite = Field(default=3.0, gt=0)
     floor_plan: FloorPlan | None = None
-    waypoints: tuple[Waypoint, ...] = Field(min_length=2)
-    edges: tuple[Edge, ...] = Field(min_length=1)
+    waypoints: tuple[Waypoint, ...]
+    edges: tuple[Edge, ...]
     rooms: tuple[Room, ...] = ()
     landmarks: tuple[Landmark, ...] = ()
 
@@ -154,22 +155,28 @@ class Building(_Strict):
     # -- lookups ------------------------------------------------------------------------
 
     def waypoint(self, wid: str) -> Waypoint:
-        return self._waypoint_index()[wid]
+        return self._waypoint_index[wid]
 
     def room(self, rid: str) -> Room:
-        return self._room_index()[rid]
+        return self._room_index[rid]
 
     def landmark(self, lid: str) -> Landmark:
-        return {lm.id: lm for lm in self.landmarks}[lid]
+        return self._landmark_index[lid]
 
     def edge_width(self, edge: Edge) -> float:
         return edge.width if edge.width is not None else self.corridor_width
 
+    @cached_property
     def _waypoint_index(self) -> dict[str, Waypoint]:
         return {w.id: w for w in self.waypoints}
 
+    @cached_property
     def _room_index(self) -> dict[str, Room]:
         return {r.id: r for r in self.rooms}
+
+    @cached_property
+    def _landmark_index(self) -> dict[str, Landmark]:
+        return {lm.id: lm for lm in self.landmarks}
 
     def corridor_graph(self) -> nx.Graph:
         """Key waypoints as nodes, corridors as edges weighted by length (metres)."""
@@ -230,6 +237,10 @@ def _pydantic_problems(err: ValidationError) -> list[Problem]:
 def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem]:
     """Problems of meaning in a structurally valid building."""
     problems: list[Problem] = []
+    if len(b.waypoints) < 2:
+        problems.append(Problem("waypoints", "a building needs at least 2 key waypoints"))
+    if not b.edges:
+        problems.append(Problem("edges", "a building needs at least 1 corridor edge"))
     # IDs share one namespace: plan steps name waypoints, rooms and landmarks alike.
     where: dict[str, list[str]] = {}
     for group, items in (("waypoints", b.waypoints), ("rooms", b.rooms), ("landmarks", b.landmarks)):
@@ -241,7 +252,7 @@ def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem
                 Problem(f"{places[1]}.id", f"duplicate id {ident!r} (also at {places[0]})")
             )
 
-    wps = b._waypoint_index()
+    wps = b._waypoint_index
     seen_edges: dict[frozenset, int] = {}
     for i, e in enumerate(b.edges):
         for end, field in ((e.a, "from"), (e.b, "to")):

@@ -1,0 +1,115 @@
+"""The ``pmnav`` command line.
+
+A user error (bad file, unknown room, ...) prints one line on stderr and exits
+with status 2; ``pmnav validate`` exits 1 when the file has problems.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import typer
+
+from pmnav_bt.errors import BuildingFileError, PmNavError
+
+app = typer.Typer(
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    no_args_is_help=True,
+    help="PM-Nav BT: find a named room in a functional building from a prior floor plan.",
+)
+
+FILE_HELP = "A building file (YAML) or the name of a built-in building (see 'pmnav buildings')."
+
+
+def _priori_map(file: str):
+    from pmnav_bt.building import load_building
+    from pmnav_bt.priori_map import parse_building
+
+    return parse_building(load_building(file))
+
+
+@app.command()
+def buildings() -> None:
+    """List the built-in buildings."""
+    from pmnav_bt.building import builtin_buildings, load_building
+
+    for name in builtin_buildings():
+        b = load_building(name)
+        typer.echo(f"{name:<16} {b.kind:<9} {len(b.rooms):>3} rooms  {b.description}")
+
+
+@app.command()
+def validate(file: str = typer.Argument(..., help=FILE_HELP)) -> None:
+    """Check a building file and list every problem (exit 1 if there are any)."""
+    from pmnav_bt.building import load_building
+    from pmnav_bt.priori_map import parse_building
+
+    try:
+        b = load_building(file)
+    except BuildingFileError as err:
+        for line in err.lines():
+            typer.echo(line, err=True)
+        typer.echo(f"{len(err.problems)} problem(s)", err=True)
+        raise typer.Exit(1) from None
+    pm = parse_building(b)
+    typer.echo(
+        f"{file}: OK: {b.name}: {len(b.rooms)} rooms, {len(b.landmarks)} landmarks, "
+        f"{len(b.waypoints)} key waypoints, {len(b.edges)} corridors, {len(pm.segments)} segments"
+    )
+
+
+@app.command("map")
+def map_(
+    file: str = typer.Argument(..., help=FILE_HELP),
+    as_json: bool = typer.Option(False, "--json", help="Print the priori-map as JSON."),
+    image: Path | None = typer.Option(None, "--image", help="Write the annotated map PNG here."),
+) -> None:
+    """Print the semantic priori-map (structured text or JSON); optionally draw it."""
+    pm = _priori_map(file)
+    typer.echo(json.dumps(pm.to_dict(), indent=2) if as_json else pm.to_text(), nl=not as_json)
+    if image is not None:
+        from pmnav_bt.annotate import render_annotated_map
+
+        render_annotated_map(pm, path=image)
+        typer.echo(f"wrote {image}", err=True)
+
+
+@app.command()
+def plan(
+    file: str = typer.Argument(..., help=FILE_HELP),
+    start: str = typer.Option(
+        ..., "--from", help="Start: a segment (seg13), a waypoint or room ID, or a pose 'x,y[,yaw_deg]'."
+    ),
+    goal: str = typer.Option(..., "--to", help="Goal room: ID, name or alias."),
+    as_json: bool = typer.Option(False, "--json", help="Print the plan as JSON."),
+    image: Path | None = typer.Option(None, "--image", help="Draw the plan on the annotated map."),
+    max_gap: float = typer.Option(10.0, help="Most metres between consecutive plan steps."),
+) -> None:
+    """Plan from a start to a goal room: ordered {landmark: action} steps."""
+    from pmnav_bt.planner import GraphPlanner
+
+    pm = _priori_map(file)
+    p = GraphPlanner(max_gap=max_gap).plan(pm, start, goal)
+    typer.echo(p.to_json() if as_json else p.text())
+    if image is not None:
+        from pmnav_bt.annotate import render_annotated_map
+
+        render_annotated_map(pm, path=image, path_xy=list(p.path))
+        typer.echo(f"wrote {image}", err=True)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point: run the app; user errors become one line on stderr and exit status 2."""
+    try:
+        app(args=argv, prog_name="pmnav")
+    except PmNavError as err:
+        msg = err.summary() if isinstance(err, BuildingFileError) else str(err)
+        print(f"pmnav: error: {msg}", file=sys.stderr)
+        sys.exit(2)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,226 @@
+"""Graph planner: the shortest corridor path from a start to a goal room, as a paper-style plan.
+
+The path is found on the priori-map graph (Dijkstra on corridor lengths). It then
+becomes ordered ``{landmark: action}`` steps: first-person actions from the change
+of heading at each node; every turn and fork; the last recognisable landmark before
+each unseen turn, carrying that turn as an action prediction; and enough landmarks
+in between that no two consecutive steps are more than ``max_gap`` metres apart.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import networkx as nx
+import numpy as np
+
+from pmnav_bt.errors import PlanningError
+from pmnav_bt.geometry import Action, heading, relative_action, wrap_angle
+from pmnav_bt.plan import ForkChoice, Plan, PlanStart, PlanStep
+from pmnav_bt.priori_map import PrioriMap
+from pmnav_bt.resolve import StartPoint, resolve_room, resolve_start
+
+
+@dataclass(frozen=True)
+class GraphPlanner:
+    """Shortest-path planner over the priori-map (the default planner)."""
+
+    max_gap: float = 10.0  # metres between consecutive steps, where landmarks allow
+
+    name = "graph"
+
+    def plan(self, pm: PrioriMap, start: str | StartPoint, goal: str) -> Plan:
+        goal_id = resolve_room(pm, goal)
+        sp = resolve_start(pm, start) if isinstance(start, str) else start
+        nodes, length, start_xy = shortest_route(pm, sp, pm.places[goal_id].node)
+        return build_plan(pm, sp, goal_id, nodes, length, start_xy, self.max_gap, self.name)
+
+
+def shortest_route(
+    pm: PrioriMap, sp: StartPoint, goal_node: str
+) -> tuple[list[str], float, np.ndarray]:
+    """Nodes from the start point to the goal node, the route length, and the start point."""
+    seg = sp.segment
+    a_xy, b_xy = pm.node_xy(seg.a), pm.node_xy(seg.b)
+    start_xy = a_xy + sp.t * (b_xy - a_xy)
+    best: tuple[float, list[str]] | None = None
+    for end, lead in ((seg.a, sp.t * seg.length), (seg.b, (1.0 - sp.t) * seg.length)):
+        try:
+            d, path = nx.bidirectional_dijkstra(pm.graph, end, goal_node, weight="length")
+        except nx.NetworkXNoPath:
+            continue
+        total = lead + d
+        # On a tie, prefer the way the robot already faces.
+        tie_break = 0.0
+        if sp.heading is not None:
+            toward = heading(start_xy, pm.node_xy(end)) if lead > 1e-9 else sp.heading
+            tie_break = abs(wrap_angle(toward - sp.heading)) * 1e-9
+        if best is None or total + tie_break < best[0]:
+            best = (total + tie_break, path)
+    if best is None:
+        raise PlanningError(f"{goal_node} cannot be reached from {sp.description}")
+    nodes = best[1]
+    length = _route_length(pm, start_xy, nodes)
+    return nodes, length, start_xy
+
+
+def _route_length(pm: PrioriMap, start_xy: np.ndarray, nodes: list[str]) -> float:
+    pts = [start_xy] + [pm.node_xy(n) for n in nodes]
+    return float(sum(np.linalg.norm(q - p) for p, q in zip(pts, pts[1:], strict=False)))
+
+
+def _side(heading_in: float, at: np.ndarray, target) -> str:
+    bearing = wrap_angle(heading(at, target) - heading_in)
+    if abs(bearing) <= math.radians(30):
+        return "ahead"
+    if abs(bearing) >= math.radians(150):
+        return "behind"
+    return "left" if bearing > 0 else "right"
+
+
+def _target_of(pm: PrioriMap, node_id: str, goal_id: str) -> tuple[str | None, object]:
+    """What to look for at a node (room or landmark id) and its position."""
+    n = pm.nodes[node_id]
+    b = pm.building
+    if goal_id in n.rooms:
+        return goal_id, b.room(goal_id).door
+    if n.rooms:
+        return n.rooms[0], b.room(n.rooms[0]).door
+    if n.landmarks:
+        return n.landmarks[0], b.landmark(n.landmarks[0]).pos
+    return None, None
+
+
+def build_plan(
+    pm: PrioriMap,
+    sp: StartPoint,
+    goal_id: str,
+    nodes: list[str],
+    length: float,
+    start_xy: np.ndarray,
+    max_gap: float,
+    planner: str,
+) -> Plan:
+    """Turn a node route into plan steps (actions, predictions, forks, sides)."""
+    pts = [start_xy] + [pm.node_xy(n) for n in nodes]
+    # Drop the start point when it sits on the first node.
+    if np.linalg.norm(pts[1] - pts[0]) < 1e-6:
+        pts = pts[1:]
+        route = list(nodes)  # index i of route matches pts[i]
+    else:
+        route = [None, *nodes]
+    cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    notes: list[str] = []
+    if len(pts) == 1:
+        first_heading = sp.heading if sp.heading is not None else sp.segment.heading
+    else:
+        first_heading = heading(pts[0], pts[1])
+    if sp.heading is None:
+        initial = Action.GO_STRAIGHT
+        notes.append("start heading unknown: the plan assumes the robot faces its first segment")
+    else:
+        initial = relative_action(sp.heading, first_heading)
+
+    candidates: list[dict] = []
+    if len(pts) == 1:  # already at the goal's room waypoint
+        look_for, target = _target_of(pm, route[0], goal_id)
+        candidates.append(
+            dict(
+                i=0, node=pm.nodes[route[0]], action=Action.ARRIVE, h_in=first_heading,
+                fork=None, is_goal=True, landmark=goal_id, visible=True, target=target,
+                segment=sp.segment.name,
+            )
+        )
+    for i in range(1, len(pts)):
+        node_id = route[i]
+        h_in = heading(pts[i - 1], pts[i])
+        is_goal = i == len(pts) - 1
+        h_out = h_in if is_goal else heading(pts[i], pts[i + 1])
+        action = Action.ARRIVE if is_goal else relative_action(h_in, h_out)
+        node = pm.nodes[node_id]
+        fork = None
+        if node.kind == "branch" and not is_goal:
+            prev = route[i - 1]
+            others = [
+                relative_action(h_in, heading(pts[i], pm.node_xy(nb)))
+                for nb in pm.graph.neighbors(node_id)
+                if nb not in (prev, route[i + 1])
+            ]
+            fork = ForkChoice(action, tuple(others))
+        look_for, target = _target_of(pm, node_id, goal_id)
+        prev_node = route[i - 1] if route[i - 1] is not None else None
+        if prev_node is not None and pm.graph.has_edge(prev_node, node_id):
+            seg_name = pm.segments[pm.graph.edges[prev_node, node_id]["segment"] - 1].name
+        else:
+            seg_name = sp.segment.name
+        candidates.append(
+            dict(
+                i=i, node=node, action=action, h_in=h_in, fork=fork, is_goal=is_goal,
+                landmark=goal_id if is_goal else node_id,
+                visible=look_for is not None, target=target, segment=seg_name,
+            )
+        )
+
+    required = {
+        c["i"] for c in candidates
+        if c["is_goal"] or c["fork"] is not None or c["action"] is not Action.GO_STRAIGHT
+    }
+    # The last visible node before each unseen required step predicts it.
+    predictor: dict[int, int] = {}
+    last_visible = None
+    for c in candidates:
+        if c["i"] in required and not c["visible"] and last_visible is not None:
+            predictor[last_visible] = c["i"]
+            required.add(last_visible)
+        if c["visible"]:
+            last_visible = c["i"]
+        if c["i"] in required:
+            last_visible = None if not c["visible"] else c["i"]
+    # Fill long gaps with visible landmarks (greedy: keep one before the gap gets too long).
+    kept: list[int] = []
+    last_cum = 0.0
+    anchors = [c for c in candidates if c["visible"] or c["i"] in required]
+    for k, c in enumerate(anchors):
+        nxt = anchors[k + 1]["i"] if k + 1 < len(anchors) else None
+        if c["i"] in required or (nxt is not None and cum[nxt] - last_cum > max_gap):
+            kept.append(c["i"])
+            last_cum = cum[c["i"]]
+    by_i = {c["i"]: c for c in candidates}
+    steps: list[PlanStep] = []
+    prev_cum = 0.0
+    for i in kept:
+        c = by_i[i]
+        pred = by_i[predictor[i]] if i in predictor else None
+        steps.append(
+            PlanStep(
+                landmark=c["landmark"],
+                action=c["action"],
+                kind=c["node"].kind,
+                visible=c["visible"],
+                position=tuple(float(v) for v in pts[i]),
+                heading=c["h_in"],
+                distance=float(cum[i] - prev_cum),
+                segment=c["segment"],
+                side=_side(c["h_in"], pts[i], c["target"]) if c["visible"] else None,
+                target=tuple(float(v) for v in c["target"]) if c["visible"] else None,
+                predicts=(pred["landmark"], pred["action"]) if pred else None,
+                fork=c["fork"],
+            )
+        )
+        prev_cum = cum[i]
+    room = pm.building.room(goal_id)
+    return Plan(
+        building=pm.building.name,
+        start=PlanStart(sp.description, sp.segment.name,
+                        (float(start_xy[0]), float(start_xy[1])), sp.heading),
+        goal=goal_id,
+        goal_name=room.display_name,
+        steps=tuple(steps),
+        nodes=tuple(nodes),
+        path=tuple((float(p[0]), float(p[1])) for p in [start_xy] + [pm.node_xy(n) for n in nodes]),
+        length=float(length),
+        initial_action=initial,
+        planner=planner,
+        notes=tuple(notes),
+    )

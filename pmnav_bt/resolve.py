@@ -1,0 +1,120 @@
+"""Resolve what a person types into map entities: goal rooms and plan starts.
+
+Room names match by ID, display name or alias, ignoring case, spaces and
+punctuation ("Room 17", "room17", "one-stop service centre"). An unknown or
+ambiguous name is an UnknownNameError that lists the closest candidates.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from dataclasses import dataclass
+
+from pmnav_bt.errors import UnknownNameError
+from pmnav_bt.priori_map import PrioriMap, Segment
+
+
+def normalise(name: str) -> str:
+    """Lower case, letters and digits only: 'One-Stop  Service Centre' -> 'onestopservicecentre'."""
+    return re.sub(r"[^0-9a-z]", "", name.casefold())
+
+
+def _index(pm: PrioriMap) -> tuple[dict[str, set[str]], dict[str, str]]:
+    """normalised key -> room ids; room id -> label for messages (cached on the map)."""
+    cached = pm.__dict__.get("_room_name_index")
+    if cached is not None:
+        return cached
+    keys: dict[str, set[str]] = {}
+    labels: dict[str, str] = {}
+    for r in pm.building.rooms:
+        labels[r.id] = f"{r.id} ({r.display_name})" if r.name else r.id
+        for name in (r.id, r.name, r.sign, *r.aliases):
+            if name and normalise(name):
+                keys.setdefault(normalise(name), set()).add(r.id)
+    pm.__dict__["_room_name_index"] = (keys, labels)
+    return keys, labels
+
+
+def resolve_room(pm: PrioriMap, name: str) -> str:
+    """The ID of the room a person means by ``name``."""
+    keys, labels = _index(pm)
+    key = normalise(name)
+    ids = keys.get(key, set())
+    if len(ids) == 1:
+        return next(iter(ids))
+    if len(ids) > 1:
+        cands = sorted(labels[i] for i in ids)
+        raise UnknownNameError(
+            f"room name {name!r} is ambiguous: it matches {', '.join(cands)}; give the room ID",
+            cands,
+        )
+    if key:
+        for lm in pm.building.landmarks:
+            if key in {normalise(n) for n in (lm.id, lm.name, lm.kind, *lm.aliases) if n}:
+                raise UnknownNameError(
+                    f"{name!r} is a landmark ({lm.kind}), not a room; plans go to rooms"
+                )
+    close = difflib.get_close_matches(key, list(keys), n=5, cutoff=0.5) if key else []
+    cands = sorted({labels[i] for k in close for i in keys[k]})
+    hint = f"; closest: {', '.join(cands)}" if cands else ""
+    raise UnknownNameError(f"no room called {name!r} in {pm.building.name}{hint}", cands)
+
+
+@dataclass(frozen=True)
+class StartPoint:
+    """A resolved start: on ``segment`` at fraction ``t`` from a to b, heading if known."""
+
+    description: str
+    segment: Segment
+    t: float
+    heading: float | None = None
+
+
+_POSE = re.compile(r"^\s*(-?[\d.]+)\s*,\s*(-?[\d.]+)\s*(?:,\s*(-?[\d.]+)\s*)?$")
+
+
+def resolve_start(pm: PrioriMap, spec: str) -> StartPoint:
+    """A start given as a segment ("seg13", "seg13(room14-room7)"), a waypoint or room ID,
+    or a map pose "x,y" / "x,y,yaw_deg" (degrees, counter-clockwise from east)."""
+    spec = spec.strip()
+    m = _POSE.match(spec)
+    if m:
+        try:
+            x, y = float(m.group(1)), float(m.group(2))
+            yaw = math.radians(float(m.group(3))) if m.group(3) is not None else None
+        except ValueError:
+            raise UnknownNameError(f"bad pose {spec!r}: expected 'x,y' or 'x,y,yaw_deg'") from None
+        loc = pm.locate(x, y)
+        limit = loc.segment.width / 2.0 + 1.0
+        if loc.offset > limit:
+            raise UnknownNameError(
+                f"pose ({x:.2f}, {y:.2f}) is {loc.offset:.2f} m from the nearest corridor "
+                f"({loc.segment.name}); a start must be in a corridor"
+            )
+        return StartPoint(f"pose ({x:.1f}, {y:.1f})", loc.segment, loc.t, yaw)
+    if re.fullmatch(r"(?i)seg\s*\d+.*", spec):
+        seg = pm.segment(spec)
+        return StartPoint(seg.name, seg, 0.5)
+    node = spec if spec in pm.nodes else pm.places[spec].node if spec in pm.places else None
+    if node is None:
+        # A room given by name or alias starts at its room waypoint.
+        try:
+            node = pm.places[resolve_room(pm, spec)].node
+        except UnknownNameError:
+            node = None
+    if node is not None:
+        segs = pm.segments_at(node)
+        if not segs:
+            raise UnknownNameError(f"{spec!r} is not on any corridor")
+        seg = segs[0]
+        return StartPoint(spec, seg, 0.0 if seg.a == node else 1.0)
+    keys = list(pm.nodes) + [s.short for s in pm.segments]
+    close = difflib.get_close_matches(spec, keys, n=5, cutoff=0.5)
+    hint = f"; closest: {', '.join(close)}" if close else ""
+    raise UnknownNameError(
+        f"unknown start {spec!r}: give a segment (seg13), a waypoint or room ID, "
+        f"or a pose 'x,y[,yaw_deg]'{hint}",
+        close,
+    )
