@@ -149,7 +149,9 @@ class Building(_Strict):
     @classmethod
     def _known_version(cls, v: int) -> int:
         if v != SCHEMA_VERSION:
-            raise ValueError(f"this version of pmnav reads schema_version {SCHEMA_VERSION}, not {v}")
+            raise ValueError(
+                f"this version of pmnav reads schema_version {SCHEMA_VERSION}, not {v}"
+            )
         return v
 
     # -- lookups ------------------------------------------------------------------------
@@ -243,7 +245,11 @@ def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem
         problems.append(Problem("edges", "a building needs at least 1 corridor edge"))
     # IDs share one namespace: plan steps name waypoints, rooms and landmarks alike.
     where: dict[str, list[str]] = {}
-    for group, items in (("waypoints", b.waypoints), ("rooms", b.rooms), ("landmarks", b.landmarks)):
+    for group, items in (
+        ("waypoints", b.waypoints),
+        ("rooms", b.rooms),
+        ("landmarks", b.landmarks),
+    ):
         for i, item in enumerate(items):
             where.setdefault(item.id, []).append(f"{group}[{i}]")
     for ident, places in where.items():
@@ -264,7 +270,9 @@ def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem
         key = frozenset((e.a, e.b))
         if key in seen_edges:
             problems.append(
-                Problem(f"edges[{i}]", f"duplicate edge {e.a}-{e.b} (also edges[{seen_edges[key]}])")
+                Problem(
+                    f"edges[{i}]", f"duplicate edge {e.a}-{e.b} (also edges[{seen_edges[key]}])"
+                )
             )
         seen_edges.setdefault(key, i)
         if e.a in wps and e.b in wps and math.dist(wps[e.a].pos, wps[e.b].pos) < 0.05:
@@ -297,8 +305,9 @@ def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem
     comps = [c for c in nx.connected_components(g) if c]
     if len(comps) > 1:
         comps.sort(key=len, reverse=True)
-        parts = "; ".join("{" + ", ".join(sorted(c)[:6]) + ("..." if len(c) > 6 else "") + "}"
-                          for c in comps)
+        parts = "; ".join(
+            "{" + ", ".join(sorted(c)[:6]) + ("..." if len(c) > 6 else "") + "}" for c in comps
+        )
         problems.append(
             Problem("edges", f"the corridors fall into {len(comps)} disconnected parts: {parts}")
         )
@@ -330,9 +339,7 @@ def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem
         for field in ("image", "ros_map"):
             rel = getattr(b.floor_plan, field)
             if rel is not None and not (base_dir / rel).is_file():
-                problems.append(
-                    Problem(f"floor_plan.{field}", f"file not found: {base_dir / rel}")
-                )
+                problems.append(Problem(f"floor_plan.{field}", f"file not found: {base_dir / rel}"))
     return problems
 
 
@@ -362,7 +369,9 @@ def load_building(path: str | Path) -> Building:
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as err:
-        raise BuildingFileError(str(path), [Problem("", f"cannot read file: {err.strerror}")]) from None
+        raise BuildingFileError(
+            str(path), [Problem("", f"cannot read file: {err.strerror}")]
+        ) from None
     try:
         data = yaml.load(text, Loader=_yaml_loader())  # noqa: S506 - a safe loader
     except yaml.YAMLError as err:
@@ -406,6 +415,11 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
         return builtin
     raise BuildingFileError(
         str(name_or_path),
-        [Problem("", f"no such file, and no built-in building of that name "
-                     f"(built-in: {', '.join(builtin_buildings()) or 'none'})")],
+        [
+            Problem(
+                "",
+                f"no such file, and no built-in building of that name "
+                f"(built-in: {', '.join(builtin_buildings()) or 'none'})",
+            )
+        ],
     )

@@ -81,7 +81,9 @@ def map_(
 def plan(
     file: str = typer.Argument(..., help=FILE_HELP),
     start: str = typer.Option(
-        ..., "--from", help="Start: a segment (seg13), a waypoint or room ID, or a pose 'x,y[,yaw_deg]'."
+        ...,
+        "--from",
+        help="Start: a segment (seg13), a waypoint or room ID, or a pose 'x,y[,yaw_deg]'.",
     ),
     goal: str = typer.Option(..., "--to", help="Goal room: ID, name or alias."),
     as_json: bool = typer.Option(False, "--json", help="Print the plan as JSON."),

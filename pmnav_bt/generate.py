@@ -62,7 +62,9 @@ def generate_building(
     waypoints = []
     for n in sorted(g, key=str):
         deg = g.degree(n)
-        kind = "start" if n == start_node else "end" if deg == 1 else "turn" if deg == 2 else "branch"
+        kind = (
+            "start" if n == start_node else "end" if deg == 1 else "turn" if deg == 2 else "branch"
+        )
         counters[kind] += 1
         ids[n] = kind if kind == "start" else f"{kind}{counters[kind]}"
         waypoints.append({"id": ids[n], "kind": kind, "pos": list(pos[n])})
@@ -81,7 +83,9 @@ def generate_building(
             k = len(rooms) + 1
             off = side_sign * corridor_width / 2.0
             door = [round(x0 + ux * s - uy * off, 3), round(y0 + uy * s + ux * off, 3)]
-            rooms.append({"id": f"room{k}", "name": f"Room {k}", "door": door, "sign": str(100 + k)})
+            rooms.append(
+                {"id": f"room{k}", "name": f"Room {k}", "door": door, "sign": str(100 + k)}
+            )
             s += ROOM_PITCH
             side_sign = -side_sign
     if len(rooms) < n_rooms:  # cannot happen with the sizing above; keep it loud if it does
@@ -93,8 +97,12 @@ def generate_building(
         kind = ("elevator", "stairs")[i % 2]
         x, y = pos[n]
         landmarks.append(
-            {"id": f"{kind}{i + 1}", "kind": kind, "name": f"{kind.title()} {i + 1}",
-             "pos": [x + corridor_width / 2.0, y + corridor_width / 2.0 + 0.5]}
+            {
+                "id": f"{kind}{i + 1}",
+                "kind": kind,
+                "name": f"{kind.title()} {i + 1}",
+                "pos": [x + corridor_width / 2.0, y + corridor_width / 2.0 + 0.5],
+            }
         )
     data = {
         "schema_version": SCHEMA_VERSION,

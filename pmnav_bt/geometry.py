@@ -9,6 +9,7 @@ import math
 from enum import Enum
 
 import numpy as np
+import shapely
 
 COMPASS = ("east", "northeast", "north", "northwest", "west", "southwest", "south", "southeast")
 
@@ -58,39 +59,34 @@ def relative_action(heading_in: float, heading_out: float) -> Action:
 
 
 def side_of(heading_travel: float, origin, point) -> str:
-    """'left' or 'right': where ``point`` lies for a traveller at ``origin`` heading ``heading_travel``."""
+    """'left' or 'right': where ``point`` lies seen from ``origin`` facing ``heading_travel``."""
     dx, dy = float(point[0]) - float(origin[0]), float(point[1]) - float(origin[1])
     cross = math.cos(heading_travel) * dy - math.sin(heading_travel) * dx
     return "left" if cross >= 0.0 else "right"
 
 
 def project_points_to_segments(
-    points: np.ndarray, seg_a: np.ndarray, seg_b: np.ndarray, chunk: int = 2048
+    points: np.ndarray, seg_a: np.ndarray, seg_b: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Nearest segment for each point.
 
     points (N,2), seg_a/seg_b (M,2). Returns (index of nearest segment (N,),
-    parameter t in [0,1] along it (N,), distance (N,)). Vectorised, chunked over points.
+    parameter t in [0,1] along it (N,), distance (N,)). Uses an STR-tree, so large
+    maps cost O(N log M).
     """
     points = np.asarray(points, dtype=float).reshape(-1, 2)
     seg_a = np.asarray(seg_a, dtype=float).reshape(-1, 2)
     seg_b = np.asarray(seg_b, dtype=float).reshape(-1, 2)
     n = len(points)
-    idx = np.zeros(n, dtype=int)
-    tt = np.zeros(n)
-    dist = np.full(n, np.inf)
     if n == 0 or len(seg_a) == 0:
-        return idx, tt, dist
-    d = seg_b - seg_a  # (M,2)
-    len2 = np.maximum((d * d).sum(axis=1), 1e-12)  # (M,)
-    for s in range(0, n, chunk):
-        p = points[s : s + chunk, None, :]  # (C,1,2)
-        t = np.clip(((p - seg_a[None]) * d[None]).sum(axis=2) / len2[None], 0.0, 1.0)  # (C,M)
-        proj = seg_a[None] + t[..., None] * d[None]
-        dd = np.linalg.norm(p - proj, axis=2)
-        j = dd.argmin(axis=1)
-        rows = np.arange(len(j))
-        idx[s : s + chunk] = j
-        tt[s : s + chunk] = t[rows, j]
-        dist[s : s + chunk] = dd[rows, j]
-    return idx, tt, dist
+        return np.zeros(n, dtype=int), np.zeros(n), np.full(n, np.inf)
+    lines = shapely.linestrings(np.stack([seg_a, seg_b], axis=1))
+    tree = shapely.STRtree(lines)
+    pairs = tree.query_nearest(shapely.points(points), all_matches=False)
+    idx = np.empty(n, dtype=int)
+    idx[pairs[0]] = pairs[1]
+    a, d = seg_a[idx], seg_b[idx] - seg_a[idx]
+    len2 = np.maximum((d * d).sum(axis=1), 1e-12)
+    t = np.clip(((points - a) * d).sum(axis=1) / len2, 0.0, 1.0)
+    dist = np.linalg.norm(points - (a + t[:, None] * d), axis=1)
+    return idx, t, dist

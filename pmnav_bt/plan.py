@@ -78,7 +78,7 @@ class Plan:
         """Human-readable plan, one step per line."""
         lines = [
             f"Plan in {self.building}: {self.start.description} -> {self.goal} "
-            f"\"{self.goal_name}\" ({self.length:.1f} m, {len(self.steps)} steps, {self.planner})",
+            f'"{self.goal_name}" ({self.length:.1f} m, {len(self.steps)} steps, {self.planner})',
         ]
         first_heading = self.steps[0].heading if self.steps else 0.0
         lines.append(
@@ -106,7 +106,8 @@ class Plan:
             d["predicts"] = {s.predicts[0]: s.predicts[1].value} if s.predicts else None
             d["fork"] = (
                 {"chosen": s.fork.chosen.value, "options": [o.value for o in s.fork.options]}
-                if s.fork else None
+                if s.fork
+                else None
             )
             d["text"] = s.text()
             steps.append(d)

@@ -127,8 +127,15 @@ def build_plan(
         look_for, target = _target_of(pm, route[0], goal_id)
         candidates.append(
             dict(
-                i=0, node=pm.nodes[route[0]], action=Action.ARRIVE, h_in=first_heading,
-                fork=None, is_goal=True, landmark=goal_id, visible=True, target=target,
+                i=0,
+                node=pm.nodes[route[0]],
+                action=Action.ARRIVE,
+                h_in=first_heading,
+                fork=None,
+                is_goal=True,
+                landmark=goal_id,
+                visible=True,
+                target=target,
                 segment=sp.segment.name,
             )
         )
@@ -156,14 +163,22 @@ def build_plan(
             seg_name = sp.segment.name
         candidates.append(
             dict(
-                i=i, node=node, action=action, h_in=h_in, fork=fork, is_goal=is_goal,
+                i=i,
+                node=node,
+                action=action,
+                h_in=h_in,
+                fork=fork,
+                is_goal=is_goal,
                 landmark=goal_id if is_goal else node_id,
-                visible=look_for is not None, target=target, segment=seg_name,
+                visible=look_for is not None,
+                target=target,
+                segment=seg_name,
             )
         )
 
     required = {
-        c["i"] for c in candidates
+        c["i"]
+        for c in candidates
         if c["is_goal"] or c["fork"] is not None or c["action"] is not Action.GO_STRAIGHT
     }
     # The last visible node before each unseen required step predicts it.
@@ -212,8 +227,9 @@ def build_plan(
     room = pm.building.room(goal_id)
     return Plan(
         building=pm.building.name,
-        start=PlanStart(sp.description, sp.segment.name,
-                        (float(start_xy[0]), float(start_xy[1])), sp.heading),
+        start=PlanStart(
+            sp.description, sp.segment.name, (float(start_xy[0]), float(start_xy[1])), sp.heading
+        ),
         goal=goal_id,
         goal_name=room.display_name,
         steps=tuple(steps),

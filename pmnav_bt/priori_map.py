@@ -190,7 +190,7 @@ class PrioriMap:
             seg = self.segments[p.segment - 1]
             extra = f"; aliases: {', '.join(r.aliases)}" if r.aliases else ""
             lines.append(
-                f"- {r.id}: {r.display_name}{extra}; sign \"{r.sign_text}\"; at {p.node}, "
+                f'- {r.id}: {r.display_name}{extra}; sign "{r.sign_text}"; at {p.node}, '
                 f"on the {p.side} of {seg.short} going {seg.a}->{seg.b}"
             )
         if b.landmarks:
@@ -199,7 +199,7 @@ class PrioriMap:
                 p = self.places[lm.id]
                 seg = self.segments[p.segment - 1]
                 lines.append(
-                    f"- {lm.id}: {lm.kind} \"{lm.display_name}\" at {p.node}, "
+                    f'- {lm.id}: {lm.kind} "{lm.display_name}" at {p.node}, '
                     f"on the {p.side} of {seg.short} going {seg.a}->{seg.b}"
                 )
         return "\n".join(lines) + "\n"
@@ -210,30 +210,58 @@ class PrioriMap:
             "building": self.building.name,
             "kind": self.building.kind,
             "nodes": [
-                {"id": n.id, "kind": n.kind, "pos": list(n.pos), "rooms": list(n.rooms),
-                 "landmarks": list(n.landmarks)}
+                {
+                    "id": n.id,
+                    "kind": n.kind,
+                    "pos": list(n.pos),
+                    "rooms": list(n.rooms),
+                    "landmarks": list(n.landmarks),
+                }
                 for n in self.nodes.values()
             ],
             "segments": [
-                {"index": s.index, "name": s.name, "a": s.a, "b": s.b,
-                 "length_m": round(s.length, 3), "heading_deg": round(math.degrees(s.heading), 1),
-                 "compass": compass(s.heading), "corridor": list(s.corridor),
-                 "width_m": s.width}
+                {
+                    "index": s.index,
+                    "name": s.name,
+                    "a": s.a,
+                    "b": s.b,
+                    "length_m": round(s.length, 3),
+                    "heading_deg": round(math.degrees(s.heading), 1),
+                    "compass": compass(s.heading),
+                    "corridor": list(s.corridor),
+                    "width_m": s.width,
+                }
                 for s in self.segments
             ],
             "directions": [
-                {"from": d.a, "to": d.b, "compass": d.compass, "length_m": round(d.length, 3),
-                 "text": d.sentence()}
+                {
+                    "from": d.a,
+                    "to": d.b,
+                    "compass": d.compass,
+                    "length_m": round(d.length, 3),
+                    "text": d.sentence(),
+                }
                 for d in self.directions
             ],
             "rooms": [
-                {"id": r.id, "name": r.display_name, "aliases": list(r.aliases),
-                 "sign": r.sign_text, "door": list(r.door), **_place_dict(self.places[r.id])}
+                {
+                    "id": r.id,
+                    "name": r.display_name,
+                    "aliases": list(r.aliases),
+                    "sign": r.sign_text,
+                    "door": list(r.door),
+                    **_place_dict(self.places[r.id]),
+                }
                 for r in self.building.rooms
             ],
             "landmarks": [
-                {"id": lm.id, "kind": lm.kind, "name": lm.display_name, "pos": list(lm.pos),
-                 **_place_dict(self.places[lm.id])}
+                {
+                    "id": lm.id,
+                    "kind": lm.kind,
+                    "name": lm.display_name,
+                    "pos": list(lm.pos),
+                    **_place_dict(self.places[lm.id]),
+                }
                 for lm in self.building.landmarks
             ],
         }
@@ -277,7 +305,9 @@ def parse_building(b: Building) -> PrioriMap:
     for wid, attached in at_key.items():
         n = nodes[wid]
         nodes[wid] = MapNode(
-            n.id, n.kind, n.pos,
+            n.id,
+            n.kind,
+            n.pos,
             tuple(sorted((i for k, i in attached if k == "room"), key=natural_key)),
             tuple(sorted((i for k, i in attached if k == "landmark"), key=natural_key)),
         )
@@ -305,8 +335,9 @@ def parse_building(b: Building) -> PrioriMap:
         width = b.edge_width(e)
         for u, v in zip(chain, chain[1:], strict=False):
             pu, pv = nodes[u].pos, nodes[v].pos
-            seg = Segment(len(segments) + 1, u, v, math.dist(pu, pv), heading(pu, pv),
-                          (e.a, e.b), width)
+            seg = Segment(
+                len(segments) + 1, u, v, math.dist(pu, pv), heading(pu, pv), (e.a, e.b), width
+            )
             segments.append(seg)
             graph.add_edge(u, v, length=seg.length, segment=seg.index)
 

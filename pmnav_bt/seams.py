@@ -135,8 +135,7 @@ class Base(Protocol):
         """Command a body velocity (m/s, rad/s), clipped to the body's limits."""
         ...
 
-    def motion_status(self) -> MotionStatus:
-        ...
+    def motion_status(self) -> MotionStatus: ...
 
     def stop(self) -> None:
         """Stop at once and drop any step in progress."""
@@ -164,8 +163,7 @@ class Detection:
 class Grounder(Protocol):
     """Text query -> detections in one image."""
 
-    def detect(self, obs: Observation, query: str) -> list[Detection]:
-        ...
+    def detect(self, obs: Observation, query: str) -> list[Detection]: ...
 
 
 @dataclass(frozen=True)
@@ -179,19 +177,16 @@ class View:
 class CoarseDirection(Protocol):
     """Panorama views -> the relative yaw of the view that shows the target, or None."""
 
-    def choose(self, views: list[View], target: str) -> float | None:
-        ...
+    def choose(self, views: list[View], target: str) -> float | None: ...
 
 
 class Refiner(Protocol):
     """Observation + goal pixel/mask -> precise relative heading (rad) to the goal."""
 
-    def refine(self, obs: Observation, goal: Detection) -> float:
-        ...
+    def refine(self, obs: Observation, goal: Detection) -> float: ...
 
 
 class Planner(Protocol):
     """Priori-map + start + goal -> Plan."""
 
-    def plan(self, pm: PrioriMap, start: str, goal: str) -> Plan:
-        ...
+    def plan(self, pm: PrioriMap, start: str, goal: str) -> Plan: ...

@@ -1,0 +1,37 @@
+# Quick start: `make demo` runs the main job on a built-in building; `make test` runs the tests.
+# Both create .venv on first use: torch 2.13.0 (CPU) first, so the project's torch range
+# installs nothing more, then the project with its dev extras.
+
+PY ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+OUT ?= out
+
+.PHONY: setup demo test lint bench clean
+
+setup: $(VENV)/.installed
+
+$(VENV)/.installed: pyproject.toml
+	test -x $(BIN)/python || $(PY) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet torch==2.13.0
+	$(BIN)/pip install --quiet -e ".[dev]"
+	touch $@
+
+demo: setup
+	mkdir -p $(OUT)
+	$(BIN)/pmnav map fig2_hospital --image $(OUT)/fig2_hospital_map.png > $(OUT)/fig2_hospital_map.txt
+	$(BIN)/pmnav plan fig2_hospital --from seg13 --to "One-Stop Service Centre" \
+		--image $(OUT)/fig2_hospital_plan.png
+
+lint: setup
+	$(BIN)/ruff check .
+
+test: lint
+	$(BIN)/pytest -q
+
+bench: setup
+	$(BIN)/python benchmarks/bench_plan.py
+
+clean:
+	rm -rf $(VENV) $(OUT) .pytest_cache .ruff_cache .hypothesis
