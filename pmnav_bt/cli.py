@@ -31,6 +31,13 @@ def _priori_map(file: str):
     return parse_building(load_building(file))
 
 
+def _folder(file: str) -> Path:
+    """The folder a building file's relative paths (floor plan) are resolved against."""
+    from pmnav_bt.building import resolve_building_path
+
+    return resolve_building_path(file).parent
+
+
 @app.command()
 def buildings() -> None:
     """List the built-in buildings."""
@@ -73,7 +80,7 @@ def map_(
     if image is not None:
         from pmnav_bt.annotate import render_annotated_map
 
-        render_annotated_map(pm, path=image)
+        render_annotated_map(pm, path=image, base_dir=_folder(file))
         typer.echo(f"wrote {image}", err=True)
 
 
@@ -99,7 +106,7 @@ def plan(
     if image is not None:
         from pmnav_bt.annotate import render_annotated_map
 
-        render_annotated_map(pm, path=image, path_xy=list(p.path))
+        render_annotated_map(pm, path=image, path_xy=list(p.path), base_dir=_folder(file))
         typer.echo(f"wrote {image}", err=True)
 
 

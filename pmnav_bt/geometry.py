@@ -90,3 +90,47 @@ def project_points_to_segments(
     t = np.clip(((points - a) * d).sum(axis=1) / len2, 0.0, 1.0)
     dist = np.linalg.norm(points - (a + t[:, None] * d), axis=1)
     return idx, t, dist
+
+
+# -- planar rigid transforms, as (x, y, yaw) triples ------------------------------------
+
+
+def se2_compose(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple:
+    """a * b: the pose b expressed in a's parent frame."""
+    ax, ay, ath = a
+    bx, by, bth = b
+    c, s = math.cos(ath), math.sin(ath)
+    return (ax + c * bx - s * by, ay + s * bx + c * by, wrap_angle(ath + bth))
+
+
+def se2_inverse(a: tuple[float, float, float]) -> tuple:
+    """The inverse transform of a."""
+    x, y, th = a
+    c, s = math.cos(th), math.sin(th)
+    return (-c * x - s * y, s * x - c * y, wrap_angle(-th))
+
+
+def se2_apply(a: tuple[float, float, float], p) -> np.ndarray:
+    """Transform point p (x, y) by a."""
+    x, y, th = a
+    c, s = math.cos(th), math.sin(th)
+    return np.array([x + c * float(p[0]) - s * float(p[1]), y + s * float(p[0]) + c * float(p[1])])
+
+
+def fit_se2(src: np.ndarray, dst: np.ndarray) -> tuple[tuple[float, float, float], float]:
+    """Least-squares rigid transform T with T(src_i) ~ dst_i (2D Kabsch), and the RMS residual.
+
+    src, dst: (N, 2) with N >= 2 distinct points.
+    """
+    src = np.asarray(src, dtype=float)
+    dst = np.asarray(dst, dtype=float)
+    cs, cd = src.mean(axis=0), dst.mean(axis=0)
+    a, b = src - cs, dst - cd
+    sxx = float((a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]).sum())
+    sxy = float((a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum())
+    th = math.atan2(sxy, sxx)
+    c, s = math.cos(th), math.sin(th)
+    t = cd - np.array([c * cs[0] - s * cs[1], s * cs[0] + c * cs[1]])
+    tf = (float(t[0]), float(t[1]), th)
+    res = np.array([se2_apply(tf, p) for p in src]) - dst
+    return tf, float(np.sqrt((res**2).sum(axis=1).mean()))

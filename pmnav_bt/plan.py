@@ -37,6 +37,7 @@ class PlanStep:
     segment: str  # name of the segment that arrives at this step
     side: str | None = None  # where the landmark is seen on arrival: left | right | ahead
     target: tuple[float, float] | None = None  # door or landmark position, when visible
+    look_for: str | None = None  # the room or landmark whose sign marks this step
     predicts: tuple[str, Action] | None = None  # the next, unseen step (action prediction)
     fork: ForkChoice | None = None
 

@@ -30,24 +30,49 @@ class GraphPlanner:
 
     name = "graph"
 
-    def plan(self, pm: PrioriMap, start: str | StartPoint, goal: str) -> Plan:
+    def plan(
+        self,
+        pm: PrioriMap,
+        start: str | StartPoint,
+        goal: str,
+        avoid_landmarks: frozenset[str] = frozenset(),
+        blocked_segments: frozenset[int] = frozenset(),
+    ) -> Plan:
+        """Plan from ``start`` to the room ``goal``.
+
+        ``avoid_landmarks``: IDs not to use as intermediate steps (they failed to be
+        found); ``blocked_segments``: segment indices the route must not use.
+        """
         goal_id = resolve_room(pm, goal)
         sp = resolve_start(pm, start) if isinstance(start, str) else start
-        nodes, length, start_xy = shortest_route(pm, sp, pm.places[goal_id].node)
-        return build_plan(pm, sp, goal_id, nodes, length, start_xy, self.max_gap, self.name)
+        graph = pm.graph
+        if blocked_segments:
+            graph = nx.subgraph_view(
+                pm.graph, filter_edge=lambda u, v: graph_segment(pm, u, v) not in blocked_segments
+            )
+        nodes, length, start_xy = shortest_route(pm, sp, pm.places[goal_id].node, graph)
+        return build_plan(
+            pm, sp, goal_id, nodes, length, start_xy, self.max_gap, self.name, avoid_landmarks
+        )
+
+
+def graph_segment(pm: PrioriMap, u: str, v: str) -> int:
+    """Index of the segment between two adjacent nodes."""
+    return pm.graph.edges[u, v]["segment"]
 
 
 def shortest_route(
-    pm: PrioriMap, sp: StartPoint, goal_node: str
+    pm: PrioriMap, sp: StartPoint, goal_node: str, graph: nx.Graph | None = None
 ) -> tuple[list[str], float, np.ndarray]:
     """Nodes from the start point to the goal node, the route length, and the start point."""
+    graph = pm.graph if graph is None else graph
     seg = sp.segment
     a_xy, b_xy = pm.node_xy(seg.a), pm.node_xy(seg.b)
     start_xy = a_xy + sp.t * (b_xy - a_xy)
     best: tuple[float, list[str]] | None = None
     for end, lead in ((seg.a, sp.t * seg.length), (seg.b, (1.0 - sp.t) * seg.length)):
         try:
-            d, path = nx.bidirectional_dijkstra(pm.graph, end, goal_node, weight="length")
+            d, path = nx.bidirectional_dijkstra(graph, end, goal_node, weight="length")
         except nx.NetworkXNoPath:
             continue
         total = lead + d
@@ -79,16 +104,20 @@ def _side(heading_in: float, at: np.ndarray, target) -> str:
     return "left" if bearing > 0 else "right"
 
 
-def _target_of(pm: PrioriMap, node_id: str, goal_id: str) -> tuple[str | None, object]:
-    """What to look for at a node (room or landmark id) and its position."""
+def _target_of(
+    pm: PrioriMap, node_id: str, goal_id: str, avoid: frozenset[str] = frozenset()
+) -> tuple[str | None, object]:
+    """What to look for at a node (room or landmark id) and its position, or (None, None)."""
     n = pm.nodes[node_id]
     b = pm.building
     if goal_id in n.rooms:
         return goal_id, b.room(goal_id).door
-    if n.rooms:
-        return n.rooms[0], b.room(n.rooms[0]).door
-    if n.landmarks:
-        return n.landmarks[0], b.landmark(n.landmarks[0]).pos
+    for rid in n.rooms:
+        if rid not in avoid:
+            return rid, b.room(rid).door
+    for lid in n.landmarks:
+        if lid not in avoid:
+            return lid, b.landmark(lid).pos
     return None, None
 
 
@@ -101,6 +130,7 @@ def build_plan(
     start_xy: np.ndarray,
     max_gap: float,
     planner: str,
+    avoid_landmarks: frozenset[str] = frozenset(),
 ) -> Plan:
     """Turn a node route into plan steps (actions, predictions, forks, sides)."""
     pts = [start_xy] + [pm.node_xy(n) for n in nodes]
@@ -135,6 +165,7 @@ def build_plan(
                 is_goal=True,
                 landmark=goal_id,
                 visible=True,
+                look_for=goal_id,
                 target=target,
                 segment=sp.segment.name,
             )
@@ -155,7 +186,7 @@ def build_plan(
                 if nb not in (prev, route[i + 1])
             ]
             fork = ForkChoice(action, tuple(others))
-        look_for, target = _target_of(pm, node_id, goal_id)
+        look_for, target = _target_of(pm, node_id, goal_id, avoid_landmarks)
         prev_node = route[i - 1] if route[i - 1] is not None else None
         if prev_node is not None and pm.graph.has_edge(prev_node, node_id):
             seg_name = pm.segments[pm.graph.edges[prev_node, node_id]["segment"] - 1].name
@@ -171,6 +202,7 @@ def build_plan(
                 is_goal=is_goal,
                 landmark=goal_id if is_goal else node_id,
                 visible=look_for is not None,
+                look_for=look_for,
                 target=target,
                 segment=seg_name,
             )
@@ -219,6 +251,7 @@ def build_plan(
                 segment=c["segment"],
                 side=_side(c["h_in"], pts[i], c["target"]) if c["visible"] else None,
                 target=tuple(float(v) for v in c["target"]) if c["visible"] else None,
+                look_for=c["look_for"],
                 predicts=(pred["landmark"], pred["action"]) if pred else None,
                 fork=c["fork"],
             )

@@ -118,3 +118,30 @@ def resolve_start(pm: PrioriMap, spec: str) -> StartPoint:
         f"or a pose 'x,y[,yaw_deg]'{hint}",
         close,
     )
+
+
+def entity_index(building) -> dict[str, str]:
+    """Normalised sign text / name / ID / alias -> 'room:<id>' or 'landmark:<id>'.
+
+    The first entity to claim a name keeps it (rooms before landmarks).
+    """
+    cached = building.__dict__.get("_entity_index")
+    if cached is not None:
+        return cached
+    index: dict[str, str] = {}
+    for r in building.rooms:
+        for n in (r.id, r.name, r.sign_text, *r.aliases):
+            if n and normalise(n):
+                index.setdefault(normalise(n), f"room:{r.id}")
+    for lm in building.landmarks:
+        for n in (lm.id, lm.name, lm.sign, *lm.aliases):
+            if n and normalise(n):
+                index.setdefault(normalise(n), f"landmark:{lm.id}")
+    building.__dict__["_entity_index"] = index
+    return index
+
+
+def entity_position(building, entity: str) -> tuple[float, float]:
+    """Map position of 'room:<id>' (its door) or 'landmark:<id>'."""
+    kind, ident = entity.split(":", 1)
+    return building.room(ident).door if kind == "room" else building.landmark(ident).pos
