@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from itertools import pairwise
 
 import networkx as nx
 import numpy as np
@@ -92,7 +93,7 @@ def shortest_route(
 
 def _route_length(pm: PrioriMap, start_xy: np.ndarray, nodes: list[str]) -> float:
     pts = [start_xy] + [pm.node_xy(n) for n in nodes]
-    return float(sum(np.linalg.norm(q - p) for p, q in zip(pts, pts[1:], strict=False)))
+    return float(sum(np.linalg.norm(q - p) for p, q in pairwise(pts)))
 
 
 def _side(heading_in: float, at: np.ndarray, target) -> str:

@@ -15,6 +15,7 @@ import math
 import re
 from dataclasses import dataclass, field
 from functools import cached_property
+from itertools import pairwise
 
 import networkx as nx
 import numpy as np
@@ -333,7 +334,7 @@ def parse_building(b: Building) -> PrioriMap:
             chain.append(node_id)
         chain.append(e.b)
         width = b.edge_width(e)
-        for u, v in zip(chain, chain[1:], strict=False):
+        for u, v in pairwise(chain):
             pu, pv = nodes[u].pos, nodes[v].pos
             seg = Segment(
                 len(segments) + 1, u, v, math.dist(pu, pv), heading(pu, pv), (e.a, e.b), width

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from itertools import pairwise
 
 import pytest
 
@@ -35,7 +36,7 @@ def test_unseen_steps_are_never_the_only_warning(fig2_map, loop_map):
     # Every unseen turn/fork is predicted by the visible step just before it, when one exists.
     for pm, start, goal in ((fig2_map, "start", "room21"), (loop_map, "start", "room10")):
         steps = planner.plan(pm, start, goal).steps
-        for prev, s in zip(steps, steps[1:], strict=False):
+        for prev, s in pairwise(steps):
             if not s.visible and prev.visible:
                 assert prev.predicts == (s.landmark, s.action)
 
@@ -170,3 +171,32 @@ def test_loop_takes_the_shorter_way_round(loop_map):
     # room13 (Art Room, east side) from the west side: round the north, not the south.
     p = planner.plan(loop_map, "seg16", "room13")
     assert "branch2" in p.nodes and "branch1" not in p.nodes
+
+
+def test_avoided_landmarks_are_not_used_as_steps(fig2_map):
+    p = planner.plan(fig2_map, "seg13", "room17")
+    assert any(s.look_for == "room8" for s in p.steps)
+    q = planner.plan(fig2_map, "seg13", "room17", avoid_landmarks=frozenset({"room8"}))
+    assert all(s.look_for != "room8" for s in q.steps)
+    # turn2 is then predicted by the visible landmark before room8
+    pred = next(s for s in q.steps if s.predicts and s.predicts[0] == "turn2")
+    assert pred.look_for in ("room7", "room15")
+
+
+def test_the_goal_is_never_avoided(fig2_map):
+    q = planner.plan(fig2_map, "seg13", "room17", avoid_landmarks=frozenset({"room17"}))
+    assert q.steps[-1].look_for == "room17"
+
+
+def test_blocked_segments_are_routed_around(loop_map):
+    p = planner.plan(loop_map, "seg16", "room13")
+    used = {loop_map.graph.edges[u, v]["segment"] for u, v in pairwise(p.nodes)}
+    q = planner.plan(loop_map, "seg16", "room13", blocked_segments=frozenset(used))
+    assert q.length > p.length and "branch1" in q.nodes
+
+
+def test_no_route_is_a_planning_error(fig2_map):
+    from pmnav_bt.errors import PlanningError
+
+    with pytest.raises(PlanningError):
+        planner.plan(fig2_map, "seg13", "room17", blocked_segments=frozenset({14, 12}))

@@ -4,6 +4,7 @@ and no shorter walk exists (checked against an independent shortest-path computa
 from __future__ import annotations
 
 import math
+from itertools import pairwise
 
 import networkx as nx
 import numpy as np
@@ -77,7 +78,7 @@ def independent_distance(b: Building, start_xy, goal_xy) -> float:
             if -EPS <= t <= 1 + EPS and np.linalg.norm(a + t * d - r) < 1e-6:
                 on.append((t, name))
         on.sort()
-        for (t0, u), (t1, v) in zip(on, on[1:], strict=False):
+        for (t0, u), (t1, v) in pairwise(on):
             w = (t1 - t0) * float(np.linalg.norm(d))
             if u != v and (not g.has_edge(u, v) or g.edges[u, v]["w"] > w):
                 g.add_edge(u, v, w=w)
@@ -105,13 +106,13 @@ def test_plans_are_shortest_valid_walks_to_the_target(b, data):
     plan = GraphPlanner().plan(pm, start, goal)
 
     # A valid walk: each move runs along one corridor of the building file.
-    for p, q in zip(plan.path, plan.path[1:], strict=False):
+    for p, q in pairwise(plan.path):
         assert on_corridor(b, p, q), (p, q)
     # It ends at the target's room waypoint (the door's projection on its corridor).
     assert plan.nodes[-1] == pm.places[goal].node
     assert plan.steps[-1].landmark == goal and plan.steps[-1].action.value == "arrive"
     # Its length is the length of the polyline, and no shorter walk exists.
-    poly = sum(math.dist(p, q) for p, q in zip(plan.path, plan.path[1:], strict=False))
+    poly = sum(math.dist(p, q) for p, q in pairwise(plan.path))
     assert math.isclose(plan.length, poly, abs_tol=1e-6)
     best = independent_distance(b, plan.start.position, pm.nodes[plan.nodes[-1]].pos)
     assert math.isclose(plan.length, best, rel_tol=1e-9, abs_tol=1e-6), (plan.length, best)

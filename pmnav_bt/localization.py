@@ -1,0 +1,86 @@
+"""Localization from landmarks (paper, "Localization"): two recognised landmarks fix the pose.
+
+Each sighting pairs a landmark's known map position with where it was seen, in the
+odometry frame. Two or more distinct landmarks give the rigid transform
+``map_T_odom`` (2D least squares); sightings that do not fit the map (a misread
+sign, a false detection) are dropped by trying every consistent subset.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose
+from pmnav_bt.perception.geometry import target_point
+from pmnav_bt.resolve import entity_index, entity_position, normalise
+from pmnav_bt.seams import Detection, Observation, Pose2D
+
+MAX_RESIDUAL = 0.8  # metres (RMS) for a set of sightings to count as consistent
+
+
+@dataclass(frozen=True)
+class Sighting:
+    """A landmark seen: which one, its map position, and where it was seen (odom frame)."""
+
+    entity: str
+    map_xy: tuple[float, float]
+    odom_xy: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Fix:
+    """A localization result: map_T_odom, the landmarks used and the fit residual."""
+
+    map_T_odom: tuple[float, float, float]
+    entities: tuple[str, ...]
+    residual: float
+
+    def map_pose(self, odom: Pose2D) -> Pose2D:
+        x, y, yaw = se2_compose(self.map_T_odom, (odom.x, odom.y, odom.yaw))
+        return Pose2D(x, y, yaw)
+
+
+def sighting(
+    building, obs: Observation, det: Detection, entity: str | None = None
+) -> Sighting | None:
+    """A sighting from a detection, if its label names a map entity and depth gives its range."""
+    if entity is None:
+        entity = entity_index(building).get(normalise(det.label))
+    if entity is None:
+        return None
+    p = target_point(obs, det)
+    if p is None:
+        return None
+    odom = se2_apply((obs.pose.x, obs.pose.y, obs.pose.yaw), p)
+    m = entity_position(building, entity)
+    return Sighting(entity, (float(m[0]), float(m[1])), (float(odom[0]), float(odom[1])))
+
+
+def fix_pose(sightings: list[Sighting], max_residual: float = MAX_RESIDUAL) -> Fix | None:
+    """The best consistent fix from at least two distinct landmarks, or None."""
+    by_entity: dict[str, list[Sighting]] = {}
+    for s in sightings:
+        by_entity.setdefault(s.entity, []).append(s)
+    # One averaged sighting per landmark.
+    merged = [
+        Sighting(e, ss[0].map_xy, tuple(np.mean([s.odom_xy for s in ss], axis=0)))
+        for e, ss in by_entity.items()
+    ]
+    if len(merged) < 2:
+        return None
+    best: Fix | None = None
+    for k in range(len(merged), 1, -1):
+        for subset in itertools.combinations(merged, k):
+            src = np.array([s.odom_xy for s in subset])
+            dst = np.array([s.map_xy for s in subset])
+            if np.linalg.norm(dst.max(axis=0) - dst.min(axis=0)) < 0.5:
+                continue  # landmarks too close together to fix a heading
+            tf, res = fit_se2(src, dst)
+            if res <= max_residual and (best is None or res < best.residual):
+                best = Fix(tf, tuple(sorted(s.entity for s in subset)), res)
+        if best is not None:
+            return best  # the largest consistent set wins
+    return None

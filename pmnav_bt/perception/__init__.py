@@ -1,0 +1,1 @@
+"""Perception back ends behind the seams: grounders, coarse direction, refiners, corner checks."""
