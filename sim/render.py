@@ -1,0 +1,241 @@
+"""Images of a SimWorld: first-person camera frames (tiny renderer) and a drawn top-down map."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import cv2
+import numpy as np
+import pybullet as p
+
+from pmnav_bt.seams import CameraIntrinsics, Pose2D
+from pmnav_bt.sim.world import LIGHT_AMBIENT, LIGHT_DIFFUSE, LIGHT_DIRECTION
+
+if TYPE_CHECKING:  # pragma: no cover
+    from pmnav_bt.sim.world import SimWorld
+
+NEAR = 0.05  # clipping planes, metres
+FAR = 100.0
+# The tiny renderer never returns when the eye lies (to float32 precision) in the plane of a
+# face, which round teleport poses easily hit (a camera at x = -1.3 beside a wall face at
+# x = -1.3). The eye is therefore moved by this sub-millimetre offset, off all round numbers.
+EYE_JITTER = (1.37e-4, 1.71e-4, 1.13e-4)
+
+
+@dataclass
+class Frame:
+    """One camera frame: RGB, depth along the optical axis (m), label-id segmentation."""
+
+    rgb: np.ndarray  # (H, W, 3) uint8
+    depth: np.ndarray | None  # (H, W) float32
+    segmentation: np.ndarray | None  # (H, W) int32 label ids (SimWorld.labels)
+
+
+def linearise_depth(zbuf: np.ndarray, near: float = NEAR, far: float = FAR) -> np.ndarray:
+    """OpenGL z-buffer values in [0, 1] -> metric depth along the optical axis."""
+    z = np.asarray(zbuf, np.float64)
+    return (far * near / (far - (far - near) * z)).astype(np.float32)
+
+
+def render_camera(
+    world: SimWorld,
+    x: float,
+    y: float,
+    yaw: float,
+    intrinsics: CameraIntrinsics,
+    *,
+    height: float = 1.6,
+    pitch: float = 0.0,
+    depth: bool = True,
+    segmentation: bool = True,
+) -> Frame:
+    """Render the view of a camera at (x, y, height) looking along ``yaw`` (tilted by ``pitch``).
+
+    Uses pybullet's headless tiny renderer, under the world's lock.
+    """
+    w, h = intrinsics.width, intrinsics.height
+    vfov = 2.0 * math.atan((h / 2.0) / intrinsics.fy)
+    fwd = (math.cos(yaw) * math.cos(pitch), math.sin(yaw) * math.cos(pitch), math.sin(pitch))
+    jx, jy, jz = EYE_JITTER
+    eye = (x + jx, y + jy, height + jz)
+    target = (eye[0] + fwd[0], eye[1] + fwd[1], eye[2] + fwd[2])
+    flags = 0 if segmentation else p.ER_NO_SEGMENTATION_MASK
+    with world.lock:
+        c = world.client
+        view = p.computeViewMatrix(eye, target, (0.0, 0.0, 1.0), physicsClientId=c)
+        proj = p.computeProjectionMatrixFOV(math.degrees(vfov), w / h, NEAR, FAR, physicsClientId=c)
+        _, _, rgba, zbuf, seg = p.getCameraImage(
+            w,
+            h,
+            view,
+            proj,
+            shadow=0,
+            lightDirection=LIGHT_DIRECTION,
+            lightAmbientCoeff=LIGHT_AMBIENT,
+            lightDiffuseCoeff=LIGHT_DIFFUSE,
+            lightSpecularCoeff=0.0,
+            renderer=p.ER_TINY_RENDERER,
+            flags=flags,
+            physicsClientId=c,
+        )
+        labels = (
+            world.segmentation_to_labels(np.asarray(seg).reshape(h, w)) if segmentation else None
+        )
+    rgb = np.ascontiguousarray(np.asarray(rgba, np.uint8).reshape(h, w, 4)[:, :, :3])
+    d = linearise_depth(np.asarray(zbuf).reshape(h, w)) if depth else None
+    return Frame(rgb, d, labels)
+
+
+# -- false colour ------------------------------------------------------------------------
+
+
+def colorize_depth(depth: np.ndarray, max_m: float = 15.0) -> np.ndarray:
+    """Depth (m) -> RGB with the turbo colormap: near red, far (``max_m`` and beyond) dark blue."""
+    d = np.clip(np.nan_to_num(depth, nan=max_m) / max_m, 0.0, 1.0)
+    img = cv2.applyColorMap(((1.0 - d) * 255).astype(np.uint8), cv2.COLORMAP_TURBO)
+    return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
+
+
+def label_colour(label: str) -> tuple[int, int, int]:
+    """A fixed RGB colour per label (kind colours for the fixed labels, hashed otherwise)."""
+    fixed = {
+        "background": (0, 0, 0),
+        "floor": (90, 90, 160),
+        "wall": (200, 200, 200),
+        "ceiling": (120, 120, 120),
+        "obstacle": (255, 120, 0),
+        "robot": (255, 0, 255),
+    }
+    if label in fixed:
+        return fixed[label]
+    h = sum((i + 1) * ord(ch) for i, ch in enumerate(label))
+    base = {"door": (150, 80, 20), "sign": (0, 200, 60), "landmark": (220, 40, 40)}
+    r, g, b = base.get(label.split(":")[0], (200, 200, 0))
+    jitter = (h * 37) % 70 - 35
+    return tuple(int(np.clip(v + jitter, 0, 255)) for v in (r, g, b))  # type: ignore[return-value]
+
+
+def colorize_segmentation(seg: np.ndarray, labels: dict[int, str]) -> np.ndarray:
+    """Label-id image -> RGB."""
+    lut = np.zeros((max(labels, default=0) + 1, 3), np.uint8)
+    for i, name in labels.items():
+        lut[i] = label_colour(name)
+    return lut[np.clip(seg, 0, len(lut) - 1)]
+
+
+def annotate_labels(rgb: np.ndarray, seg: np.ndarray, labels: dict[int, str]) -> np.ndarray:
+    """Write each door/sign/landmark label at its region's centre (for a person to check)."""
+    out = rgb.copy()
+    for i in np.unique(seg):
+        name = labels.get(int(i), "")
+        if ":" not in name:
+            continue
+        ys, xs = np.nonzero(seg == i)
+        if len(xs) < 30:
+            continue
+        org = (int(xs.mean()) - 4 * len(name), int(ys.mean()))
+        cv2.putText(out, name, org, cv2.FONT_HERSHEY_SIMPLEX, 0.4, (255, 255, 255), 2)
+        cv2.putText(out, name, org, cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1)
+    return out
+
+
+# -- top-down map --------------------------------------------------------------------------
+
+
+def draw_top_down(
+    world: SimWorld,
+    pose: Pose2D | None = None,
+    *,
+    px_per_m: float = 20.0,
+    hfov: float = math.radians(60.0),
+    margin_m: float = 3.0,
+) -> np.ndarray:
+    """A labelled plan of the world (RGB, north up): corridors, walls, doors, signs,
+    landmarks, waypoints, obstacles and the robot with its field of view."""
+    x0, y0, x1, y1 = world.bounds(margin=margin_m)
+    w = int(math.ceil((x1 - x0) * px_per_m))
+    h = int(math.ceil((y1 - y0) * px_per_m))
+    img = np.full((h, w, 3), (60, 60, 60), np.uint8)
+
+    def px(pt) -> tuple[int, int]:
+        return int(round((pt[0] - x0) * px_per_m)), int(round((y1 - pt[1]) * px_per_m))
+
+    def text(s: str, at, colour=(0, 0, 0), scale=0.4) -> None:
+        cv2.putText(img, s, at, cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), 3, cv2.LINE_AA)
+        cv2.putText(img, s, at, cv2.FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv2.LINE_AA)
+
+    polys = getattr(world.free_space, "geoms", [world.free_space])
+    for poly in polys:
+        cv2.fillPoly(
+            img, [np.array([px(q) for q in poly.exterior.coords], np.int32)], (205, 210, 225)
+        )
+        for ring in poly.interiors:
+            cv2.fillPoly(img, [np.array([px(q) for q in ring.coords], np.int32)], (60, 60, 60))
+    thick = max(2, int(round(0.1 * px_per_m)))
+    for wall in world.walls:
+        cv2.line(img, px(wall.a), px(wall.b), (235, 225, 190), thick)
+
+    b = world.building
+    pos = {wp.id: wp.pos for wp in b.waypoints}
+    for e in b.edges:
+        cv2.line(img, px(pos[e.a]), px(pos[e.b]), (150, 150, 170), 1, cv2.LINE_AA)
+    for wp in b.waypoints:
+        cv2.circle(img, px(wp.pos), 4, (40, 40, 200), -1)
+        q = px(wp.pos)
+        text(f"{wp.id} ({wp.kind.value})", (q[0] + 5, q[1] - 5), (40, 40, 200))
+
+    def mark(item, colour, half_depth: float) -> None:
+        n = np.asarray(item.normal)
+        t = np.array([-n[1], n[0]])
+        c = np.asarray(item.centre)
+        corners = [
+            c + t * item.width / 2,
+            c - t * item.width / 2,
+            c - t * item.width / 2 + n * half_depth,
+            c + t * item.width / 2 + n * half_depth,
+        ]
+        cv2.fillPoly(img, [np.array([px(q) for q in corners], np.int32)], colour)
+
+    for rid, door in world.doors.items():
+        mark(door, (150, 90, 40), 0.25)
+        n = np.asarray(door.normal)
+        q = px(np.asarray(door.centre) - n * 0.9)
+        text(rid, (q[0] - 4 * len(rid), q[1] + 4), (120, 60, 20))
+    for sign in world.signs.values():
+        mark(sign, (0, 170, 60), 0.15)
+    for lid, lm in world.landmarks.items():
+        mark(lm, (200, 40, 40), 0.5)
+        n = np.asarray(lm.normal)
+        q = px(np.asarray(lm.centre) - n * 1.4)
+        text(f"{lid} [{lm.kind}]", (q[0] - 3 * len(lid), q[1] + 4), (170, 20, 20))
+    for sign in world.landmark_signs.values():
+        mark(sign, (0, 170, 60), 0.15)
+    for ox, oy, size in world.obstacles.values():
+        cv2.rectangle(
+            img,
+            px((ox - size / 2, oy + size / 2)),
+            px((ox + size / 2, oy - size / 2)),
+            (255, 120, 0),
+            -1,
+        )
+
+    if pose is not None:
+        c = px((pose.x, pose.y))
+        r = max(3, int(round(0.17 * px_per_m)))
+        reach = 4.0
+        for s in (-1, 1):
+            end = (
+                pose.x + reach * math.cos(pose.yaw + s * hfov / 2),
+                pose.y + reach * math.sin(pose.yaw + s * hfov / 2),
+            )
+            cv2.line(img, c, px(end), (255, 0, 255), 1, cv2.LINE_AA)
+        cv2.circle(img, c, r, (255, 0, 255), -1)
+        tip = (pose.x + 0.5 * math.cos(pose.yaw), pose.y + 0.5 * math.sin(pose.yaw))
+        cv2.line(img, c, px(tip), (0, 0, 0), 2, cv2.LINE_AA)
+    title = f"{b.name} ({b.kind})   1 m = {px_per_m:g} px"
+    cv2.putText(
+        img, title, (8, 20), cv2.FONT_HERSHEY_SIMPLEX, 0.55, (255, 255, 255), 1, cv2.LINE_AA
+    )
+    return img

@@ -1,0 +1,313 @@
+"""The simulated robot: a Create 3 sized differential-drive body with a 1.6 m camera.
+
+``SimBase`` implements the ``pmnav_bt.seams.Base`` seam. Motion is kinematic: each
+clock tick moves the body at the speed limits (discrete steps) or at the commanded
+velocity, and a translation that would make the body's cylinder touch a wall,
+door, landmark or obstacle is cut at the contact point (bisection to 0.1 mm), which
+ends the motion as BLOCKED. A collision event is counted once, when the body first
+touches something; it ends when the body is 1 cm clear again. Turning in place never
+collides (the body is a round cylinder).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pybullet as p
+
+from pmnav_bt.seams import (
+    FORWARD_STEP_M,
+    TURN_STEP_RAD,
+    CameraIntrinsics,
+    DiscreteAction,
+    MotionStatus,
+    Observation,
+    Pose2D,
+)
+from pmnav_bt.sim.clock import SimClock
+from pmnav_bt.sim.render import render_camera
+from pmnav_bt.sim.world import ROBOT, SimWorld
+
+MAX_LINEAR = 0.306  # m/s, iRobot Create 3
+MAX_ANGULAR = 1.9  # rad/s
+RADIUS = 0.17  # m
+COLLISION_HEIGHT = 1.7  # the body with its camera mast, for collisions
+CAMERA_HEIGHT = 1.6  # m (paper)
+HFOV = math.radians(60.0)  # horizontal field of view (paper)
+CONTACT_CLEAR = 0.01  # a collision event ends once the body is this far from everything
+_BISECT_TOL = 1e-4
+
+
+def _wrap(a: float) -> float:
+    return math.atan2(math.sin(a), math.cos(a))
+
+
+@dataclass
+class MotionStats:
+    """What the body has done: metres driven, radians turned, collision events, actions."""
+
+    path_length: float = 0.0
+    rotation: float = 0.0
+    collisions: int = 0
+    actions: int = 0
+
+
+class SimBase:
+    """A simulated Create 3 in a SimWorld, driven by a SimClock (``pmnav_bt.seams.Base``).
+
+    ``width``/``height``/``hfov`` set the camera; ``depth``/``segmentation`` choose what
+    ``observe`` renders besides RGB. The body starts at ``pose`` (default: the world's
+    start pose).
+    """
+
+    def __init__(
+        self,
+        world: SimWorld,
+        clock: SimClock | None = None,
+        *,
+        pose: Pose2D | None = None,
+        width: int = 320,
+        height: int = 240,
+        hfov: float = HFOV,
+        camera_height: float = CAMERA_HEIGHT,
+        depth: bool = True,
+        segmentation: bool = True,
+        radius: float = RADIUS,
+        max_linear: float = MAX_LINEAR,
+        max_angular: float = MAX_ANGULAR,
+    ) -> None:
+        self.world = world
+        self.clock = clock if clock is not None else SimClock()
+        self.intrinsics = CameraIntrinsics.from_hfov(width, height, hfov)
+        self.camera_height = camera_height
+        self.render_depth = depth
+        self.render_segmentation = segmentation
+        self.radius = radius
+        self.max_linear = max_linear
+        self.max_angular = max_angular
+        self.stats = MotionStats()
+        self._pose = pose if pose is not None else world.start_pose()
+        self._status = MotionStatus.IDLE
+        self._step: DiscreteAction | None = None
+        self._remaining = 0.0
+        self._cmd = (0.0, 0.0)
+        self._in_contact = False
+        with world.lock:
+            vis = p.createVisualShape(
+                p.GEOM_CYLINDER,
+                radius=radius,
+                length=0.09,
+                rgbaColor=(0.85, 0.85, 0.85, 1.0),
+                physicsClientId=world.client,
+            )
+            self.body = p.createMultiBody(0.0, -1, vis, (0, 0, 0.045), physicsClientId=world.client)
+            world.register(self.body, ROBOT, solid=False)
+        self._sync_body()
+        self.clock.add_listener(self._advance)
+
+    # -- Base seam --------------------------------------------------------------------------
+
+    def observe(self) -> Observation:
+        """Render the camera now (RGB, and depth/segmentation if enabled)."""
+        return self.render_view(0.0)
+
+    def pose(self) -> Pose2D:
+        """Odometry pose (sim ground truth)."""
+        return self._pose
+
+    def step(self, action: DiscreteAction) -> None:
+        """Start a discrete step (replaces any motion in progress)."""
+        action = DiscreteAction(action)
+        with self.world.lock:
+            self.stats.actions += 1
+            self._cmd = (0.0, 0.0)
+            if action == DiscreteAction.STOP:
+                self._step = None
+                self._status = MotionStatus.IDLE
+                return
+            self._step = action
+            self._remaining = FORWARD_STEP_M if action == DiscreteAction.FORWARD else TURN_STEP_RAD
+            self._status = MotionStatus.MOVING
+
+    def set_velocity(self, linear: float, angular: float) -> None:
+        """Command a body velocity, clipped to the limits; it holds until changed or blocked."""
+        v = max(-self.max_linear, min(self.max_linear, float(linear)))
+        w = max(-self.max_angular, min(self.max_angular, float(angular)))
+        with self.world.lock:
+            self._step = None
+            self._cmd = (v, w)
+            self._status = MotionStatus.MOVING if (v or w) else MotionStatus.IDLE
+
+    def motion_status(self) -> MotionStatus:
+        return self._status
+
+    def stop(self) -> None:
+        with self.world.lock:
+            self._step = None
+            self._cmd = (0.0, 0.0)
+            self._status = MotionStatus.IDLE
+
+    # -- helpers for runners, tests and the oracle ------------------------------------------
+
+    @property
+    def velocity_command(self) -> tuple[float, float]:
+        """The (clipped) velocity command in force."""
+        return self._cmd
+
+    def set_pose(self, pose: Pose2D) -> None:
+        """Teleport the body (drops any motion; does not count as driving)."""
+        with self.world.lock:
+            self._pose = Pose2D(float(pose.x), float(pose.y), _wrap(float(pose.yaw)))
+            self._step = None
+            self._cmd = (0.0, 0.0)
+            self._status = MotionStatus.IDLE
+            self._in_contact = False
+            self._sync_body()
+
+    def execute(self, action: DiscreteAction, timeout: float = 30.0) -> MotionStatus:
+        """Run one discrete step to its end, advancing the clock; the final status."""
+        self.step(action)
+        t_end = self.clock.now() + timeout
+        while self._status == MotionStatus.MOVING and self.clock.now() < t_end:
+            self.clock.wait(self.clock.tick)
+        return self._status
+
+    def step_duration(self, action: DiscreteAction) -> float:
+        """Seconds an unobstructed discrete step takes at the speed limits."""
+        action = DiscreteAction(action)
+        if action == DiscreteAction.FORWARD:
+            return FORWARD_STEP_M / self.max_linear
+        if action in (DiscreteAction.TURN_LEFT, DiscreteAction.TURN_RIGHT):
+            return TURN_STEP_RAD / self.max_angular
+        return 0.0
+
+    def render_view(
+        self,
+        yaw_offset: float = 0.0,
+        pose: Pose2D | None = None,
+        *,
+        depth: bool | None = None,
+        segmentation: bool | None = None,
+    ) -> Observation:
+        """Render the camera turned by ``yaw_offset`` (rad, left positive) from ``pose``
+        (default: the current pose). The observation's pose is the body pose, not the
+        camera's; safe to call from a worker thread (for panoramas)."""
+        body = pose if pose is not None else self._pose
+        stamp = self.clock.now()
+        with self.world.lock:
+            labels = dict(self.world.labels)
+        frame = render_camera(
+            self.world,
+            body.x,
+            body.y,
+            body.yaw + yaw_offset,
+            self.intrinsics,
+            height=self.camera_height,
+            depth=self.render_depth if depth is None else depth,
+            segmentation=self.render_segmentation if segmentation is None else segmentation,
+        )
+        return Observation(
+            rgb=frame.rgb,
+            pose=body,
+            stamp=stamp,
+            intrinsics=self.intrinsics,
+            depth=frame.depth,
+            segmentation=frame.segmentation,
+            labels=labels,
+            camera_height=self.camera_height,
+        )
+
+    def close(self) -> None:
+        """Detach from the clock (the world is closed by its owner)."""
+        if self._advance in self.clock._listeners:
+            self.clock.remove_listener(self._advance)
+
+    # -- motion integration -------------------------------------------------------------------
+
+    def _advance(self, h: float) -> None:
+        """Clock listener: integrate ``h`` seconds of motion."""
+        with self.world.lock:
+            if self._step is not None:
+                self._advance_step(h)
+            elif self._cmd != (0.0, 0.0):
+                v, w = self._cmd
+                self._rotate(w * h / 2.0)
+                want = v * h
+                moved = self._translate(want)
+                self._rotate(w * h / 2.0)
+                if abs(moved) < abs(want) - 1e-12:
+                    self._cmd = (0.0, 0.0)
+                    self._status = MotionStatus.BLOCKED
+            else:
+                return
+            self._sync_body()
+
+    def _advance_step(self, h: float) -> None:
+        if self._step == DiscreteAction.FORWARD:
+            want = min(self.max_linear * h, self._remaining)
+            moved = self._translate(want)
+            self._remaining -= moved
+            if moved < want - 1e-12:
+                self._step = None
+                self._status = MotionStatus.BLOCKED
+                return
+        else:
+            da = min(self.max_angular * h, self._remaining)
+            self._rotate(da if self._step == DiscreteAction.TURN_LEFT else -da)
+            self._remaining -= da
+        if self._remaining <= 1e-9:
+            self._step = None
+            self._status = MotionStatus.IDLE
+
+    def _rotate(self, da: float) -> None:
+        if da:
+            q = self._pose
+            self._pose = Pose2D(q.x, q.y, _wrap(q.yaw + da))
+            self.stats.rotation += abs(da)
+
+    def _clearance(self, x: float, y: float) -> float:
+        return self.world.clearance(x, y, self.radius, COLLISION_HEIGHT)
+
+    def _translate(self, ds: float) -> float:
+        """Move ``ds`` metres along the heading, stopping at contact; the signed distance moved."""
+        if ds == 0.0:
+            return 0.0
+        q = self._pose
+        cx, cy = math.cos(q.yaw), math.sin(q.yaw)
+        d_new = self._clearance(q.x + ds * cx, q.y + ds * cy)
+        if d_new >= 0.0:
+            frac = 1.0
+        else:
+            d_now = self._clearance(q.x, q.y)
+            if d_now < 0.0 and d_new > d_now:  # already inside something: let it back out
+                frac = 1.0
+            else:
+                lo, hi = 0.0, 1.0  # lo is free, hi touches
+                while (hi - lo) * abs(ds) > _BISECT_TOL:
+                    mid = (lo + hi) / 2.0
+                    if self._clearance(q.x + mid * ds * cx, q.y + mid * ds * cy) >= 0.0:
+                        lo = mid
+                    else:
+                        hi = mid
+                frac = lo
+                if not self._in_contact:
+                    self.stats.collisions += 1
+                    self._in_contact = True
+        moved = frac * ds
+        if moved:
+            self._pose = Pose2D(q.x + moved * cx, q.y + moved * cy, q.yaw)
+            self.stats.path_length += abs(moved)
+            if frac == 1.0 and d_new > CONTACT_CLEAR:
+                self._in_contact = False
+        return moved
+
+    def _sync_body(self) -> None:
+        q = self._pose
+        with self.world.lock:
+            p.resetBasePositionAndOrientation(
+                self.body,
+                (q.x, q.y, 0.045),
+                p.getQuaternionFromEuler((0.0, 0.0, q.yaw)),
+                physicsClientId=self.world.client,
+            )

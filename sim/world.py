@@ -1,0 +1,788 @@
+"""Build a pybullet world from a Building: floor, ceiling, corridor walls, doors, signs, landmarks.
+
+The free space is the union of the corridor rectangles (each corridor buffered by half
+its width with square ends, so dead ends close half a width beyond the end waypoint
+and corners are square); walls are thin boxes extruded outwards from every edge of
+that polygon, so junctions stay open. Doors, sign plates and landmarks are snapped to
+the nearest wall. Every body carries a semantic label ("floor", "wall", "ceiling",
+"door:<room>", "sign:<room>", "landmark:<id>", "obstacle", "robot"); segmentation
+images map to label ids through ``SimWorld.labels``.
+
+pybullet is not thread-safe: every pybullet call goes through ``SimWorld.lock``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import tempfile
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pybullet as p
+import shapely
+from shapely.geometry import LineString, MultiPolygon, Polygon
+from shapely.geometry.polygon import orient
+
+from pmnav_bt.building import Building, Landmark, WaypointKind, load_building
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.seams import Pose2D
+from pmnav_bt.sim.textures import make_sign, write_png
+
+log = logging.getLogger(__name__)
+
+
+class SimError(PmNavError):
+    """The simulator cannot do what was asked (no display for the GUI, a bad obstacle ...)."""
+
+
+# -- labels ------------------------------------------------------------------------------
+
+BACKGROUND = "background"
+FLOOR = "floor"
+WALL = "wall"
+CEILING = "ceiling"
+OBSTACLE = "obstacle"
+ROBOT = "robot"
+FIXED_LABELS = (BACKGROUND, FLOOR, WALL, CEILING, OBSTACLE, ROBOT)  # ids 0..5
+
+
+def door_label(room_id: str) -> str:
+    return f"door:{room_id}"
+
+
+def sign_label(room_id: str) -> str:
+    return f"sign:{room_id}"
+
+
+def landmark_label(landmark_id: str) -> str:
+    return f"landmark:{landmark_id}"
+
+
+# -- appearance and sizes (metres, RGBA) -------------------------------------------------
+
+FLOOR_RGBA = (0.42, 0.45, 0.52, 1.0)
+WALL_RGBA = (0.93, 0.90, 0.80, 1.0)
+SKIRTING_RGBA = (0.25, 0.24, 0.22, 1.0)
+CEILING_RGBA = (0.97, 0.97, 0.97, 1.0)
+DOOR_RGBA = (0.58, 0.38, 0.20, 1.0)
+FRAME_RGBA = (0.30, 0.22, 0.16, 1.0)
+HANDLE_RGBA = (0.80, 0.80, 0.82, 1.0)
+PLATE_RGBA = (0.15, 0.15, 0.15, 1.0)
+METAL_RGBA = (0.70, 0.73, 0.78, 1.0)
+STEEL_DARK_RGBA = (0.35, 0.37, 0.40, 1.0)
+STEP_RGBA = ((0.62, 0.62, 0.60, 1.0), (0.50, 0.50, 0.48, 1.0))
+DESK_RGBA = (0.40, 0.27, 0.18, 1.0)
+COUNTER_RGBA = (0.92, 0.92, 0.88, 1.0)
+OBSTACLE_RGBA = (0.95, 0.45, 0.10, 1.0)
+
+# Light for the tiny renderer: direction towards the light (map frame), and coefficients.
+LIGHT_DIRECTION = tuple(
+    float(v) for v in np.array([0.4, 0.3, 1.0]) / np.linalg.norm([0.4, 0.3, 1.0])
+)
+LIGHT_AMBIENT = 0.72
+LIGHT_DIFFUSE = 0.35
+
+WALL_THICKNESS = 0.10
+SKIRTING_HEIGHT = 0.10
+DOOR_WIDTH = 1.0
+DOOR_HEIGHT = 2.1
+FRAME_WIDTH = 0.08
+FRAME_DEPTH = 0.04  # how far door frames stand out of the wall
+PANEL_DEPTH = 0.02
+SIGN_CENTRE_Z = 1.6  # sign plates are centred at camera height
+SIGN_DEPTH = 0.015
+SIGN_GAP = 0.15  # between a door frame and its sign plate
+ELEVATOR_WIDTH = 1.6
+ELEVATOR_HEIGHT = 2.2
+STAIRS_STEPS = 6
+STAIRS_LENGTH = 1.8
+STAIRS_DEPTH = 0.45
+STAIRS_RISE = 0.17
+DESK_LENGTH = 1.8
+DESK_DEPTH = 0.6
+DESK_HEIGHT = 1.0
+
+_ELEVATOR_KINDS = {"elevator", "lift"}
+_STAIRS_KINDS = {"stairs", "stair", "staircase", "stairway"}
+_DESK_KINDS = {"reception_desk", "reception", "desk", "counter", "information_desk"}
+
+
+@dataclass(frozen=True)
+class WallSegment:
+    """One straight piece of the free-space boundary; ``normal`` points into the free space."""
+
+    a: tuple[float, float]
+    b: tuple[float, float]
+    normal: tuple[float, float]
+
+    @property
+    def length(self) -> float:
+        return math.dist(self.a, self.b)
+
+    @property
+    def tangent(self) -> np.ndarray:
+        d = np.subtract(self.b, self.a)
+        return d / np.linalg.norm(d)
+
+    def point(self, s: float) -> np.ndarray:
+        """The point ``s`` metres from ``a`` towards ``b``."""
+        return np.asarray(self.a, float) + s * self.tangent
+
+
+@dataclass(frozen=True)
+class WallItem:
+    """Something mounted on a corridor wall: a door, a sign plate or a landmark."""
+
+    id: str  # room or landmark id
+    kind: str  # "door", "sign", or the landmark's kind
+    label: str
+    centre: tuple[float, float]  # on the wall surface, map frame
+    normal: tuple[float, float]  # unit, from the wall into the corridor
+    width: float  # along the wall
+    z: tuple[float, float]  # bottom and top heights
+    text: str = ""
+
+    @property
+    def facing_yaw(self) -> float:
+        """Heading of a viewer looking straight at the item (along -normal)."""
+        return math.atan2(-self.normal[1], -self.normal[0])
+
+    def viewpoint(self, distance: float) -> Pose2D:
+        """A pose ``distance`` metres out from the wall, facing the item."""
+        x = self.centre[0] + distance * self.normal[0]
+        y = self.centre[1] + distance * self.normal[1]
+        return Pose2D(float(x), float(y), self.facing_yaw)
+
+
+@dataclass(frozen=True)
+class RayHit:
+    """First hit of a ray: the body, its label, distance from the start, point and normal."""
+
+    body: int
+    label: str
+    distance: float
+    point: tuple[float, float, float]
+    normal: tuple[float, float, float]
+
+
+def free_space_polygon(building: Building) -> Polygon | MultiPolygon:
+    """Union of the corridor rectangles (square ends), oriented (exterior CCW), simplified."""
+    pos = {w.id: w.pos for w in building.waypoints}
+    parts = [
+        LineString([pos[e.a], pos[e.b]]).buffer(
+            building.edge_width(e) / 2.0, cap_style="square", join_style="mitre"
+        )
+        for e in building.edges
+    ]
+    geom = shapely.union_all(parts).simplify(1e-4)
+    if isinstance(geom, MultiPolygon):
+        return MultiPolygon([orient(g, 1.0) for g in geom.geoms])
+    return orient(geom, 1.0)
+
+
+def _rings(geom: Polygon | MultiPolygon) -> list[list[tuple[float, float]]]:
+    polys = geom.geoms if isinstance(geom, MultiPolygon) else [geom]
+    rings = []
+    for poly in polys:
+        rings.append(list(poly.exterior.coords)[:-1])
+        rings.extend(list(r.coords)[:-1] for r in poly.interiors)
+    return rings
+
+
+def _xy(v) -> tuple[float, float]:
+    return float(v[0]), float(v[1])
+
+
+def _cross(u: np.ndarray, v: np.ndarray) -> float:
+    return float(u[0] * v[1] - u[1] * v[0])
+
+
+class SimWorld:
+    """A pybullet world built from a Building, with its own physics client and lock.
+
+    Parameters: ``building`` (a Building, a built-in name or a path), ``gui`` (use
+    p.GUI; needs a display), ``ceiling`` (add a ceiling at the wall height).
+    """
+
+    def __init__(
+        self, building: Building | str | Path, *, gui: bool = False, ceiling: bool = True
+    ) -> None:
+        self.building = building if isinstance(building, Building) else load_building(building)
+        self.lock = threading.RLock()
+        self.labels: dict[int, str] = {}
+        self._label_ids: dict[str, int] = {}
+        for name in FIXED_LABELS:
+            self.label_id(name)
+        self._body_label: dict[int, int] = {}
+        self._lut: np.ndarray | None = None
+        self._solid: set[int] = set()
+        self._probe_shapes: dict[tuple[float, float], int] = {}
+        self._occupied: dict[int, list[tuple[float, float]]] = {}
+        self._where: dict[str, tuple[int, float]] = {}  # label -> (wall, s) of the main item
+        self._tmp = tempfile.TemporaryDirectory(prefix="pmnav_sim_")
+        self.walls: list[WallSegment] = []
+        self.doors: dict[str, WallItem] = {}
+        self.signs: dict[str, WallItem] = {}
+        self.landmarks: dict[str, WallItem] = {}
+        self.landmark_signs: dict[str, WallItem] = {}
+        self.obstacles: dict[int, tuple[float, float, float]] = {}
+        if gui:
+            if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+                raise SimError(
+                    "--gui needs a display, but DISPLAY is not set; "
+                    "run without --gui to write images only"
+                )
+            self.client = p.connect(p.GUI)
+        else:
+            self.client = p.connect(p.DIRECT)
+        if self.client < 0:
+            raise SimError("could not start a pybullet physics client")
+        self._ceiling_wanted = ceiling
+        self.free_space = free_space_polygon(self.building)
+        try:
+            with self.lock:
+                self._build()
+        except BaseException:
+            self.close()
+            raise
+
+    # -- lifecycle ------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Disconnect the physics client and delete the texture files."""
+        with self.lock:
+            if self.client >= 0 and p.isConnected(physicsClientId=self.client):
+                p.disconnect(physicsClientId=self.client)
+            self.client = -1
+        self._tmp.cleanup()
+
+    def __enter__(self) -> SimWorld:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- labels ---------------------------------------------------------------------------
+
+    def label_id(self, label: str) -> int:
+        """The id of a label (registered on first use)."""
+        if label not in self._label_ids:
+            i = len(self._label_ids)
+            self._label_ids[label] = i
+            self.labels[i] = label
+        return self._label_ids[label]
+
+    def label_of(self, body: int) -> str:
+        """The label of a pybullet body id (BACKGROUND for -1 or unknown)."""
+        return self.labels[self._body_label.get(body, 0)]
+
+    def bodies_with_label(self, label: str) -> list[int]:
+        lid = self._label_ids.get(label, -1)
+        return [b for b, i in self._body_label.items() if i == lid]
+
+    def segmentation_to_labels(self, seg: np.ndarray) -> np.ndarray:
+        """Map a pybullet segmentation image (body ids, -1 = nothing) to label ids."""
+        if self._lut is None:
+            n = max(self._body_label, default=0) + 2
+            lut = np.zeros(n, np.int32)
+            for body, lid in self._body_label.items():
+                lut[body + 1] = lid
+            self._lut = lut
+        seg = np.asarray(seg, np.int64)
+        out = np.zeros(seg.shape, np.int32)
+        ok = (seg >= -1) & (seg < len(self._lut) - 1)
+        out[ok] = self._lut[seg[ok] + 1]
+        return out
+
+    # -- bodies ---------------------------------------------------------------------------
+
+    def register(self, body: int, label: str, solid: bool = False) -> int:
+        """Give a body created with this world's client a label; ``solid`` ones block the robot."""
+        self._body_label[body] = self.label_id(label)
+        self._lut = None
+        if solid:
+            self._solid.add(body)
+        return body
+
+    def add_box(
+        self,
+        centre: tuple[float, float, float],
+        half_extents: tuple[float, float, float],
+        yaw: float,
+        rgba: tuple[float, ...],
+        label: str,
+        *,
+        solid: bool = True,
+        collision: bool | None = None,
+    ) -> int:
+        """A static box; ``solid`` bodies block the robot, ``collision`` ones block rays."""
+        collision = solid if collision is None else collision
+        c = self.client
+        with self.lock:
+            vis = p.createVisualShape(
+                p.GEOM_BOX, halfExtents=half_extents, rgbaColor=rgba, physicsClientId=c
+            )
+            col = (
+                p.createCollisionShape(p.GEOM_BOX, halfExtents=half_extents, physicsClientId=c)
+                if collision
+                else -1
+            )
+            q = p.getQuaternionFromEuler((0.0, 0.0, yaw))
+            body = p.createMultiBody(0.0, col, vis, centre, q, physicsClientId=c)
+            return self.register(body, label, solid)
+
+    def _add_textured_quad(
+        self,
+        centre: np.ndarray,
+        normal: np.ndarray,
+        width: float,
+        height: float,
+        image: np.ndarray,
+        label: str,
+    ) -> int:
+        """A flat quad facing ``normal`` (2D), showing ``image`` upright and unmirrored."""
+        left = np.array([normal[1], -normal[0], 0.0]) * (width / 2.0)  # viewer's left
+        up = np.array([0.0, 0.0, height / 2.0])
+        verts = [left - up, -left - up, -left + up, left + up]
+        uvs = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+        # Normals point at the light, so plates are fully lit (white) from every side.
+        normals = [list(LIGHT_DIRECTION)] * 4
+        path = write_png(image, Path(self._tmp.name) / f"tex{len(self._body_label)}.png")
+        c = self.client
+        with self.lock:
+            vis = p.createVisualShape(
+                p.GEOM_MESH,
+                vertices=[v.tolist() for v in verts],
+                indices=[0, 1, 2, 0, 2, 3],
+                uvs=uvs,
+                normals=normals,
+                rgbaColor=(1.0, 1.0, 1.0, 1.0),
+                physicsClientId=c,
+            )
+            body = p.createMultiBody(0.0, -1, vis, centre.tolist(), physicsClientId=c)
+            tex = p.loadTexture(str(path), physicsClientId=c)
+            p.changeVisualShape(body, -1, textureUniqueId=tex, physicsClientId=c)
+        return self.register(body, label, solid=False)
+
+    def add_obstacle(self, x: float, y: float, size: float, height: float = 1.0) -> int:
+        """A square box obstacle (side ``size``) standing on the floor at (x, y); its body id."""
+        if not (size > 0 and height > 0):
+            raise SimError(f"obstacle size and height must be positive (got {size}, {height})")
+        body = self.add_box(
+            (x, y, height / 2.0),
+            (size / 2.0, size / 2.0, height / 2.0),
+            0.0,
+            OBSTACLE_RGBA,
+            OBSTACLE,
+        )
+        self.obstacles[body] = (float(x), float(y), float(size))
+        return body
+
+    def remove_obstacle(self, body: int) -> None:
+        with self.lock:
+            if body not in self.obstacles:
+                raise SimError(f"body {body} is not an obstacle of this world")
+            p.removeBody(body, physicsClientId=self.client)
+            del self.obstacles[body]
+            self._solid.discard(body)
+            self._body_label.pop(body, None)
+            self._lut = None
+
+    # -- queries --------------------------------------------------------------------------
+
+    def ray(self, start: tuple[float, ...], end: tuple[float, ...]) -> RayHit | None:
+        """The first body a ray from ``start`` to ``end`` (3D, metres) hits, or None."""
+        with self.lock:
+            hit = p.rayTest(start, end, physicsClientId=self.client)[0]
+        body, frac = hit[0], hit[2]
+        if body < 0:
+            return None
+        length = math.dist(start, end)
+        return RayHit(body, self.label_of(body), frac * length, tuple(hit[3]), tuple(hit[4]))
+
+    def _probe(self, radius: float, height: float) -> int:
+        key = (round(radius, 4), round(height, 4))
+        if key not in self._probe_shapes:
+            with self.lock:
+                self._probe_shapes[key] = p.createCollisionShape(
+                    p.GEOM_CYLINDER, radius=radius, height=height, physicsClientId=self.client
+                )
+        return self._probe_shapes[key]
+
+    def clearance(
+        self, x: float, y: float, radius: float, height: float = 1.7, margin: float = 0.05
+    ) -> float:
+        """Signed distance from an upright cylinder at (x, y) to the nearest solid body.
+
+        Negative means penetration; ``margin`` is returned when nothing is that close.
+        The cylinder stands 2 cm above the floor, so the floor never counts.
+        """
+        z = 0.02 + height / 2.0
+        r = radius + margin + 0.05
+        best = margin
+        with self.lock:
+            shape = self._probe(radius, height)
+            found = p.getOverlappingObjects(
+                (x - r, y - r, 0.0), (x + r, y + r, height + 0.1), physicsClientId=self.client
+            )
+            if not found:
+                return best
+            for body in {b for b, _ in found}:
+                if body not in self._solid:
+                    continue
+                pts = p.getClosestPoints(
+                    -1,
+                    body,
+                    margin,
+                    collisionShapeA=shape,
+                    collisionShapePositionA=(x, y, z),
+                    collisionShapeOrientationA=(0.0, 0.0, 0.0, 1.0),
+                    physicsClientId=self.client,
+                )
+                for pt in pts:
+                    best = min(best, pt[8])
+        return best
+
+    def start_pose(self) -> Pose2D:
+        """The first start waypoint, facing along its corridor."""
+        b = self.building
+        starts = [w for w in b.waypoints if w.kind == WaypointKind.START] or list(b.waypoints)
+        w = starts[0]
+        for e in b.edges:
+            if w.id in (e.a, e.b):
+                other = b.waypoint(e.b if e.a == w.id else e.a)
+                yaw = math.atan2(other.pos[1] - w.pos[1], other.pos[0] - w.pos[0])
+                return Pose2D(float(w.pos[0]), float(w.pos[1]), yaw)
+        return Pose2D(float(w.pos[0]), float(w.pos[1]), 0.0)
+
+    def bounds(self, margin: float = 0.0) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) of the free space, grown by ``margin``."""
+        x0, y0, x1, y1 = self.free_space.bounds
+        return x0 - margin, y0 - margin, x1 + margin, y1 + margin
+
+    # -- building ------------------------------------------------------------------------
+
+    def _build(self) -> None:
+        b = self.building
+        c = self.client
+        p.setGravity(0, 0, 0, physicsClientId=c)
+        x0, y0, x1, y1 = self.bounds(margin=3.0)
+        cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
+        hx, hy = (x1 - x0) / 2.0, (y1 - y0) / 2.0
+        self.add_box(
+            (cx, cy, -0.05), (hx, hy, 0.05), 0.0, FLOOR_RGBA, FLOOR, solid=False, collision=True
+        )
+        if self._ceiling_wanted:
+            self.add_box(
+                (cx, cy, b.wall_height + 0.05),
+                (hx, hy, 0.05),
+                0.0,
+                CEILING_RGBA,
+                CEILING,
+                solid=False,
+                collision=True,
+            )
+        self._build_walls()
+        for room in b.rooms:
+            self.label_id(door_label(room.id))
+            self.label_id(sign_label(room.id))
+        for lm in b.landmarks:
+            self.label_id(landmark_label(lm.id))
+        for room in b.rooms:
+            self._build_door(room.id, room.door)
+        for lm in b.landmarks:
+            self._build_landmark(lm)
+        for room in b.rooms:
+            self._build_room_sign(room.id, room.sign_text)
+
+    def _build_walls(self) -> None:
+        h = self.building.wall_height
+        t = WALL_THICKNESS
+        for ring in _rings(self.free_space):
+            n = len(ring)
+            pts = [np.asarray(q, float) for q in ring]
+            for i in range(n):
+                a, b = pts[i], pts[(i + 1) % n]
+                prev, nxt = pts[i - 1], pts[(i + 2) % n]
+                d = b - a
+                length = float(np.linalg.norm(d))
+                if length < 1e-6:
+                    continue
+                tan = d / length
+                inward = np.array([-tan[1], tan[0]])  # free space is on the left
+                # Extend past convex corners (seen from the free space) to close them.
+                ext_a = t if _cross(a - prev, d) > 1e-9 else 0.0
+                ext_b = t if _cross(d, nxt - b) > 1e-9 else 0.0
+                mid = (a + b) / 2.0 + tan * (ext_b - ext_a) / 2.0 - inward * t / 2.0
+                yaw = math.atan2(tan[1], tan[0])
+                half_len = length / 2.0 + (ext_a + ext_b) / 2.0
+                self.add_box(
+                    (mid[0], mid[1], h / 2.0), (half_len, t / 2.0, h / 2.0), yaw, WALL_RGBA, WALL
+                )
+                sk = (a + b) / 2.0 + inward * 0.005
+                self.add_box(
+                    (sk[0], sk[1], SKIRTING_HEIGHT / 2.0),
+                    (length / 2.0, 0.005, SKIRTING_HEIGHT / 2.0),
+                    yaw,
+                    SKIRTING_RGBA,
+                    WALL,
+                    solid=False,
+                    collision=False,
+                )
+                self.walls.append(WallSegment(_xy(a), _xy(b), _xy(inward)))
+
+    # -- placing things on walls ---------------------------------------------------------
+
+    def _nearest_wall(self, pt: tuple[float, float]) -> tuple[int, float]:
+        """Index of the wall segment nearest to ``pt`` and the distance along it."""
+        q = np.asarray(pt, float)
+        best, best_d, best_s = -1, math.inf, 0.0
+        for i, w in enumerate(self.walls):
+            a = np.asarray(w.a)
+            s = float(np.clip(np.dot(q - a, w.tangent), 0.0, w.length))
+            d = float(np.linalg.norm(q - w.point(s)))
+            if d < best_d - 1e-9:
+                best, best_d, best_s = i, d, s
+        return best, best_s
+
+    def _fits(self, wall: int, s0: float, s1: float) -> bool:
+        w = self.walls[wall]
+        if s0 < -1e-6 or s1 > w.length + 1e-6:
+            return False
+        return all(s1 <= o0 or s0 >= o1 for o0, o1 in self._occupied.get(wall, []))
+
+    def _occupy(self, wall: int, s: float, half: float) -> None:
+        self._occupied.setdefault(wall, []).append((s - half, s + half))
+
+    def _snap(self, what: str, pt: tuple[float, float], half: float) -> tuple[int, float]:
+        """Wall and position along it for an item ``2*half`` wide nearest to ``pt``."""
+        wi, s = self._nearest_wall(pt)
+        w = self.walls[wi]
+        if w.length < 2.0 * half:
+            log.warning("%s: wall %.2f m long is too short for %.2f m", what, w.length, 2 * half)
+            s = w.length / 2.0
+        else:
+            s = float(np.clip(s, half, w.length - half))
+        if not self._fits(wi, s - half, s + half):
+            log.warning("%s at %s overlaps another item on the same wall", what, pt)
+        self._occupy(wi, s, half)
+        return wi, s
+
+    def _wall_box(
+        self,
+        wall: int,
+        s: float,
+        depth: float,
+        width: float,
+        z0: float,
+        z1: float,
+        rgba: tuple[float, ...],
+        label: str,
+        *,
+        solid: bool = True,
+        out: float = 0.0,
+    ) -> int:
+        """A box on a wall: ``width`` along it, standing ``depth`` out of it (from ``out``)."""
+        w = self.walls[wall]
+        n = np.asarray(w.normal)
+        c = w.point(s) + n * (out + depth / 2.0)
+        yaw = math.atan2(w.tangent[1], w.tangent[0])
+        return self.add_box(
+            (c[0], c[1], (z0 + z1) / 2.0),
+            (width / 2.0, depth / 2.0, (z1 - z0) / 2.0),
+            yaw,
+            rgba,
+            label,
+            solid=solid,
+        )
+
+    def _item(
+        self,
+        ident: str,
+        kind: str,
+        label: str,
+        wall: int,
+        s: float,
+        width: float,
+        z: tuple[float, float],
+        text: str = "",
+    ) -> WallItem:
+        w = self.walls[wall]
+        c = w.point(s)
+        self._where.setdefault(label, (wall, s))
+        return WallItem(ident, kind, label, _xy(c), w.normal, float(width), z, text)
+
+    def _build_door(self, room_id: str, pt: tuple[float, float]) -> None:
+        label = door_label(room_id)
+        total = DOOR_WIDTH + 2 * FRAME_WIDTH
+        wi, s = self._snap(f"door of {room_id}", pt, total / 2.0)
+        fw, fd = FRAME_WIDTH, FRAME_DEPTH
+        self._wall_box(wi, s, PANEL_DEPTH, DOOR_WIDTH, 0.0, DOOR_HEIGHT, DOOR_RGBA, label)
+        for side in (-1, 1):
+            js = s + side * (DOOR_WIDTH + fw) / 2.0
+            self._wall_box(wi, js, fd, fw, 0.0, DOOR_HEIGHT + fw, FRAME_RGBA, label)
+        self._wall_box(wi, s, fd, DOOR_WIDTH, DOOR_HEIGHT, DOOR_HEIGHT + fw, FRAME_RGBA, label)
+        # Lever handle near the opening edge (the viewer's right, i.e. towards -s).
+        hs = s - DOOR_WIDTH / 2.0 + 0.12
+        self._wall_box(wi, hs, 0.04, 0.14, 0.98, 1.02, HANDLE_RGBA, label, out=PANEL_DEPTH)
+        self.doors[room_id] = self._item(
+            room_id, "door", label, wi, s, total, (0.0, DOOR_HEIGHT + fw)
+        )
+
+    def _build_plate(
+        self,
+        ident: str,
+        label: str,
+        text: str,
+        wall: int,
+        s: float,
+        z_centre: float,
+        kind: str,
+    ) -> WallItem:
+        tex = make_sign(text)
+        w = self.walls[wall]
+        n = np.asarray(w.normal)
+        z0, z1 = z_centre - tex.height_m / 2.0, z_centre + tex.height_m / 2.0
+        self._wall_box(
+            wall, s, SIGN_DEPTH, tex.width_m + 0.02, z0 - 0.01, z1 + 0.01, PLATE_RGBA, label
+        )
+        centre = np.append(w.point(s) + n * (SIGN_DEPTH + 0.002), z_centre)
+        self._add_textured_quad(centre, n, tex.width_m, tex.height_m, tex.image, label)
+        return self._item(ident, kind, label, wall, s, tex.width_m + 0.02, (z0, z1), text)
+
+    def _plate_beside(
+        self, item: WallItem, wi: int, s_item: float, what: str
+    ) -> tuple[int, float, float]:
+        """Wall, position and height for a sign plate beside ``item`` (right, else left)."""
+        half = (make_sign("x").width_m + 0.02) / 2.0
+        off = item.width / 2.0 + SIGN_GAP + half
+        for s in (s_item - off, s_item + off):  # -s is the viewer's right
+            if self._fits(wi, s - half, s + half):
+                self._occupy(wi, s, half)
+                return wi, s, SIGN_CENTRE_Z
+        log.info("%s: no room beside it on the wall; the sign goes above it", what)
+        return wi, s_item, item.z[1] + 0.35
+
+    def _build_room_sign(self, room_id: str, text: str) -> None:
+        door = self.doors[room_id]
+        wi, s, z = self._plate_beside(door, *self._where[door.label], f"sign of {room_id}")
+        self.signs[room_id] = self._build_plate(
+            room_id, sign_label(room_id), text, wi, s, z, "sign"
+        )
+
+    def _build_landmark(self, lm: Landmark) -> None:
+        kind = lm.kind.lower()
+        label = landmark_label(lm.id)
+        text = lm.sign or lm.display_name
+        if kind in _ELEVATOR_KINDS:
+            item = self._build_elevator(lm, label)
+        elif kind in _STAIRS_KINDS:
+            item = self._build_stairs(lm, label)
+        elif kind in _DESK_KINDS:
+            item = self._build_desk(lm, label)
+        else:
+            half = (make_sign(text).width_m + 0.02) / 2.0
+            wi, s = self._snap(f"landmark {lm.id}", lm.pos, half)
+            item = self._build_plate(lm.id, label, text, wi, s, SIGN_CENTRE_Z, lm.kind)
+            self.landmarks[lm.id] = item
+            return
+        self.landmarks[lm.id] = item
+        wi, s = self._where[label]
+        if kind in _ELEVATOR_KINDS:
+            wi, s, z = self._plate_beside(item, wi, s, f"sign of {lm.id}")
+        else:  # above the steps or the desk, on the wall at camera height
+            z = SIGN_CENTRE_Z
+        self.landmark_signs[lm.id] = self._build_plate(lm.id, label, text, wi, s, z, "lmsign")
+
+    def _build_elevator(self, lm: Landmark, label: str) -> WallItem:
+        fw = 0.12
+        total = ELEVATOR_WIDTH + 2 * fw + 0.3  # the call button panel beside it
+        wi, s = self._snap(f"landmark {lm.id}", lm.pos, total / 2.0)
+        s_door = s + 0.15  # the call panel sits on the viewer's right (-s)
+        half = ELEVATOR_WIDTH / 4.0
+        for side in (-1, 1):
+            self._wall_box(
+                wi,
+                s_door + side * (half + 0.01),
+                0.03,
+                2 * half - 0.02,
+                0.0,
+                ELEVATOR_HEIGHT,
+                METAL_RGBA,
+                label,
+            )
+            self._wall_box(
+                wi,
+                s_door + side * (ELEVATOR_WIDTH + fw) / 2.0,
+                0.06,
+                fw,
+                0.0,
+                ELEVATOR_HEIGHT + fw,
+                STEEL_DARK_RGBA,
+                label,
+            )
+        self._wall_box(wi, s_door, 0.025, 0.04, 0.0, ELEVATOR_HEIGHT, STEEL_DARK_RGBA, label)
+        self._wall_box(
+            wi,
+            s_door,
+            0.06,
+            ELEVATOR_WIDTH,
+            ELEVATOR_HEIGHT,
+            ELEVATOR_HEIGHT + fw,
+            STEEL_DARK_RGBA,
+            label,
+        )
+        panel = s_door - ELEVATOR_WIDTH / 2.0 - fw - 0.15
+        self._wall_box(wi, panel, 0.02, 0.12, 0.95, 1.25, STEEL_DARK_RGBA, label)
+        self._wall_box(wi, panel, 0.015, 0.05, 1.05, 1.10, (0.95, 0.75, 0.2, 1.0), label, out=0.02)
+        return self._item(
+            lm.id,
+            lm.kind,
+            label,
+            wi,
+            s,
+            total,
+            (0.0, ELEVATOR_HEIGHT + fw),
+            lm.sign or lm.display_name,
+        )
+
+    def _build_stairs(self, lm: Landmark, label: str) -> WallItem:
+        wi, s = self._snap(f"landmark {lm.id}", lm.pos, STAIRS_LENGTH / 2.0)
+        step = STAIRS_LENGTH / STAIRS_STEPS
+        for k in range(STAIRS_STEPS):
+            sk = s - STAIRS_LENGTH / 2.0 + (k + 0.5) * step
+            self._wall_box(
+                wi, sk, STAIRS_DEPTH, step, 0.0, (k + 1) * STAIRS_RISE, STEP_RGBA[k % 2], label
+            )
+        top = STAIRS_STEPS * STAIRS_RISE
+        return self._item(
+            lm.id, lm.kind, label, wi, s, STAIRS_LENGTH, (0.0, top), lm.sign or lm.display_name
+        )
+
+    def _build_desk(self, lm: Landmark, label: str) -> WallItem:
+        wi, s = self._snap(f"landmark {lm.id}", lm.pos, (DESK_LENGTH + 0.1) / 2.0)
+        self._wall_box(wi, s, DESK_DEPTH, DESK_LENGTH, 0.0, DESK_HEIGHT - 0.04, DESK_RGBA, label)
+        self._wall_box(
+            wi,
+            s,
+            DESK_DEPTH + 0.1,
+            DESK_LENGTH + 0.1,
+            DESK_HEIGHT - 0.04,
+            DESK_HEIGHT,
+            COUNTER_RGBA,
+            label,
+        )
+        return self._item(
+            lm.id,
+            lm.kind,
+            label,
+            wi,
+            s,
+            DESK_LENGTH + 0.1,
+            (0.0, DESK_HEIGHT),
+            lm.sign or lm.display_name,
+        )
