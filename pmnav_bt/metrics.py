@@ -1,0 +1,162 @@
+"""Navigation metrics: success, SPL, SDF, per-episode results and a per-tier table.
+
+- Success: the agent stops within ``SUCCESS_RADIUS_M`` of the goal room's door point.
+- SPL = S * l / max(l, p) (Anderson et al. 2018, "On Evaluation of Embodied Navigation
+  Agents"; habitat-lab), l the shortest path length, p the length the agent travelled.
+- SDF (PM-Nav paper, eq. 1) is implemented as S * 2 / max(2, d), d the number of
+  localisation attempts. The paper prints d / max(2, d), which *rewards* more attempts;
+  its Table 3 only fits 2 / max(2, d), so that is what this module computes.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+# The agent succeeds when it stops within this distance (metres) of the goal door point.
+SUCCESS_RADIUS_M = 1.0
+
+# Tiers in display order; other tier names follow in alphabetical order.
+TIER_ORDER = ("easy", "medium", "hard")
+
+
+def success(
+    stop_xy: Sequence[float], door_xy: Sequence[float], radius: float = SUCCESS_RADIUS_M
+) -> bool:
+    """True when the stop position lies within ``radius`` metres of the door point."""
+    return math.dist(tuple(stop_xy[:2]), tuple(door_xy[:2])) <= radius
+
+
+def spl(succeeded: bool | float, shortest: float, travelled: float) -> float:
+    """Success weighted by path length for one episode: S * l / max(l, p), in [0, 1]."""
+    if not succeeded:
+        return 0.0
+    if shortest < 0 or travelled < 0:
+        raise ValueError("path lengths must be non-negative")
+    longest = max(shortest, travelled)
+    return 1.0 if longest == 0 else float(shortest / longest)
+
+
+def sdf_term(succeeded: bool | float, attempts: int) -> float:
+    """One trial's SDF term: S * 2 / max(2, d) (the form that fits the paper's Table 3)."""
+    if attempts < 0:
+        raise ValueError("attempts must be non-negative")
+    return float(bool(succeeded)) * 2.0 / max(2, attempts)
+
+
+def sdf(successes: Sequence[bool | float], attempts: Sequence[int]) -> float:
+    """Success weighted by detection frequency over N trials: mean of S_i * 2 / max(2, d_i)."""
+    if len(successes) != len(attempts):
+        raise ValueError("successes and attempts must have the same length")
+    if not successes:
+        return 0.0
+    return float(np.mean([sdf_term(s, d) for s, d in zip(successes, attempts, strict=True)]))
+
+
+@dataclass
+class EpisodeResult:
+    """The outcome of one navigation episode.
+
+    ``failure_reason`` is None on success, otherwise a short code or sentence
+    ("step budget exhausted", "stopped 2.3 m from the door"). ``trace`` optionally holds
+    the visited poses or tree events.
+    """
+
+    episode_id: str
+    tier: str
+    success: bool
+    spl: float
+    path_length: float  # metres travelled
+    steps: int  # actions (or control commands) issued
+    collisions: int = 0
+    wall_time: float = 0.0  # seconds
+    failure_reason: str | None = None
+    shortest_path_length: float = float("nan")
+    distance_to_goal: float = float("nan")  # final distance to the door point, metres
+    building: str = ""
+    trace: list[Any] | None = None
+
+    def to_dict(self, with_trace: bool = False) -> dict[str, Any]:
+        d = asdict(self)
+        if not with_trace:
+            d.pop("trace")
+        return {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in d.items()}
+
+
+@dataclass(frozen=True)
+class TierRow:
+    """Aggregates over the episodes of one tier (SR and SPL in percent)."""
+
+    tier: str
+    episodes: int
+    sr: float
+    spl: float
+    mean_steps: float
+    mean_path_length: float
+    collisions: int
+
+
+@dataclass
+class TierTable:
+    """SR/SPL per tier, plus an "all" row; renders as Markdown or JSON."""
+
+    rows: list[TierRow] = field(default_factory=list)
+
+    def row(self, tier: str) -> TierRow:
+        return next(r for r in self.rows if r.tier == tier)
+
+    def to_markdown(self, digits: int = 1) -> str:
+        head = "| tier | episodes | SR (%) | SPL (%) | mean steps | mean path (m) | collisions |"
+        lines = [head, "|---|---:|---:|---:|---:|---:|---:|"]
+        for r in self.rows:
+            lines.append(
+                f"| {r.tier} | {r.episodes} | {r.sr:.{digits}f} | {r.spl:.{digits}f} | "
+                f"{r.mean_steps:.1f} | {r.mean_path_length:.1f} | {r.collisions} |"
+            )
+        return "\n".join(lines) + "\n"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"tiers": [asdict(r) for r in self.rows]}
+
+    def to_json(self, indent: int | None = 2) -> str:
+        return json.dumps(self.to_dict(), indent=indent)
+
+
+def _tier_key(tier: str) -> tuple[int, str]:
+    return (TIER_ORDER.index(tier), "") if tier in TIER_ORDER else (len(TIER_ORDER), tier)
+
+
+def _row(tier: str, rs: list[EpisodeResult]) -> TierRow:
+    return TierRow(
+        tier=tier,
+        episodes=len(rs),
+        sr=100.0 * float(np.mean([bool(r.success) for r in rs])),
+        spl=100.0 * float(np.mean([r.spl for r in rs])),
+        mean_steps=float(np.mean([r.steps for r in rs])),
+        mean_path_length=float(np.mean([r.path_length for r in rs])),
+        collisions=int(sum(r.collisions for r in rs)),
+    )
+
+
+def aggregate_by_tier(results: Iterable[EpisodeResult], overall: bool = True) -> TierTable:
+    """SR and SPL (percent) per tier, tiers in easy/medium/hard order, then an "all" row."""
+    results = list(results)
+    by: dict[str, list[EpisodeResult]] = {}
+    for r in results:
+        by.setdefault(r.tier, []).append(r)
+    rows = [_row(t, by[t]) for t in sorted(by, key=_tier_key)]
+    if overall and results:
+        rows.append(_row("all", results))
+    return TierTable(rows)
+
+
+def results_to_json(
+    results: Iterable[EpisodeResult], with_trace: bool = False, indent: int | None = 2
+) -> str:
+    """Per-episode results as a JSON list."""
+    return json.dumps([r.to_dict(with_trace) for r in results], indent=indent)
