@@ -40,7 +40,7 @@ class RefinerConfig(_Section):
 
 class PlannerConfig(_Section):
     backend: Literal["graph"] = "graph"
-    max_gap: float = Field(10.0, gt=0.0)
+    max_gap: float = Field(8.0, gt=0.0)
 
 
 class TreeConfig(_Section):
@@ -52,7 +52,13 @@ class TreeConfig(_Section):
     )
     localization_attempts: int = Field(4, ge=1)
     explore_distance: float = Field(2.0, gt=0.0)
-    search_attempts: int = Field(2, ge=1)
+    search_range: float = Field(
+        4.5, gt=0.0, description="drive until a target is this close (by the map) before searching"
+    )
+    search_attempts: int = Field(3, ge=1)
+    research_distance: float = Field(
+        2.0, gt=0.0, description="move this far towards a target not found before searching again"
+    )
     replans: int = Field(2, ge=0)
     approach_offset: float = Field(1.0, ge=0.0, description="stop this far from a landmark door")
     goal_offset: float = Field(0.6, ge=0.0, description="stop this far from the goal door")

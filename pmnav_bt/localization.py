@@ -49,7 +49,7 @@ def sighting(
     """A sighting from a detection, if its label names a map entity and depth gives its range."""
     if entity is None:
         entity = entity_index(building).get(normalise(det.label))
-    if entity is None:
+    if entity is None or truncated(obs, det):
         return None
     p = target_point(obs, det)
     if p is None:
@@ -59,8 +59,21 @@ def sighting(
     return Sighting(entity, (float(m[0]), float(m[1])), (float(odom[0]), float(odom[1])))
 
 
+def truncated(obs: Observation, det: Detection) -> bool:
+    """True when the detection touches the left or right image border (its centre is biased)."""
+    x0, _, x1, _ = det.box
+    return x0 <= 1 or x1 >= obs.intrinsics.width - 2
+
+
 def fix_pose(sightings: list[Sighting], max_residual: float = MAX_RESIDUAL) -> Fix | None:
-    """The best consistent fix from at least two distinct landmarks, or None."""
+    """The best consistent fix from at least two distinct landmarks, or None.
+
+    Doors are placed exactly by the map; other landmarks (desks, lifts) only roughly. So
+    with two or more doors in view only doors are used.
+    """
+    doors = [s for s in sightings if s.entity.startswith("room:")]
+    if len({s.entity for s in doors}) >= 2:
+        sightings = doors
     by_entity: dict[str, list[Sighting]] = {}
     for s in sightings:
         by_entity.setdefault(s.entity, []).append(s)

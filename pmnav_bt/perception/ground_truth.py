@@ -98,6 +98,8 @@ class GroundTruthGrounder:
             if obs.depth is not None and float(np.median(obs.depth[sign])) > self.max_range:
                 continue
             score = min(1.0, 0.5 + n / 2000.0)
+            if _truncated(sign):  # cut by the image border: part of the text is missing
+                score *= 0.6
             if kind == "sign":
                 door_id = by_label.get(f"door:{ident}")
                 mask = (seg == door_id) if door_id is not None else sign
@@ -118,6 +120,10 @@ class GroundTruthGrounder:
         dx, dy = self._rng.randint(-k, k), self._rng.randint(-k, k)
         m = np.roll(np.roll(m, dy, axis=0), dx, axis=1)
         return m.astype(bool) if m.any() else mask
+
+
+def _truncated(mask: np.ndarray) -> bool:
+    return bool(mask[:, 0].any() or mask[:, -1].any())
 
 
 def _detection(label: str, mask: np.ndarray, score: float) -> Detection:

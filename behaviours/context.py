@@ -1,0 +1,79 @@
+"""What every PM-Nav behaviour shares: the body, the map, the back ends, the worker, the trace.
+
+Data that flows between behaviours goes on the blackboard (namespace ``/pmnav``);
+the Context holds the things a behaviour *uses* (injected once, not looked up).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pmnav_bt.config import Config
+from pmnav_bt.control import Limits, Odometer
+from pmnav_bt.geometry import se2_compose
+from pmnav_bt.priori_map import PrioriMap
+from pmnav_bt.seams import Base, Grounder, Planner, Pose2D, Refiner
+from pmnav_bt.worker import Worker
+
+
+@dataclass
+class TraceEvent:
+    """Something worth drawing later: a detection, a fix, a turn, a plan."""
+
+    kind: str
+    time: float
+    odom: tuple[float, float, float]
+    label: str = ""
+    data: dict[str, Any] = field(default_factory=dict)
+    thumbnail: np.ndarray | None = None
+
+
+@dataclass
+class Context:
+    """Injected into every behaviour of one tree."""
+
+    base: Base
+    pm: PrioriMap
+    config: Config
+    grounder: Grounder
+    refiner: Refiner
+    planner: Planner
+    worker: Worker
+    odometer: Odometer = field(default_factory=Odometer)
+    trace: list[TraceEvent] = field(default_factory=list)
+    budget_actions: int = 500
+
+    @property
+    def limits(self) -> Limits:
+        return Limits(self.config.tree.max_linear, self.config.tree.max_angular)
+
+    def now(self) -> float:
+        return self.base.clock.now()
+
+    def log(self, kind: str, label: str = "", thumbnail: np.ndarray | None = None, **data) -> None:
+        p = self.base.pose()
+        self.trace.append(TraceEvent(kind, self.now(), (p.x, p.y, p.yaw), label, data, thumbnail))
+
+
+def map_pose(map_T_odom: tuple[float, float, float] | None, odom: Pose2D) -> Pose2D:
+    """The estimated map pose from the odometry pose (identity before localization)."""
+    if map_T_odom is None:
+        return odom
+    x, y, yaw = se2_compose(map_T_odom, (odom.x, odom.y, odom.yaw))
+    return Pose2D(x, y, yaw)
+
+
+def thumbnail(rgb: np.ndarray, width: int = 96) -> np.ndarray:
+    """A small copy of a frame for the trace."""
+    import cv2
+
+    h, w = rgb.shape[:2]
+    return cv2.resize(rgb, (width, max(1, int(round(h * width / w)))), interpolation=cv2.INTER_AREA)
+
+
+def heading_error(a: float, b: float) -> float:
+    return abs(math.atan2(math.sin(a - b), math.cos(a - b)))

@@ -1,0 +1,47 @@
+"""Decorators py_trees lacks: a timeout on the tree's Clock (py_trees' Timeout is wall time)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import py_trees
+from py_trees.common import Access, Status
+
+from pmnav_bt.failures import Failure, FailureCode
+
+
+class ClockTimeout(py_trees.decorators.Decorator):
+    """FAILURE (TIMEOUT) if the child runs longer than ``duration`` seconds of ``now()``
+    (the tree's Clock).
+
+    Writes ``/pmnav/failure`` on timeout.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        child: py_trees.behaviour.Behaviour,
+        now: Callable[[], float],
+        duration: float,
+    ):
+        super().__init__(name=name, child=child)
+        self.now = now
+        self.duration = duration
+        self.bb = self.attach_blackboard_client(name=name, namespace="/pmnav")
+        self.bb.register_key(key="failure", access=Access.WRITE)
+
+    def initialise(self) -> None:
+        self._start = self.now()
+
+    def update(self) -> Status:
+        elapsed = self.now() - self._start
+        if self.decorated.status == Status.RUNNING and elapsed > self.duration:
+            self.bb.set(
+                "failure",
+                Failure(
+                    FailureCode.TIMEOUT, f"{self.decorated.name} took over {self.duration:.0f} s"
+                ),
+            )
+            self.feedback_message = "timed out"
+            return Status.FAILURE
+        return self.decorated.status

@@ -1,0 +1,136 @@
+"""Localization (paper, "Localization"): two recognised landmarks fix the pose on the map."""
+
+from __future__ import annotations
+
+import math
+
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.capture import LOCALIZATION_YAWS_DEG, CapturedView
+from pmnav_bt.behaviours.common import PmNavBehaviour
+from pmnav_bt.behaviours.context import Context, thumbnail
+from pmnav_bt.control import goto_command, rotate_command
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.localization import fix_pose, sighting
+from pmnav_bt.perception.geometry import free_distance
+from pmnav_bt.resolve import entity_index, normalise
+from pmnav_bt.seams import MotionStatus
+
+ALL_SIGNS = "sign"
+
+
+def localization_yaws(_b) -> list[float]:
+    return [math.radians(y) for y in LOCALIZATION_YAWS_DEG]
+
+
+def sign_query(_b) -> str:
+    return ALL_SIGNS
+
+
+def enough_doors(ctx: Context, views: list[CapturedView], n: int = 3) -> bool:
+    """Stop the localization panorama early once ``n`` distinct doors have been read."""
+    return sum(e.startswith("room:") for e in distinct_landmarks(ctx, views)) >= n
+
+
+def distinct_landmarks(ctx: Context, views: list[CapturedView]) -> set[str]:
+    index = entity_index(ctx.pm.building)
+    return {index[k] for v in views for d in v.detections if (k := normalise(d.label)) in index}
+
+
+class FixPosition(PmNavBehaviour):
+    """Fix the map pose from the landmarks in the localization views.
+
+    Reads ``views``, ``fix_attempts``; writes ``map_T_odom``, ``fix_attempts``.
+    FAILURE (LOCALIZATION_FAILED) with fewer than two consistent landmarks.
+    """
+
+    READS = ("views", "fix_attempts")
+    WRITES = ("map_T_odom", "fix_attempts")
+
+    def update(self) -> Status:
+        attempts = (self.get("fix_attempts") or 0) + 1
+        self.bb.set("fix_attempts", attempts)
+        b = self.ctx.pm.building
+        sightings = []
+        for v in self.get("views") or []:
+            for d in v.detections:
+                s = sighting(b, v.observation, d)
+                if s is not None:
+                    sightings.append(s)
+        fix = fix_pose(sightings)
+        if fix is None:
+            seen = sorted({s.entity for s in sightings})
+            return self.fail(
+                FailureCode.LOCALIZATION_FAILED,
+                f"attempt {attempts}: {len(seen)} landmark(s) recognised "
+                f"({', '.join(seen) or 'none'})"
+                "; two are needed",
+            )
+        self.bb.set("map_T_odom", fix.map_T_odom)
+        est = fix.map_pose(self.ctx.base.pose())
+        views = self.get("views") or []
+        self.ctx.log(
+            "fix",
+            "+".join(e.split(":")[1] for e in fix.entities),
+            thumbnail(views[-1].observation.rgb) if views else None,
+            map_pose=[est.x, est.y, est.yaw],
+            residual=fix.residual,
+            attempts=attempts,
+        )
+        where = f"({est.x:.1f}, {est.y:.1f})"
+        self.feedback_message = (
+            f"at {where} from {', '.join(fix.entities)} (rms {fix.residual:.2f} m)"
+        )
+        return Status.SUCCESS
+
+
+class Explore(PmNavBehaviour):
+    """Explore along the corridor: turn to the most open direction of the last panorama
+    (the view with the most free floor ahead, from depth), then drive ``distance``.
+
+    Reads ``views``; writes nothing. SUCCESS when the distance is covered or the way
+    is blocked (exploring is best effort).
+    """
+
+    READS = ("views",)
+
+    def __init__(self, name: str, ctx: Context, distance: float):
+        super().__init__(name, ctx)
+        self.distance = distance
+
+    def initialise(self) -> None:
+        pose = self.ctx.base.pose()
+        self._heading = pose.yaw
+        best = -1.0
+        for v in self.get("views") or []:
+            free = free_distance(v.observation, 0.0)
+            if free > best:
+                best, self._heading = free, v.observation.pose.yaw
+        self._goal = None
+
+    def update(self) -> Status:
+        base = self.ctx.base
+        pose = base.pose()
+        if self._goal is None:
+            v, w, done = rotate_command(pose, self._heading, self.ctx.limits)
+            if not done:
+                base.set_velocity(v, w)
+                return Status.RUNNING
+            self._goal = (
+                pose.x + self.distance * math.cos(pose.yaw),
+                pose.y + self.distance * math.sin(pose.yaw),
+            )
+        if base.motion_status() == MotionStatus.BLOCKED:
+            base.stop()
+            self.feedback_message = "blocked: explored as far as possible"
+            return Status.SUCCESS
+        v, w, done = goto_command(pose, *self._goal, self.ctx.limits)
+        if done:
+            base.set_velocity(0.0, 0.0)
+            return Status.SUCCESS
+        base.set_velocity(v, w)
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self.ctx.base.stop()

@@ -1,0 +1,29 @@
+"""The mission monitor: counts actions against the budget and watches the body."""
+
+from __future__ import annotations
+
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.common import PmNavBehaviour
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.seams import MotionStatus
+
+
+class Monitor(PmNavBehaviour):
+    """RUNNING while the mission may go on; FAILURE when the action budget is spent
+    (BUDGET_EXCEEDED) or the body faults (BASE_FAULT). Writes ``failure`` only."""
+
+    def update(self) -> Status:
+        base = self.ctx.base
+        self.ctx.odometer.update(base.pose())
+        used = self.ctx.odometer.actions
+        if used > self.ctx.budget_actions:
+            base.stop()
+            return self.fail(
+                FailureCode.BUDGET_EXCEEDED, f"{used} actions used of {self.ctx.budget_actions}"
+            )
+        if base.motion_status() == MotionStatus.FAULT:
+            base.stop()
+            return self.fail(FailureCode.BASE_FAULT, "the base reports a fault")
+        self.feedback_message = f"{used}/{self.ctx.budget_actions} actions"
+        return Status.RUNNING

@@ -1,0 +1,282 @@
+"""Motion leaves: approach a seen target, drive to an unseen turn or fork, turn, arrive.
+
+All drive on the estimated map pose (``map_T_odom`` composed with odometry) with
+velocity commands, and watch for obstacles: the base reporting a collision, no
+progress for a while, or depth showing something on the floor ahead.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.common import PmNavBehaviour
+from pmnav_bt.behaviours.context import Context, map_pose, thumbnail
+from pmnav_bt.control import goto_command, rotate_command
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.geometry import Action, heading
+from pmnav_bt.perception.corner import is_corner, is_opening, mask_ratios
+from pmnav_bt.perception.geometry import free_distance
+from pmnav_bt.seams import MotionStatus
+
+NO_PROGRESS_S = 10.0  # clock seconds without getting 0.1 m closer -> blocked
+WATCH_PERIOD_S = 1.0  # clock seconds between obstacle checks from depth
+MAX_BUMPS = 3  # collisions before a drive gives up as blocked
+
+
+class DriveTo(PmNavBehaviour):
+    """Drive to a map point; subclasses choose the point and may refine it on the way.
+
+    Reads ``map_T_odom``, ``target``. FAILURE (BLOCKED) on repeated collisions, no
+    progress, or an obstacle closer than the goal.
+    """
+
+    READS = ("map_T_odom", "target", "plan")
+
+    def goal(self) -> tuple[float, float]:
+        raise NotImplementedError
+
+    def on_watch(self, obs) -> None:
+        """Called with each watch frame (in the tick, after the worker took it)."""
+
+    def initialise(self) -> None:
+        self._goal = self.goal()
+        self._best = math.inf
+        self._best_t = self.ctx.now()
+        self._bumps = 0
+        self._watch_job = None
+        self._watch_t = -math.inf
+
+    def estimate(self):
+        return map_pose(self.get("map_T_odom"), self.ctx.base.pose())
+
+    def update(self) -> Status:
+        base, now = self.ctx.base, self.ctx.now()
+        st = base.motion_status()
+        if st == MotionStatus.FAULT:
+            return self.fail(FailureCode.BASE_FAULT, "the base reports a fault")
+        if st == MotionStatus.BLOCKED:
+            self._bumps += 1
+            if self._bumps >= MAX_BUMPS:
+                base.stop()
+                return self.fail(FailureCode.BLOCKED, f"{self._bumps} collisions on the way")
+        blocked = self._poll_watch(now)
+        if blocked is not None:
+            base.stop()
+            return self.fail(FailureCode.BLOCKED, blocked)
+        est = self.estimate()
+        dist = math.hypot(self._goal[0] - est.x, self._goal[1] - est.y)
+        if dist < self._best - 0.1:
+            self._best, self._best_t = dist, now
+        elif now - self._best_t > NO_PROGRESS_S:
+            base.stop()
+            return self.fail(FailureCode.BLOCKED, f"no progress for {NO_PROGRESS_S:.0f} s")
+        v, w, done = goto_command(est, *self._goal, self.ctx.limits)
+        if done:
+            base.set_velocity(0.0, 0.0)
+            return Status.SUCCESS
+        base.set_velocity(v, w)
+        self.feedback_message = f"{dist:.1f} m to go"
+        return Status.RUNNING
+
+    def _poll_watch(self, now: float) -> str | None:
+        """Start or collect a depth check of the way ahead; a reason when blocked."""
+        if self._watch_job is None:
+            if now - self._watch_t >= WATCH_PERIOD_S:
+                self._watch_t = now
+                base = self.ctx.base
+                self._watch_job = self.ctx.worker.submit(lambda c: base.observe())
+            return None
+        if not self._watch_job.done():
+            return None
+        try:
+            obs = self._watch_job.result()
+        except Exception as err:  # noqa: BLE001
+            return f"no camera frame: {err}"
+        finally:
+            self._watch_job = None
+        self.on_watch(obs)
+        est = map_pose(self.get("map_T_odom"), obs.pose)
+        to_goal = math.hypot(self._goal[0] - est.x, self._goal[1] - est.y)
+        bearing = heading((est.x, est.y), self._goal) - est.yaw
+        if abs(math.atan2(math.sin(bearing), math.cos(bearing))) > math.radians(25):
+            return None  # still turning towards the goal: nothing to judge yet
+        free = free_distance(obs, bearing)
+        if free < min(to_goal, 1.2) - 0.3:
+            self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)
+            return f"obstacle {free:.1f} m ahead"
+        return None
+
+    def terminate(self, new_status: Status) -> None:
+        if getattr(self, "_watch_job", None) is not None:
+            self._watch_job.cancel()
+            self._watch_job = None
+        if new_status == Status.INVALID:
+            self.ctx.base.stop()
+
+
+class Approach(DriveTo):
+    """Approach the seen target: stop ``offset`` metres from its door, towards the corridor.
+
+    Reads ``target`` (PlanStep), ``map_T_odom``. The goal room uses the tree's goal
+    offset, other landmarks the approach offset.
+    """
+
+    def goal(self) -> tuple[float, float]:
+        t = self.get("target")
+        cfg = self.ctx.config.tree
+        offset = cfg.goal_offset if t.action == Action.ARRIVE else cfg.approach_offset
+        return approach_point(t.target, t.position, offset)
+
+
+class MoveToward(DriveTo):
+    """Move along the way to the target until ``keep`` metres short of it, at most
+    ``distance`` metres: into search range before a search, or on towards a target not
+    found ("continue to locate the old landmark"). Reads ``target``, ``map_T_odom``."""
+
+    def __init__(self, name: str, ctx: Context, keep: float, distance: float = math.inf):
+        super().__init__(name, ctx)
+        self.keep = keep
+        self.distance = distance
+
+    def goal(self) -> tuple[float, float]:
+        t = self.get("target")
+        est = self.estimate()
+        d = np.asarray(t.position, float) - (est.x, est.y)
+        n = float(np.linalg.norm(d))
+        step = max(0.0, min(self.distance, n - self.keep))
+        if step == 0.0:
+            return est.x, est.y
+        return float(est.x + d[0] * step / n), float(est.y + d[1] * step / n)
+
+
+def approach_point(target, node, offset: float) -> tuple[float, float]:
+    """The point ``offset`` m from ``target`` (a door) towards its node on the centre line."""
+    m, n = np.asarray(target, float), np.asarray(node, float)
+    d = float(np.linalg.norm(n - m))
+    if d < 1e-6:
+        return float(n[0]), float(n[1])
+    p = m + (n - m) * min(offset, d) / d
+    return float(p[0]), float(p[1])
+
+
+class DriveToWaypoint(DriveTo):
+    """Drive to an unseen key waypoint (turn or fork) on the centre line.
+
+    For a turn, the corner check (wall/floor mask ratio ahead) refines where the
+    corner is: once a wall fills the way ahead, the turn point is half a corridor
+    width before it. Reads ``target``, ``map_T_odom``.
+    """
+
+    def goal(self) -> tuple[float, float]:
+        t = self.get("target")
+        self._corner_seen = False
+        return float(t.position[0]), float(t.position[1])
+
+    def on_watch(self, obs) -> None:
+        t = self.get("target")
+        if t.kind != "turn" or self._corner_seen or obs.depth is None:
+            return
+        ratios = mask_ratios(obs, self.ctx.grounder)
+        if not is_corner(ratios):
+            return
+        h, w = obs.depth.shape
+        wall = float(np.median(obs.depth[h // 2 : h // 2 + max(2, h // 20), w // 3 : 2 * w // 3]))
+        width = self.ctx.pm.segment(t.segment).width
+        est = map_pose(self.get("map_T_odom"), obs.pose)
+        ahead = max(0.0, wall - width / 2.0)
+        p = (est.x + ahead * math.cos(t.heading), est.y + ahead * math.sin(t.heading))
+        if math.dist(p, t.position) <= 2.0:  # agrees with the map: trust the eyes
+            self._goal = p
+            self._corner_seen = True
+            self.ctx.log(
+                "corner", t.landmark, thumbnail(obs.rgb), wall=ratios.wall, floor=ratios.floor
+            )
+
+
+def out_heading(plan, step) -> float:
+    """Heading of the route leaving a step's node (the arrival heading at the goal)."""
+    pts = [np.asarray(p) for p in plan.path]
+    here = np.asarray(step.position)
+    for i, p in enumerate(pts[:-1]):
+        if np.linalg.norm(p - here) < 1e-6 and np.linalg.norm(pts[i + 1] - p) > 1e-6:
+            return heading(p, pts[i + 1])
+    return step.heading
+
+
+class TurnOnto(PmNavBehaviour):
+    """Turn in place onto the heading the plan takes after the target (turn or fork).
+
+    Reads ``target``, ``plan``, ``map_T_odom``.
+    """
+
+    READS = ("target", "plan", "map_T_odom")
+
+    def initialise(self) -> None:
+        self._heading = out_heading(self.get("plan"), self.get("target"))
+
+    def update(self) -> Status:
+        est = map_pose(self.get("map_T_odom"), self.ctx.base.pose())
+        v, w, done = rotate_command(est, self._heading, self.ctx.limits)
+        if done:
+            self.ctx.base.set_velocity(0.0, 0.0)
+            t = self.get("target")
+            self.ctx.log("turn", t.landmark, action=t.action.value)
+            return Status.SUCCESS
+        self.ctx.base.set_velocity(v, w)
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self.ctx.base.stop()
+
+
+class CheckOpening(PmNavBehaviour):
+    """Fork choice / turn check: the way now ahead is an open corridor (floor in the band).
+
+    Reads ``target``. FAILURE (TARGET_NOT_FOUND) when a wall fills the way ahead.
+    """
+
+    READS = ("target",)
+
+    def initialise(self) -> None:
+        base, grounder = self.ctx.base, self.ctx.grounder
+        self._job = self.ctx.worker.submit(
+            lambda c: (lambda o: (o, mask_ratios(o, grounder)))(base.observe())
+        )
+
+    def update(self) -> Status:
+        if not self._job.done():
+            return Status.RUNNING
+        obs, ratios = self._job.result()
+        t = self.get("target")
+        if not is_opening(ratios):
+            return self.fail(
+                FailureCode.TARGET_NOT_FOUND,
+                f"no corridor to take at {t.landmark} (floor {ratios.floor:.2f}, "
+                f"wall {ratios.wall:.2f})",
+            )
+        self.feedback_message = f"open (floor {ratios.floor:.2f})"
+        return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self._job.cancel()
+
+
+class Arrive(PmNavBehaviour):
+    """Arrive and stop at the goal. Reads ``plan``."""
+
+    READS = ("plan",)
+
+    def __init__(self, name: str, ctx: Context):
+        super().__init__(name, ctx)
+
+    def update(self) -> Status:
+        self.ctx.base.stop()
+        plan = self.get("plan")
+        self.ctx.log("arrive", plan.goal if plan else "")
+        self.feedback_message = f"arrived at {plan.goal if plan else 'goal'}"
+        return Status.SUCCESS

@@ -1,0 +1,91 @@
+"""Wheel odometry with drift, around a simulated body.
+
+Real odometry drifts; a tree that never corrects itself with landmarks would look
+fine on perfect odometry and fail on a robot. ``NoisyOdometry`` wraps a SimBase and
+reports an odometry pose integrated from the true motion with a seeded relative
+error on every increment (scale on distance, and heading error growing with distance
+and rotation). It is itself a ``Base``; ``true_pose()`` gives the ground truth.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import replace
+
+from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.seams import DiscreteAction, MotionStatus, Observation, Pose2D
+from pmnav_bt.sim.robot import SimBase
+
+
+class NoisyOdometry:
+    """A Base whose pose is drifting odometry of the wrapped SimBase.
+
+    ``noise`` is the standard deviation of the relative error of each increment; the
+    odometry frame starts equal to the map frame (the tree does not know that).
+    """
+
+    def __init__(self, base: SimBase, noise: float, seed: int = 0):
+        self.inner = base
+        self.clock = base.clock
+        self.noise = float(noise)
+        self._rng = random.Random(seed)
+        self._last_true = base.pose()
+        self._odom = base.pose()
+        # Constant biases per run (miscalibrated wheel radius and wheel base), plus
+        # per-increment noise: distance scale ~ N(1, noise), heading drift ~ N(0, noise/10)
+        # rad per metre, rotation scale ~ N(1, noise).
+        self._scale = 1.0 + self._rng.gauss(0.0, self.noise)
+        self._yaw_per_m = self._rng.gauss(0.0, self.noise / 10.0)
+        self._rot_scale = 1.0 + self._rng.gauss(0.0, self.noise)
+        self.clock.add_listener(self._integrate)
+
+    def _integrate(self, _h: float) -> None:
+        # Runs before the inner body moves in this tick: integrate the previous tick's motion.
+        self._update()
+
+    def _update(self) -> None:
+        true = self.inner.pose()
+        last = self._last_true
+        dx, dy = true.x - last.x, true.y - last.y
+        # Increment in the body frame of the last true pose.
+        c, s = math.cos(last.yaw), math.sin(last.yaw)
+        fwd, side = c * dx + s * dy, -s * dx + c * dy
+        dth = wrap_angle(true.yaw - last.yaw)
+        if fwd or side or dth:
+            n = self.noise
+            dist = math.hypot(fwd, side)
+            fwd *= self._scale * (1.0 + self._rng.gauss(0.0, n))
+            side *= self._scale
+            dth = dth * self._rot_scale * (1.0 + self._rng.gauss(0.0, n)) + self._yaw_per_m * dist
+            o = self._odom
+            co, so = math.cos(o.yaw), math.sin(o.yaw)
+            self._odom = Pose2D(
+                o.x + co * fwd - so * side, o.y + so * fwd + co * side, wrap_angle(o.yaw + dth)
+            )
+        self._last_true = true
+
+    # -- Base seam ---------------------------------------------------------------------------
+
+    def pose(self) -> Pose2D:
+        self._update()
+        return self._odom
+
+    def true_pose(self) -> Pose2D:
+        return self.inner.pose()
+
+    def observe(self) -> Observation:
+        obs = self.inner.observe()
+        return replace(obs, pose=self.pose())
+
+    def step(self, action: DiscreteAction) -> None:
+        self.inner.step(action)
+
+    def set_velocity(self, linear: float, angular: float) -> None:
+        self.inner.set_velocity(linear, angular)
+
+    def motion_status(self) -> MotionStatus:
+        return self.inner.motion_status()
+
+    def stop(self) -> None:
+        self.inner.stop()

@@ -1,0 +1,205 @@
+"""The PM-Nav tree: localize, plan, then per step "target determination -> search ->
+verification -> target update", with re-search, replanning and a budget.
+
+Variants (paper, Table 4): ``pmnav`` refines the coarse direction with grounding and
+the fine-direction refiner; ``coarse_only`` keeps the coarse view direction.
+"""
+
+from __future__ import annotations
+
+import py_trees
+from py_trees.behaviours import Failure as AlwaysFail
+from py_trees.composites import Parallel, Selector, Sequence
+from py_trees.decorators import FailureIsSuccess, Repeat, Retry
+
+from pmnav_bt.behaviours.capture import CaptureViews, search_yaws
+from pmnav_bt.behaviours.common import NAMESPACE
+from pmnav_bt.behaviours.context import Context
+from pmnav_bt.behaviours.decorators import ClockTimeout
+from pmnav_bt.behaviours.localize import (
+    Explore,
+    FixPosition,
+    enough_doors,
+    localization_yaws,
+    sign_query,
+)
+from pmnav_bt.behaviours.monitor import Monitor
+from pmnav_bt.behaviours.motion import (
+    Approach,
+    Arrive,
+    CheckOpening,
+    DriveToWaypoint,
+    MoveToward,
+    TurnOnto,
+)
+from pmnav_bt.behaviours.planning import (
+    CheckGoal,
+    DetermineTarget,
+    MakePlan,
+    NoteFailure,
+    PlanComplete,
+    TargetIs,
+    UpdateTarget,
+)
+from pmnav_bt.behaviours.search import (
+    CoarseDirection,
+    FineDirection,
+    Ground,
+    Verify,
+    target_query,
+)
+
+VARIANTS = ("pmnav", "coarse_only")
+
+
+def localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour.Behaviour:
+    """Capture the six localization views and fix the pose; explore and retry if too few
+    landmarks are seen."""
+    cfg = ctx.config.tree
+    fix = Sequence(
+        f"{name}Once",
+        memory=True,
+        children=[
+            CaptureViews(
+                f"{name}Views",
+                ctx,
+                localization_yaws,
+                sign_query,
+                enough=lambda views: enough_doors(ctx, views),
+            ),
+            FixPosition(f"{name}Fix", ctx),
+        ],
+    )
+    explore = Sequence(
+        f"{name}Explore",
+        memory=True,
+        children=[
+            Explore(f"{name}Walk", ctx, cfg.explore_distance),
+            AlwaysFail(name="TryAgain"),
+        ],
+    )
+    return Retry(
+        name,
+        Selector(f"{name}OrExplore", memory=True, children=[fix, explore]),
+        num_failures=cfg.localization_attempts,
+    )
+
+
+def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
+    """One plan step: target determination, then search-verify-approach for a visible
+    target or drive-turn-check for an unseen turn or fork, then target update."""
+    cfg = ctx.config.tree
+    search_once = Sequence(
+        "SearchOnce",
+        memory=True,
+        children=[
+            CaptureViews(
+                "SearchViews",
+                ctx,
+                lambda b: search_yaws(b.get("last_action")),
+                target_query,
+                enough=lambda views: any(d.score >= 0.5 for d in views[-1].detections),
+            ),
+            CoarseDirection("CoarseDirection", ctx, ctx.config.coarse.min_score),
+            Ground("Grounding", ctx),
+            FineDirection("FineDirection", ctx),
+            Verify("Verification", ctx),
+        ],
+    )
+    research = Sequence(
+        "MoveOnAndResearch",
+        memory=True,
+        children=[
+            MoveToward("MoveOn", ctx, keep=1.0, distance=cfg.research_distance),
+            AlwaysFail(name="SearchAgain"),
+        ],
+    )
+    visible = Sequence(
+        "SeenTarget",
+        memory=True,
+        children=[
+            TargetIs("IsVisible", ctx, visible=True),
+            MoveToward("IntoSearchRange", ctx, keep=cfg.search_range),
+            Retry(
+                "Search",
+                Selector("SearchOrMoveOn", memory=True, children=[search_once, research]),
+                num_failures=cfg.search_attempts,
+            ),
+            Approach("Approach", ctx),
+        ],
+    )
+    unseen = Sequence(
+        "UnseenWaypoint",
+        memory=True,
+        children=[
+            TargetIs("IsUnseen", ctx, visible=False),
+            DriveToWaypoint("CornerCheck", ctx),
+            TurnOnto("TurnOnto", ctx),
+            CheckOpening("ForkChoice", ctx),
+        ],
+    )
+    step = Sequence(
+        "Step",
+        memory=True,
+        children=[
+            DetermineTarget("TargetDetermination", ctx),
+            Selector("ByTargetKind", memory=True, children=[visible, unseen]),
+            UpdateTarget("TargetUpdate", ctx),
+        ],
+    )
+    return ClockTimeout("StepTimeout", step, ctx.now, cfg.step_timeout_s)
+
+
+def build_pmnav_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
+    """The whole PM-Nav tree for ``goal``, for the variant named in ``ctx.config.tree``."""
+    cfg = ctx.config.tree
+    if cfg.variant not in VARIANTS:
+        raise ValueError(f"unknown tree variant {cfg.variant!r}; choose from {VARIANTS}")
+    follow = Selector(
+        "FollowPlan",
+        memory=False,
+        children=[
+            PlanComplete("PlanComplete", ctx),
+            Repeat("EachStep", step_subtree(ctx), num_success=-1),
+        ],
+    )
+    recover = Sequence(
+        "Recover",
+        memory=True,
+        children=[
+            NoteFailure("NoteFailure", ctx),
+            FailureIsSuccess("TryRelocalize", localize_subtree(ctx, "Relocalize")),
+            AlwaysFail(name="Replan"),
+        ],
+    )
+    navigate = Retry(
+        "Navigate",
+        Selector(
+            "PlanOrRecover",
+            memory=True,
+            children=[
+                Sequence("PlanAndFollow", memory=True, children=[MakePlan("Plan", ctx), follow]),
+                recover,
+            ],
+        ),
+        num_failures=cfg.replans + 1,
+    )
+    mission = Sequence(
+        "Mission",
+        memory=True,
+        children=[
+            CheckGoal("CheckGoal", ctx),
+            localize_subtree(ctx),
+            navigate,
+            Arrive("Arrive", ctx),
+        ],
+    )
+    root = Parallel(
+        "PM-Nav",
+        policy=py_trees.common.ParallelPolicy.SuccessOnOne(),
+        children=[Monitor("Monitor", ctx), mission],
+    )
+    bb = py_trees.blackboard.Client(name="setup", namespace=NAMESPACE)
+    bb.register_key(key="goal", access=py_trees.common.Access.WRITE)
+    bb.goal = goal
+    return py_trees.trees.BehaviourTree(root)

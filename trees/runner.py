@@ -1,0 +1,130 @@
+"""Tick a PM-Nav tree against any Base until it ends, logging a snapshot per tick.
+
+The runner owns time: after each tick it lets one tick period pass on the base's
+Clock (the simulator advances physics; the robot sleeps). In simulation it first
+waits for the worker's jobs, so that the same seed gives the same episode whatever
+the machine's speed; on the robot it never waits.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TextIO
+
+import py_trees
+
+from pmnav_bt.behaviours.common import NAMESPACE
+from pmnav_bt.behaviours.context import Context
+from pmnav_bt.config import Config
+from pmnav_bt.failures import Failure, FailureCode
+from pmnav_bt.perception.ground_truth import GroundTruthGrounder
+from pmnav_bt.perception.refine import CoarseOnly, GeometricRefiner
+from pmnav_bt.planner import GraphPlanner
+from pmnav_bt.priori_map import PrioriMap
+from pmnav_bt.seams import FORWARD_STEP_M, Base
+from pmnav_bt.trees.pmnav import build_pmnav_tree
+from pmnav_bt.trees.snapshots import SnapshotLogger
+from pmnav_bt.worker import Worker
+
+
+@dataclass
+class RunOutcome:
+    """How a run ended."""
+
+    success: bool
+    failure: Failure | None
+    ticks: int
+    clock_time: float
+    fix_attempts: int
+    replans: int
+    actions: int
+
+
+def action_budget(config: Config, shortest_path_m: float | None) -> int:
+    """The action budget: the configured one, scaled up when the shortest path alone needs more."""
+    cfg = config.tree
+    if shortest_path_m is None:
+        return cfg.budget_actions
+    needed = cfg.budget_path_factor * shortest_path_m / FORWARD_STEP_M
+    return max(cfg.budget_actions, int(math.ceil(needed)))
+
+
+def make_context(
+    base: Base, pm: PrioriMap, config: Config, seed: int = 0, budget: int | None = None
+) -> Context:
+    """The back ends the config names, wired into a Context."""
+    g = config.grounder
+    grounder = GroundTruthGrounder(
+        pm.building,
+        miss_rate=g.miss_rate,
+        false_positive_rate=g.false_positive_rate,
+        mask_noise_px=g.mask_noise_px,
+        min_sign_pixels=g.min_sign_pixels,
+        max_range=g.max_range,
+        seed=seed,
+    )
+    refiner = CoarseOnly() if config.tree.variant == "coarse_only" else GeometricRefiner()
+    return Context(
+        base=base,
+        pm=pm,
+        config=config,
+        grounder=grounder,
+        refiner=refiner,
+        planner=GraphPlanner(max_gap=config.planner.max_gap),
+        worker=Worker(),
+        budget_actions=budget if budget is not None else config.tree.budget_actions,
+    )
+
+
+def _blackboard(key: str):
+    store = py_trees.blackboard.Blackboard.storage
+    return store.get(f"{NAMESPACE}/{key}")
+
+
+def run_tree(
+    ctx: Context,
+    goal: str,
+    max_ticks: int = 100_000,
+    log: TextIO | None = None,
+    on_tick: Callable[[py_trees.trees.BehaviourTree], None] | None = None,
+    sync_workers: bool = True,
+) -> RunOutcome:
+    """Build the tree for ``goal`` and tick it until it succeeds or fails."""
+    py_trees.blackboard.Blackboard.clear()
+    tree = build_pmnav_tree(ctx, goal)
+    if log is not None:
+        tree.add_post_tick_handler(SnapshotLogger(tree, log, ctx.now))
+    if on_tick is not None:
+        tree.add_post_tick_handler(on_tick)
+    period = 1.0 / ctx.config.tree.tick_hz
+    status = py_trees.common.Status.RUNNING
+    try:
+        tree.setup()
+        while tree.count < max_ticks:
+            tree.tick()
+            status = tree.root.status
+            if status != py_trees.common.Status.RUNNING:
+                break
+            if sync_workers:
+                ctx.worker.drain()
+            ctx.base.clock.wait(period)
+    finally:
+        ctx.base.stop()
+        tree.interrupt()
+        ctx.worker.shutdown()
+    failure = None
+    if status != py_trees.common.Status.SUCCESS:
+        failure = _blackboard("failure") or Failure(
+            FailureCode.TIMEOUT, f"no result after {tree.count} ticks"
+        )
+    return RunOutcome(
+        success=status == py_trees.common.Status.SUCCESS,
+        failure=failure,
+        ticks=tree.count,
+        clock_time=ctx.now(),
+        fix_attempts=_blackboard("fix_attempts") or 0,
+        replans=_blackboard("replans") or 0,
+        actions=ctx.odometer.actions,
+    )
