@@ -41,6 +41,10 @@ class MakePlan(PmNavBehaviour):
         try:
             plan = self._job.result()
         except (UnknownNameError, PlanningError) as err:
+            blocked = self.get("blocked_segments")
+            if isinstance(err, PlanningError) and blocked:
+                segs = ", ".join(f"seg{i}" for i in sorted(blocked))
+                return self.fail(FailureCode.BLOCKED, f"no route around the blocked {segs}")
             return self.fail(FailureCode.PLANNING_FAILED, str(err))
         self.bb.set("plan", plan)
         self.bb.set("step_index", 0)

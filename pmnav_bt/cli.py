@@ -110,6 +110,20 @@ def plan(
         typer.echo(f"wrote {image}", err=True)
 
 
+def _mount_subcommands() -> None:
+    from pmnav_bt.sim.cli import app as sim_app
+
+    app.add_typer(sim_app, name="sim")
+    try:
+        from pmnav_bt.trees.cli import app as tree_app
+    except ImportError:  # pragma: no cover - during development only
+        return
+    app.add_typer(tree_app, name="tree")
+
+
+_mount_subcommands()
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the app; user errors become one line on stderr and exit status 2."""
     try:

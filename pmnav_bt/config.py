@@ -27,6 +27,9 @@ class GrounderConfig(_Section):
     mask_noise_px: int = Field(0, ge=0)
     min_sign_pixels: int = Field(40, ge=1)
     max_range: float = Field(9.0, gt=0.0)
+    hidden: list[str] = Field(
+        default_factory=list, description="room/landmark IDs whose signs are never read"
+    )
 
 
 class CoarseConfig(_Section):

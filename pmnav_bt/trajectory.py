@@ -91,14 +91,16 @@ def _thumb_strip(nodes: list[KeyNode], width: int, caption: str) -> np.ndarray:
     th_w = max(120, min(220, (width - 20) // max(1, len(nodes)) - 10))
     th_h = int(th_w * 0.75)
     strip = np.full((th_h + 70, width, 3), 255, np.uint8)
-    put_text(strip, "planned path (blue), driven path (red). " + caption, (10, 20), 0.5,
-             (0, 0, 0), 1)
+    put_text(
+        strip, "planned path (blue), driven path (red). " + caption, (10, 20), 0.5, (0, 0, 0), 1
+    )
     x = 10
     for letter, n in zip(string.ascii_uppercase, nodes, strict=False):
         thumb = cv2.cvtColor(cv2.resize(n.thumbnail, (th_w, th_h)), cv2.COLOR_RGB2BGR)
         strip[30 : 30 + th_h, x : x + th_w] = thumb
-        cv2.rectangle(strip, (x, 30), (x + th_w - 1, 30 + th_h - 1),
-                      EVENT_COLOUR.get(n.kind, (0, 0, 0)), 2)
+        cv2.rectangle(
+            strip, (x, 30), (x + th_w - 1, 30 + th_h - 1), EVENT_COLOUR.get(n.kind, (0, 0, 0)), 2
+        )
         text = f"{letter}: {EVENT_NAME.get(n.kind, n.kind)} {n.label}"
         put_text(strip, text[:28], (x, 30 + th_h + 20), 0.45, (0, 0, 0), 1)
         x += th_w + 10

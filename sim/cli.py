@@ -100,3 +100,163 @@ def _hold_gui(world) -> None:  # pragma: no cover - needs a display
             time.sleep(0.1)
     except KeyboardInterrupt:
         pass
+
+
+TIER_NAMES = ("easy", "medium", "hard")
+
+
+def _tiers(tier: str) -> list[str]:
+    if tier == "all":
+        return list(TIER_NAMES)
+    if tier not in TIER_NAMES:
+        raise PmNavError(f"--tier {tier!r}: choose easy, medium, hard or all")
+    return [tier]
+
+
+def _buildings(building: str) -> list[str]:
+    from pmnav_bt.building import builtin_buildings
+
+    if building != "all":
+        return [b.strip() for b in building.split(",") if b.strip()]
+    six = ["straight_office", "l_hospital", "t_school", "u_office", "loop_hospital", "ring_school"]
+    return [b for b in six if b in builtin_buildings()]
+
+
+def _config(config: Path | None, overrides: list[str] | None):
+    from pmnav_bt.config import load_config
+
+    return load_config(config, overrides or [])
+
+
+CONFIG_OPT = typer.Option(None, "--config", help="A run config YAML (see docs/config.md).")
+SET_OPT = typer.Option(None, "--set", help="Override a config value: section.key=value.")
+
+
+@app.command()
+def episodes(
+    building: str = typer.Argument(..., help="A building file or built-in name."),
+    tier: str = typer.Option("easy", "--tier", help="easy, medium, hard or all."),
+    n: int = typer.Option(20, "-n", min=1, help="Episodes per tier."),
+    seed: int = typer.Option(0, "--seed"),
+    out: Path | None = typer.Option(None, "--out", help="JSON file (default: print)."),
+) -> None:
+    """Generate seeded episodes of a tier and save them as JSON."""
+    from pmnav_bt.sim.episodes import generate_episodes, save_episodes, tier_definition
+
+    eps = []
+    for t in _tiers(tier):
+        eps += generate_episodes(building, t, n, seed=seed)
+    if out is None:
+        out = Path(f"{Path(building).stem}_{tier}_episodes.json")
+    save_episodes(eps, out)
+    typer.echo(tier_definition())
+    typer.echo(f"wrote {len(eps)} episodes to {out}")
+
+
+@app.command()
+def run(
+    building: str = typer.Option("fig2_hospital", "--building", help="A building or built-in."),
+    goal: str = typer.Option(..., "--goal", help="The goal room: ID, name or alias."),
+    start: str | None = typer.Option(
+        None, "--start", help="Start: a segment, waypoint, or pose 'x,y,yaw_deg' (default: start)."
+    ),
+    episode_file: Path | None = typer.Option(
+        None, "--episodes", help="Run an episode from a JSON file instead (with --index)."
+    ),
+    index: int = typer.Option(0, "--index", help="Which episode of --episodes."),
+    seed: int = typer.Option(0, "--seed"),
+    out: Path = typer.Option(Path("out/run"), "--out", help="Folder for the log and the plot."),
+    show_tree: bool = typer.Option(False, "--show-tree", help="Show the live tree while it runs."),
+    config: Path | None = CONFIG_OPT,
+    overrides: list[str] | None = SET_OPT,
+) -> None:
+    """Run one PM-Nav episode and print its result; write the tree log and trajectory plot."""
+    from pmnav_bt.evaluation import VARIANT_NAMES, custom_episode, run_episode
+
+    cfg = _config(config, overrides)
+    if episode_file is not None:
+        from pmnav_bt.sim.episodes import load_episodes
+
+        eps = load_episodes(episode_file)
+        if not 0 <= index < len(eps):
+            raise PmNavError(f"--index {index}: {episode_file} has {len(eps)} episodes")
+        ep = eps[index]
+    else:
+        ep = custom_episode(building, goal, start, seed)
+    on_tick = None
+    if show_tree:
+        from pmnav_bt.trees.live import LiveTree
+
+        on_tick = LiveTree()
+    typer.echo(
+        f"{VARIANT_NAMES[cfg.tree.variant]} in {ep.building}: {ep.id} ({ep.tier}), "
+        f"start ({ep.start_x:.1f}, {ep.start_y:.1f}, {math.degrees(ep.start_yaw):.0f} deg), "
+        f"shortest path {ep.geodesic_length:.1f} m"
+    )
+    r = run_episode(ep, cfg, out_dir=out, on_tick=on_tick)
+    res = r.result
+    typer.echo(
+        f"{'SUCCESS' if res.success else 'FAILURE'}: SPL {res.spl:.3f}, {res.steps} actions, "
+        f"{res.path_length:.1f} m driven, {res.collisions} collisions, stopped "
+        f"{res.distance_to_goal:.2f} m from the door, {res.wall_time:.1f} s wall"
+    )
+    if res.failure_reason:
+        typer.echo(f"reason: {res.failure_reason}")
+    typer.echo(f"tree log: {r.tree_log}\ntrajectory plot: {r.plot}")
+    if not res.success:
+        raise typer.Exit(1)
+
+
+@app.command("eval")
+def eval_(
+    building: str = typer.Option("all", "--building", help="Comma-separated buildings, or all."),
+    tier: str = typer.Option("all", "--tier", help="easy, medium, hard or all."),
+    n: int = typer.Option(20, "-n", min=1, help="Episodes per tier per building."),
+    seed: int = typer.Option(0, "--seed"),
+    variants: str = typer.Option("pmnav,coarse_only", "--variants", help="Tree variants."),
+    jobs: int = typer.Option(2, "--jobs", min=1, help="Episodes run in parallel."),
+    out: Path = typer.Option(Path("out/eval"), "--out", help="Folder for results.json/.md."),
+    config: Path | None = CONFIG_OPT,
+    overrides: list[str] | None = SET_OPT,
+) -> None:
+    """Run many episodes and print SR/SPL per tier for each tree variant (paper Table 1)."""
+    from rich.progress import Progress
+
+    from pmnav_bt.evaluation import (
+        comparison_markdown,
+        episodes_for,
+        evaluate,
+        save_evaluation,
+        variant_configs,
+    )
+    from pmnav_bt.sim.episodes import tier_definition
+
+    cfg = _config(config, overrides)
+    names = [v.strip() for v in variants.split(",") if v.strip()]
+    configs = variant_configs(cfg, names)
+    eps, notes = episodes_for(_buildings(building), _tiers(tier), n, seed)
+    for note in notes:
+        typer.echo(f"note: {note}", err=True)
+    if not eps:
+        raise PmNavError("no episodes to run")
+    with Progress(transient=False) as bar:
+        task = bar.add_task("episodes", total=len(eps) * len(configs))
+        results = evaluate(
+            eps,
+            configs,
+            jobs=jobs,
+            progress=lambda name, done, total: bar.update(task, completed=done),
+        )
+    g = cfg.grounder
+    header = (
+        f"# PM-Nav evaluation\n\nbuildings: {building}; tiers: {tier}; {n} per tier per "
+        f"building; seed {seed}; grounder {g.backend} (miss {g.miss_rate:.0%}, false positives "
+        f"{g.false_positive_rate:.0%}); odometry noise {cfg.sim.odometry_noise:.0%}; camera "
+        f"{cfg.sim.width}x{cfg.sim.height}\n\nAction budget: max({cfg.tree.budget_actions}, "
+        f"{cfg.tree.budget_path_factor:g} x shortest path / 0.25 m, the episode's own budget).\n\n"
+        + "Tiers:\n"
+        + tier_definition()
+    )
+    md = save_evaluation(results, out, header)
+    typer.echo(comparison_markdown(results))
+    typer.echo(f"wrote {md} and {out / 'results.json'}")

@@ -63,6 +63,7 @@ def make_context(
         mask_noise_px=g.mask_noise_px,
         min_sign_pixels=g.min_sign_pixels,
         max_range=g.max_range,
+        hidden=frozenset(g.hidden),
         seed=seed,
     )
     refiner = CoarseOnly() if config.tree.variant == "coarse_only" else GeometricRefiner()

@@ -38,6 +38,7 @@ class GroundTruthGrounder:
     mask_noise_px: int = 0
     min_sign_pixels: int = 40
     max_range: float = 9.0
+    hidden: frozenset[str] = frozenset()  # room/landmark IDs never detected (covered signs)
     seed: int = 0
     _rng: random.Random = field(init=False, repr=False)
     _names: dict[str, str] = field(init=False, repr=False)
@@ -89,7 +90,7 @@ class GroundTruthGrounder:
         out: dict[str, tuple[np.ndarray, float]] = {}
         for lab, i in by_label.items():
             kind, _, ident = lab.partition(":")
-            if kind not in ("sign", "landmark"):
+            if kind not in ("sign", "landmark") or ident in self.hidden:
                 continue
             sign = seg == i
             n = int(sign.sum())

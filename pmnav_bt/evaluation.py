@@ -1,0 +1,306 @@
+"""Run PM-Nav episodes in the simulator and score them (SR, SPL as in the paper's Table 1).
+
+This module joins the simulator and the tree, so it imports both lazily, inside the
+functions: importing ``pmnav_bt.evaluation`` loads neither pybullet nor py_trees.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from pmnav_bt.config import Config
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.metrics import EpisodeResult, aggregate_by_tier, spl, success
+
+if TYPE_CHECKING:  # pragma: no cover
+    from pmnav_bt.sim.episodes import Episode
+
+VARIANT_NAMES = {"pmnav": "PM-Nav", "coarse_only": "coarse-only"}
+
+
+@dataclass
+class EpisodeRun:
+    """An episode's result and the files written for it."""
+
+    result: EpisodeResult
+    plot: Path | None = None
+    tree_log: Path | None = None
+    stop_distance: float = math.nan
+
+
+def custom_episode(building: str, goal: str, start: str | None = None, seed: int = 0) -> Episode:
+    """An episode for ``pmnav sim run``: a goal by name, from a start pose or the building's
+    start waypoint (facing along its corridor)."""
+    from pmnav_bt.building import load_building
+    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.resolve import resolve_room, resolve_start
+    from pmnav_bt.seams import Pose2D
+    from pmnav_bt.sim.episodes import Episode, classify, path_facts, step_budget
+
+    b = load_building(building)
+    pm = parse_building(b)
+    room = resolve_room(pm, goal)
+    if start is None:
+        w = next((w for w in b.waypoints if w.kind.value == "start"), b.waypoints[0])
+        seg = pm.segments_at(w.id)[0]
+        yaw = seg.heading if seg.a == w.id else seg.heading + math.pi
+        pose = Pose2D(w.pos[0], w.pos[1], yaw)
+        # Start a little into the corridor, not against the end wall.
+        pose = Pose2D(pose.x + 0.5 * math.cos(yaw), pose.y + 0.5 * math.sin(yaw), yaw)
+    else:
+        sp = resolve_start(pm, start)
+        a, c = pm.node_xy(sp.segment.a), pm.node_xy(sp.segment.b)
+        xy = a + sp.t * (c - a)
+        yaw = sp.heading if sp.heading is not None else sp.segment.heading
+        pose = Pose2D(float(xy[0]), float(xy[1]), yaw)
+    facts = path_facts(pm, pose, room)
+    return Episode(
+        id=f"{b.name}-{room}",
+        building=building,
+        tier=classify(facts) or "custom",
+        start_x=pose.x,
+        start_y=pose.y,
+        start_yaw=pose.yaw,
+        goal=room,
+        geodesic_length=facts.length,
+        seed=seed,
+        goal_visible=facts.goal_visible,
+        turns=facts.turns,
+        forks=facts.forks,
+        route=tuple(facts.route),
+        step_budget=step_budget(facts.length),
+    )
+
+
+def run_episode(
+    episode: Episode,
+    config: Config,
+    out_dir: Path | None = None,
+    on_tick: Callable | None = None,
+    plot: bool = True,
+    setup_world: Callable | None = None,
+) -> EpisodeRun:
+    """Run one episode in a fresh world; write its tree log and trajectory plot to ``out_dir``.
+
+    ``setup_world(world)`` may change the world first (add an obstacle, for example).
+    """
+    from pmnav_bt.building import load_building
+    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.sim.episodes import goal_door
+    from pmnav_bt.sim.odometry import NoisyOdometry
+    from pmnav_bt.sim.robot import SimBase
+    from pmnav_bt.sim.world import SimWorld
+    from pmnav_bt.trees.runner import action_budget, make_context, run_tree
+
+    b = load_building(episode.building)
+    pm = parse_building(b)
+    sim = config.sim
+    t0 = time.perf_counter()
+    with SimWorld(b) as world:
+        if setup_world is not None:
+            setup_world(world)
+        inner = SimBase(world, pose=episode.start_pose, width=sim.width, height=sim.height)
+        base = (
+            NoisyOdometry(inner, sim.odometry_noise, seed=episode.seed)
+            if sim.odometry_noise > 0
+            else inner
+        )
+        budget = max(episode.step_budget, action_budget(config, episode.geodesic_length))
+        ctx = make_context(base, pm, config, seed=episode.seed, budget=budget)
+        truth: list[tuple[float, float, float]] = []
+
+        def record(tree) -> None:
+            p = inner.pose()
+            truth.append((ctx.now(), p.x, p.y))
+            if on_tick is not None:
+                on_tick(tree)
+
+        log_path = None
+        if out_dir is not None:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            log_path = out_dir / f"{episode.id}.tree.jsonl"
+        with open(log_path, "w", encoding="utf-8") if log_path else _null() as log:
+            outcome = run_tree(ctx, episode.goal, log=log, on_tick=record)
+        final = inner.pose()
+        stats = inner.stats
+    wall = time.perf_counter() - t0
+    door = goal_door(pm, episode.goal)
+    stop = math.dist((final.x, final.y), door)
+    ok = outcome.success and success((final.x, final.y), door)
+    reason = None
+    if not outcome.success:
+        reason = str(outcome.failure)
+    elif not ok:
+        reason = f"STOPPED_AWAY: stopped {stop:.2f} m from the door"
+    result = EpisodeResult(
+        episode_id=episode.id,
+        tier=episode.tier,
+        success=ok,
+        spl=spl(ok, episode.geodesic_length, stats.path_length),
+        path_length=stats.path_length,
+        steps=outcome.actions,
+        collisions=stats.collisions,
+        wall_time=wall,
+        failure_reason=reason,
+        shortest_path_length=episode.geodesic_length,
+        distance_to_goal=stop,
+        building=episode.building,
+    )
+    plot_path = None
+    if out_dir is not None and plot:
+        plot_path = out_dir / f"{episode.id}.trajectory.png"
+        _plot(pm, ctx.trace, truth, plot_path, result, config, outcome)
+    return EpisodeRun(result, plot_path, log_path, stop)
+
+
+class _null:
+    def __enter__(self):
+        return None
+
+    def __exit__(self, *exc):
+        return False
+
+
+def _plot(pm, trace, truth, path: Path, result: EpisodeResult, config: Config, outcome) -> None:
+    """The Fig. 4-style plot: planned path, driven path, key nodes with thumbnails."""
+    import numpy as np
+
+    from pmnav_bt.trajectory import KeyNode, render_trajectory
+
+    times = np.array([t for t, _, _ in truth]) if truth else np.zeros(1)
+
+    def true_xy(t: float) -> tuple[float, float]:
+        if not truth:
+            return (0.0, 0.0)
+        i = int(np.clip(np.searchsorted(times, t), 0, len(truth) - 1))
+        return truth[i][1], truth[i][2]
+
+    plans = [e for e in trace if e.kind == "plan"]
+    planned = [tuple(p) for p in plans[-1].data["path"]] if plans else []
+    nodes = [
+        KeyNode(e.kind, e.label, true_xy(e.time), e.thumbnail)
+        for e in trace
+        if e.kind in ("fix", "detection", "corner", "obstacle", "arrive")
+    ]
+    verdict = "SUCCESS" if result.success else f"FAILED ({result.failure_reason})"
+    caption = (
+        f"{VARIANT_NAMES.get(config.tree.variant, config.tree.variant)}: {verdict}; "
+        f"SPL {result.spl:.2f}; {result.path_length:.1f} m driven, "
+        f"{result.shortest_path_length:.1f} m shortest; {outcome.actions} actions"
+    )
+    render_trajectory(pm, planned, [(x, y) for _, x, y in truth], nodes, path, caption)
+
+
+# -- evaluation over many episodes ---------------------------------------------------------
+
+
+def episodes_for(buildings: Iterable[str], tiers: Iterable[str], n: int, seed: int):
+    """Generated episodes per building and tier; tiers a building cannot pose are skipped
+    with a note."""
+    from pmnav_bt.sim.episodes import EpisodeGenerationError, generate_episodes
+
+    out, notes = [], []
+    for b in buildings:
+        for tier in tiers:
+            try:
+                out += generate_episodes(b, tier, n, seed=seed)
+            except EpisodeGenerationError as err:
+                notes.append(str(err))
+    return out, notes
+
+
+def _run_one(args) -> dict:
+    episode, config_json = args
+    config = Config.model_validate_json(config_json)
+    run = run_episode(episode, config, out_dir=None, plot=False)
+    return run.result.to_dict()
+
+
+def evaluate(
+    episodes: list,
+    configs: dict[str, Config],
+    jobs: int = 1,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> dict[str, list[EpisodeResult]]:
+    """Run every episode under each named config; results per config name."""
+    results: dict[str, list[EpisodeResult]] = {}
+    total = len(episodes) * len(configs)
+    done = 0
+    for name, cfg in configs.items():
+        tasks = [(e, cfg.model_dump_json()) for e in episodes]
+        if jobs > 1:
+            import multiprocessing as mp
+            from concurrent.futures import ProcessPoolExecutor
+
+            with ProcessPoolExecutor(jobs, mp_context=mp.get_context("spawn")) as pool:
+                rows = []
+                for row in pool.map(_run_one, tasks):
+                    rows.append(row)
+                    done += 1
+                    if progress:
+                        progress(name, done, total)
+        else:
+            rows = []
+            for t in tasks:
+                rows.append(_run_one(t))
+                done += 1
+                if progress:
+                    progress(name, done, total)
+        results[name] = [EpisodeResult(**r) for r in rows]
+    return results
+
+
+def comparison_markdown(results: dict[str, list[EpisodeResult]]) -> str:
+    """SR/SPL per tier, one column pair per variant (like the paper's Table 1)."""
+    tables = {name: aggregate_by_tier(rs) for name, rs in results.items()}
+    tiers = []
+    for t in tables.values():
+        for row in t.rows:
+            if row.tier not in tiers:
+                tiers.append(row.tier)
+    head = (
+        "| tier | n | "
+        + " | ".join(
+            f"{VARIANT_NAMES.get(n, n)} SR | {VARIANT_NAMES.get(n, n)} SPL" for n in tables
+        )
+        + " |"
+    )
+    sep = "|---|---|" + "---|---|" * len(tables)
+    lines = [head, sep]
+    for tier in tiers:
+        cells, count = [], 0
+        for t in tables.values():
+            row = next((r for r in t.rows if r.tier == tier), None)
+            if row is None:
+                cells.append("- | -")
+                continue
+            count = row.episodes
+            cells.append(f"{row.sr:.1f} | {row.spl:.1f}")
+        lines.append(f"| {tier} | {count} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def save_evaluation(results: dict[str, list[EpisodeResult]], out_dir: Path, header: str) -> Path:
+    """Write results.json (every episode) and results.md (the table); return the .md path."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    data = {name: [r.to_dict() for r in rs] for name, rs in results.items()}
+    (out_dir / "results.json").write_text(json.dumps(data, indent=1), encoding="utf-8")
+    md = out_dir / "results.md"
+    md.write_text(header + "\n\n" + comparison_markdown(results) + "\n", encoding="utf-8")
+    return md
+
+
+def variant_configs(base: Config, variants: Iterable[str]) -> dict[str, Config]:
+    """One config per tree variant."""
+    out = {}
+    for v in variants:
+        if v not in VARIANT_NAMES:
+            raise PmNavError(f"unknown variant {v!r}; choose from {', '.join(VARIANT_NAMES)}")
+        out[v] = base.model_copy(update={"tree": base.tree.model_copy(update={"variant": v})})
+    return out
