@@ -11,10 +11,17 @@ from pmnav_bt.seams import MotionStatus
 
 class Monitor(PmNavBehaviour):
     """RUNNING while the mission may go on; FAILURE when the action budget is spent
-    (BUDGET_EXCEEDED) or the body faults (BASE_FAULT). Writes ``failure`` only."""
+    (BUDGET_EXCEEDED), a body with the optional ``fault()`` hook reports one (its
+    Failure, e.g. SENSOR_TIMEOUT for a silent camera) or the body faults (BASE_FAULT).
+    Writes ``failure`` only."""
 
     def update(self) -> Status:
         base = self.ctx.base
+        fault = getattr(base, "fault", None)  # optional: Failure | None (hardware bases)
+        failure = fault() if callable(fault) else None
+        if failure is not None:
+            base.stop()
+            return self.fail(failure.code, failure.message)
         self.ctx.odometer.update(base.pose())
         used = self.ctx.odometer.actions
         if used > self.ctx.budget_actions:

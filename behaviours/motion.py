@@ -13,7 +13,7 @@ import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
-from pmnav_bt.behaviours.context import Context, map_pose, thumbnail
+from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
 from pmnav_bt.control import goto_command, rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading
@@ -24,6 +24,8 @@ from pmnav_bt.seams import MotionStatus
 NO_PROGRESS_S = 10.0  # clock seconds without getting 0.1 m closer -> blocked
 WATCH_PERIOD_S = 1.0  # clock seconds between obstacle checks from depth
 MAX_BUMPS = 3  # collisions before a drive gives up as blocked
+# Depth is checked this far ahead: a 1 m box leaves the 1.6 m camera's view 1.4 m away.
+OBSTACLE_RANGE = 2.0
 
 
 class DriveTo(PmNavBehaviour):
@@ -104,7 +106,7 @@ class DriveTo(PmNavBehaviour):
         if abs(math.atan2(math.sin(bearing), math.cos(bearing))) > math.radians(25):
             return None  # still turning towards the goal: nothing to judge yet
         free = free_distance(obs, bearing)
-        if free < min(to_goal, 1.2) - 0.3:
+        if free < min(to_goal, OBSTACLE_RANGE) - 0.3:
             self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)
             return f"obstacle {free:.1f} m ahead"
         return None
@@ -179,13 +181,15 @@ class DriveToWaypoint(DriveTo):
         t = self.get("target")
         if t.kind != "turn" or self._corner_seen or obs.depth is None:
             return
+        est = map_pose(self.get("map_T_odom"), obs.pose)
+        if heading_error(est.yaw, t.heading) > math.radians(15):
+            return  # not looking along the corridor (still turning): the wall ahead is no corner
         ratios = mask_ratios(obs, self.ctx.grounder)
         if not is_corner(ratios):
             return
         h, w = obs.depth.shape
         wall = float(np.median(obs.depth[h // 2 : h // 2 + max(2, h // 20), w // 3 : 2 * w // 3]))
         width = self.ctx.pm.segment(t.segment).width
-        est = map_pose(self.get("map_T_odom"), obs.pose)
         ahead = max(0.0, wall - width / 2.0)
         p = (est.x + ahead * math.cos(t.heading), est.y + ahead * math.sin(t.heading))
         if math.dist(p, t.position) <= 2.0:  # agrees with the map: trust the eyes
@@ -262,7 +266,7 @@ class CheckOpening(PmNavBehaviour):
         return Status.SUCCESS
 
     def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID:
+        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
             self._job.cancel()
 
 

@@ -45,7 +45,10 @@ class MakePlan(PmNavBehaviour):
             if isinstance(err, PlanningError) and blocked:
                 segs = ", ".join(f"seg{i}" for i in sorted(blocked))
                 return self.fail(FailureCode.BLOCKED, f"no route around the blocked {segs}")
-            return self.fail(FailureCode.PLANNING_FAILED, str(err))
+            code = FailureCode.PLANNING_FAILED
+            if isinstance(err, UnknownNameError) and not _names_a_room(self.ctx, self.get("goal")):
+                code = FailureCode.INVALID_GOAL  # the goal, not the start, is unknown
+            return self.fail(code, str(err))
         self.bb.set("plan", plan)
         self.bb.set("step_index", 0)
         self.bb.set("last_action", None)
@@ -169,3 +172,11 @@ class NoteFailure(PmNavBehaviour):
         self.ctx.log("replan", str(failure) if failure else "")
         self.feedback_message = f"replan after {failure}"
         return Status.SUCCESS
+
+
+def _names_a_room(ctx: Context, goal) -> bool:
+    try:
+        resolve_room(ctx.pm, str(goal))
+    except UnknownNameError:
+        return False
+    return True

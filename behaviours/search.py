@@ -7,8 +7,10 @@ import math
 import numpy as np
 from py_trees.common import Status
 
+from pmnav_bt.behaviours.capture import CapturedView
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, map_pose, thumbnail
+from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply
 from pmnav_bt.localization import Sighting, fix_pose
@@ -77,38 +79,57 @@ class CoarseDirection(PmNavBehaviour):
 
 
 class Ground(PmNavBehaviour):
-    """Ground the target in the chosen view: box and mask.
+    """Grounding: face the coarse direction and ground the target in a fresh frame.
 
-    Reads ``choice``; writes ``choice`` with a detection that has a mask. The
-    detector-based coarse direction has grounded already; other back ends ground here,
-    in the worker.
+    Reads ``choice``; writes ``choice`` (the new frame and its best detection, with a
+    mask). Facing the target keeps its mask off the image border, where a cut-off
+    mask would bias the bearing and range. If the fresh frame misses the target, the
+    coarse view's detection stands.
     """
 
     READS = ("choice",)
     WRITES = ("choice",)
 
     def initialise(self) -> None:
+        view, det = self.get("choice")
+        obs = view.observation
+        self._yaw = obs.pose.yaw + obs.intrinsics.pixel_bearing(det.centre[0])
+        self._query = det.label
         self._job = None
 
     def update(self) -> Status:
-        view, det = self.get("choice")
-        if det is not None and det.mask is not None:
-            return Status.SUCCESS
+        base = self.ctx.base
         if self._job is None:
-            query, grounder = det.label, self.ctx.grounder
-            self._job = self.ctx.worker.submit(lambda c: grounder.detect(view.observation, query))
+            v, w, done = rotate_command(base.pose(), self._yaw, self.ctx.limits)
+            if not done:
+                base.set_velocity(v, w)
+                return Status.RUNNING
+            base.set_velocity(0.0, 0.0)
+            query, grounder = self._query, self.ctx.grounder
+
+            def take(cancelled):
+                obs = base.observe()
+                return obs, ([] if cancelled.is_set() else grounder.detect(obs, query))
+
+            self._job = self.ctx.worker.submit(take)
             return Status.RUNNING
         if not self._job.done():
             return Status.RUNNING
-        dets = self._job.result()
-        if not dets:
-            return self.fail(FailureCode.TARGET_NOT_FOUND, "grounding found nothing")
-        self.bb.set("choice", (view, max(dets, key=lambda d: d.score)))
+        obs, dets = self._job.result()
+        dets = [d for d in dets if d.mask is not None]
+        if dets:
+            best = max(dets, key=lambda d: d.score)
+            self.bb.set("choice", (CapturedView(0.0, obs, dets), best))
+            self.feedback_message = f"grounded, score {best.score:.2f}"
+        else:
+            self.feedback_message = "not in the fresh frame: keeping the coarse view's detection"
         return Status.SUCCESS
 
     def terminate(self, new_status: Status) -> None:
         if getattr(self, "_job", None) is not None:
             self._job.cancel()
+        if new_status == Status.INVALID:
+            self.ctx.base.stop()
 
 
 class FineDirection(PmNavBehaviour):

@@ -111,13 +111,11 @@ def plan(
 
 
 def _mount_subcommands() -> None:
+    # Both import only typer at module level: pybullet and py_trees load inside commands.
     from pmnav_bt.sim.cli import app as sim_app
+    from pmnav_bt.trees.cli import app as tree_app
 
     app.add_typer(sim_app, name="sim")
-    try:
-        from pmnav_bt.trees.cli import app as tree_app
-    except ImportError:  # pragma: no cover - during development only
-        return
     app.add_typer(tree_app, name="tree")
 
 

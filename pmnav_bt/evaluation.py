@@ -112,7 +112,7 @@ def run_episode(
             else inner
         )
         budget = max(episode.step_budget, action_budget(config, episode.geodesic_length))
-        ctx = make_context(base, pm, config, seed=episode.seed, budget=budget)
+        ctx = make_context(base, pm, config, seed=episode.seed, budget=budget, deferred_work=True)
         truth: list[tuple[float, float, float]] = []
 
         def record(tree) -> None:

@@ -3,6 +3,13 @@
 DESIGN.md: a tick never blocks. Anything slower than a few milliseconds (rendering a
 panorama, OCR, a network call) runs here. A job gets a ``cancelled`` event it may
 check between stages; cancelling a job that has not started drops it.
+
+Two modes:
+- immediate (on the robot): a job starts at once, in a pool thread;
+- deferred (in simulation): a job starts only when the runner calls ``drain()``
+  between ticks. The simulated world stands still during a tick anyway, a render
+  cannot then hold the interpreter lock in the middle of a tick, and no job can end
+  in the tick that submitted it, so a seed replays the same episode tick for tick.
 """
 
 from __future__ import annotations
@@ -17,23 +24,38 @@ from typing import Any
 class Job:
     """One piece of background work."""
 
-    def __init__(self, future: Future, cancelled: threading.Event):
-        self._future = future
-        self.cancelled = cancelled
+    def __init__(self, fn: Callable[[threading.Event], Any]):
+        self.fn = fn
+        self.cancelled = threading.Event()
+        self._future: Future | None = None
+
+    def _start(self, pool: ThreadPoolExecutor) -> None:
+        if self._future is None:
+            self._future = pool.submit(self.fn, self.cancelled)
+            if self.cancelled.is_set():
+                self._future.cancel()
+
+    def started(self) -> bool:
+        return self._future is not None
 
     def done(self) -> bool:
-        return self._future.done()
+        return self._future is not None and self._future.done()
 
     def result(self) -> Any:
         """The result (raises the job's exception). Call only when done()."""
+        if self._future is None:
+            raise RuntimeError("the job has not run yet")
         return self._future.result(timeout=0)
 
     def cancel(self) -> None:
         self.cancelled.set()
-        self._future.cancel()
+        if self._future is not None:
+            self._future.cancel()
 
     def wait(self, timeout: float | None = None) -> None:
         """Block until the job ends (runners and tests only; never from a tick)."""
+        if self._future is None:
+            return
         # A cancelled or timed-out job has nothing more to wait for.
         with contextlib.suppress(Exception):
             self._future.exception(timeout=timeout)
@@ -42,28 +64,33 @@ class Job:
 class Worker:
     """A small pool shared by a tree's behaviours."""
 
-    def __init__(self, threads: int = 1):
+    def __init__(self, threads: int = 1, deferred: bool = False):
         self._pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="pmnav-worker")
-        self._jobs: set[Job] = set()
+        self.deferred = deferred
+        self._jobs: list[Job] = []
         self._lock = threading.Lock()
 
     def submit(self, fn: Callable[[threading.Event], Any]) -> Job:
-        """Run ``fn(cancelled_event)`` in the background."""
-        cancelled = threading.Event()
-        job = Job(self._pool.submit(fn, cancelled), cancelled)
+        """Run ``fn(cancelled_event)`` in the background (now, or at the next drain)."""
+        job = Job(fn)
         with self._lock:
-            self._jobs = {j for j in self._jobs if not j.done()}
-            self._jobs.add(job)
+            self._jobs = [j for j in self._jobs if not j.done()]
+            self._jobs.append(job)
+        if not self.deferred:
+            job._start(self._pool)
         return job
 
     def busy(self) -> bool:
         with self._lock:
-            return any(not j.done() for j in self._jobs)
+            return any(not j.done() and not j.cancelled.is_set() for j in self._jobs)
 
     def drain(self, timeout: float | None = None) -> None:
-        """Wait for every job in flight (the simulation runner does this to stay repeatable)."""
+        """Start any deferred jobs and wait for every job in flight (between ticks only)."""
         with self._lock:
             jobs = list(self._jobs)
+        for j in jobs:
+            if not j.cancelled.is_set():
+                j._start(self._pool)
         for j in jobs:
             j.wait(timeout)
 

@@ -183,17 +183,21 @@ def run(
         ep = eps[index]
     else:
         ep = custom_episode(building, goal, start, seed)
-    on_tick = None
+    live = None
     if show_tree:
         from pmnav_bt.trees.live import LiveTree
 
-        on_tick = LiveTree()
+        live = LiveTree()
     typer.echo(
         f"{VARIANT_NAMES[cfg.tree.variant]} in {ep.building}: {ep.id} ({ep.tier}), "
         f"start ({ep.start_x:.1f}, {ep.start_y:.1f}, {math.degrees(ep.start_yaw):.0f} deg), "
         f"shortest path {ep.geodesic_length:.1f} m"
     )
-    r = run_episode(ep, cfg, out_dir=out, on_tick=on_tick)
+    if live is not None:
+        with live:
+            r = run_episode(ep, cfg, out_dir=out, on_tick=live)
+    else:
+        r = run_episode(ep, cfg, out_dir=out)
     res = r.result
     typer.echo(
         f"{'SUCCESS' if res.success else 'FAILURE'}: SPL {res.spl:.3f}, {res.steps} actions, "

@@ -52,9 +52,17 @@ def action_budget(config: Config, shortest_path_m: float | None) -> int:
 
 
 def make_context(
-    base: Base, pm: PrioriMap, config: Config, seed: int = 0, budget: int | None = None
+    base: Base,
+    pm: PrioriMap,
+    config: Config,
+    seed: int = 0,
+    budget: int | None = None,
+    deferred_work: bool = False,
 ) -> Context:
-    """The back ends the config names, wired into a Context."""
+    """The back ends the config names, wired into a Context.
+
+    ``deferred_work``: background jobs start between ticks (simulation; see Worker).
+    """
     g = config.grounder
     grounder = GroundTruthGrounder(
         pm.building,
@@ -74,7 +82,7 @@ def make_context(
         grounder=grounder,
         refiner=refiner,
         planner=GraphPlanner(max_gap=config.planner.max_gap),
-        worker=Worker(),
+        worker=Worker(deferred=deferred_work),
         budget_actions=budget if budget is not None else config.tree.budget_actions,
     )
 

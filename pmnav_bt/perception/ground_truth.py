@@ -5,7 +5,8 @@ Queries:
 - "sign": every readable room sign and landmark in view, labelled with the text a
   person would read (localization);
 - anything else: a room or landmark by sign text, name or ID; a room is grounded
-  as its *door* (the door whose sign reads the query), a landmark as itself.
+  as its *door* (the door whose sign reads the query; the door must be in view), a
+  landmark as itself.
 
 A room is recognised only if its sign is readable: enough sign pixels and close
 enough. Misses, false positives (another visible sign read as the target) and mask
@@ -99,14 +100,16 @@ class GroundTruthGrounder:
             if obs.depth is not None and float(np.median(obs.depth[sign])) > self.max_range:
                 continue
             score = min(1.0, 0.5 + n / 2000.0)
-            if _truncated(sign):  # cut by the image border: part of the text is missing
-                score *= 0.6
             if kind == "sign":
                 door_id = by_label.get(f"door:{ident}")
-                mask = (seg == door_id) if door_id is not None else sign
-                out[f"room:{ident}"] = (mask, score)
+                if door_id is None:
+                    continue  # the sign alone: no door in view to go to or to locate
+                mask, entity = seg == door_id, f"room:{ident}"
             else:
-                out[f"landmark:{ident}"] = (sign, score)
+                mask, entity = sign, f"landmark:{ident}"
+            if _truncated(sign) or _truncated(mask):  # cut by the image border: less sure
+                score *= 0.6
+            out[entity] = (mask, score)
         return out
 
     def _noisy(self, mask: np.ndarray) -> np.ndarray:

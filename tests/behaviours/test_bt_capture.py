@@ -1,0 +1,187 @@
+"""CaptureViews against the simulator: the sweep, the views, early stop, cancellation."""
+
+from __future__ import annotations
+
+import math
+from concurrent.futures import CancelledError
+
+import pytest
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.capture import (
+    LOCALIZATION_YAWS_DEG,
+    SEARCH_YAWS_DEG,
+    CaptureViews,
+    search_yaws,
+    sweep_order,
+)
+from pmnav_bt.behaviours.localize import (
+    distinct_landmarks,
+    enough_doors,
+    localization_yaws,
+    sign_query,
+)
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.geometry import Action, wrap_angle
+from pmnav_bt.seams import Pose2D
+
+# On the start-turn1 corridor (x = 0) facing south: room4 (104) and room2 (102) are
+# either side at y = 22 and 18, the reception desk behind.
+SOUTH_AT_20 = Pose2D(0.0, 20.0, math.radians(-90))
+TOL = 0.035  # rotate_command stops within 0.03 rad
+
+
+def no_query(_b):
+    return None
+
+
+def rel_deg(views) -> list[int]:
+    """The views' relative yaws in degrees, to the nearest 10 (turns stop within 1.7 deg)."""
+    return [round(math.degrees(v.relative_yaw) / 10) * 10 for v in views]
+
+
+@pytest.mark.parametrize(
+    "last, missing",
+    [(None, None), (Action.GO_STRAIGHT, None), (Action.TURN_LEFT, -90), (Action.TURN_RIGHT, 90)],
+)
+def test_search_yaws_leave_out_the_view_the_last_turn_rules_out(last, missing):
+    got = [round(math.degrees(y)) for y in search_yaws(last)]
+    assert got == [y for y in SEARCH_YAWS_DEG if y != missing]
+    assert len(got) == (7 if missing is None else 6)
+
+
+def test_sweep_order_starts_at_the_nearer_extreme():
+    r = math.radians
+    assert sweep_order([]) == []
+    assert sweep_order([r(0), r(30), r(-60)]) == [r(30), r(0), r(-60)]  # -60 is farther
+    assert sweep_order([r(0), r(-30), r(60)]) == [r(-30), r(0), r(60)]
+    left = sweep_order(search_yaws(Action.TURN_LEFT))  # -90 left out: start at -60
+    assert [round(math.degrees(y)) for y in left] == [-60, -30, 0, 30, 60, 90]
+
+
+def test_capture_turns_through_the_yaws_taking_one_view_at_each(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    cap = CaptureViews("Views", rig.ctx, localization_yaws, sign_query)
+    seen = rig.run(cap, max_ticks=300)
+
+    rig.expect(seen, Status.SUCCESS)
+    assert len(seen) > 6  # it turned between views: no panorama in one tick
+    views = rig.get("views")
+    want = [wrap_angle(y) for y in sweep_order(localization_yaws(cap))]
+    assert rel_deg(views) == [30, 90, 150, -150, -90, -30]
+    for v, rel in zip(views, want, strict=True):
+        assert rig.yaw_error(v.relative_yaw, rel) <= TOL
+        # each frame was taken facing its yaw (the observation's pose is the body's)
+        assert rig.yaw_error(v.observation.pose.yaw, SOUTH_AT_20.yaw + rel) <= TOL
+        assert v.observation.rgb.shape == (120, 160, 3)
+    # One sweep to the left, 30 -> 330 deg, no back and forth; it ends facing the last view.
+    assert rig.body.stats.rotation == pytest.approx(math.radians(330), abs=0.1)
+    assert rig.yaw_error(rig.true_pose().yaw, SOUTH_AT_20.yaw + want[-1]) <= TOL
+    assert rig.stopped()
+    assert rig.true_pose().x == pytest.approx(0.0) and rig.true_pose().y == pytest.approx(20.0)
+    # The signs either side were read in the views that face them.
+    labels = dict(zip(rel_deg(views), (v.detections for v in views), strict=True))
+    assert "104 Laboratory" in {d.label for d in labels[150]}  # door at (1.2, 22), behind left
+    assert "102 Pharmacy" in {d.label for d in labels[-30]}  # door at (-1.2, 18), ahead right
+    assert rig.failure is None
+
+
+def test_capture_keeps_the_given_order_without_sweep(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    yaws = [math.radians(60), math.radians(-30)]
+    cap = CaptureViews("Views", rig.ctx, lambda b: yaws, no_query, sweep=False)
+    rig.expect(rig.run(cap, max_ticks=200), Status.SUCCESS)
+    views = rig.get("views")
+    assert rel_deg(views) == [60, -30]
+    assert all(v.detections == [] for v in views)  # no query: frames only
+
+
+def test_search_views_after_a_left_turn_skip_minus_90(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    rig.set(last_action=Action.TURN_LEFT)
+    cap = CaptureViews(
+        "SearchViews", rig.ctx, lambda b: search_yaws(b.get("last_action")), no_query
+    )
+    rig.expect(rig.run(cap, max_ticks=300), Status.SUCCESS)
+    rels = rel_deg(rig.get("views"))
+    assert rels == [-60, -30, 0, 30, 60, 90]
+
+
+def test_capture_stops_early_once_enough(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    cap = CaptureViews(
+        "Views", rig.ctx, localization_yaws, sign_query, enough=lambda views: len(views) >= 2
+    )
+    rig.expect(rig.run(cap, max_ticks=200), Status.SUCCESS)
+    views = rig.get("views")
+    assert rel_deg(views) == [30, 90]
+    assert rig.yaw_error(rig.true_pose().yaw, SOUTH_AT_20.yaw + math.radians(90)) <= TOL
+
+
+def test_localization_capture_stops_once_enough_doors_are_read(make_rig):
+    # At (0, 24) facing south, room4 (104) is read at +30 deg and room1 (101) at -150 deg,
+    # the fourth view: two doors, so the last two views are not needed.
+    rig = make_rig(Pose2D(0.0, 24.0, math.radians(-90)))
+    ctx = rig.ctx
+    cap = CaptureViews(
+        "Views",
+        ctx,
+        localization_yaws,
+        sign_query,
+        enough=lambda views: enough_doors(ctx, views, n=2),
+    )
+    rig.expect(rig.run(cap, max_ticks=300), Status.SUCCESS)
+    views = rig.get("views")
+    assert len(views) < len(LOCALIZATION_YAWS_DEG)
+    assert enough_doors(ctx, views, n=2)
+    assert not enough_doors(ctx, views[:-1], n=2)  # it stopped at the first view that did it
+    doors = {e for e in distinct_landmarks(ctx, views) if e.startswith("room:")}
+    assert doors == {"room:room1", "room:room4"}
+
+
+def test_terminate_while_turning_stops_the_base(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    cap = CaptureViews("Views", rig.ctx, localization_yaws, sign_query)
+    assert rig.tick(cap) == Status.RUNNING
+    assert rig.body.velocity_command[1] > 0.0  # turning left towards +30 deg
+    rig.wait()
+    assert rig.tick(cap) == Status.RUNNING
+    cap.stop(Status.INVALID)  # what a higher-priority branch or an interrupt does
+    assert cap.status == Status.INVALID
+    assert rig.stopped()
+    rig.wait(1.0)
+    assert rig.body.stats.rotation < math.radians(30)  # it did not go on turning
+    assert rig.get("views") is None
+
+
+def test_terminate_with_a_frame_in_flight_cancels_the_job_and_stops(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    release = rig.hold_worker()  # the frame job stays queued behind this one
+    cap = CaptureViews("Views", rig.ctx, lambda b: [0.0], sign_query)
+    assert rig.tick(cap) == Status.RUNNING  # already facing 0: the frame is requested
+    job = cap._job
+    assert job is not None and not job.done()
+    assert rig.tick(cap) == Status.RUNNING  # still waiting: a tick never blocks
+    rig.body.set_velocity(0.2, 0.0)  # (as if something else had the base moving)
+    cap.stop(Status.INVALID)
+    assert job.cancelled.is_set()
+    release.set()
+    rig.ctx.worker.drain()
+    with pytest.raises(CancelledError):
+        job.result()  # dropped before it ran
+    assert rig.stopped()
+    assert rig.get("views") is None
+    # Ticked again, it starts afresh and completes.
+    rig.expect(rig.run(cap, max_ticks=20), Status.SUCCESS)
+    assert len(rig.get("views")) == 1
+
+
+def test_a_frame_that_cannot_be_grounded_fails_sensor_timeout(make_rig):
+    rig = make_rig(SOUTH_AT_20, segmentation=False)  # the ground-truth grounder needs it
+    cap = CaptureViews("Views", rig.ctx, lambda b: [0.0, math.radians(30)], sign_query)
+    seen = rig.run(cap, max_ticks=50)
+    rig.expect(seen, Status.FAILURE)
+    assert len(seen) == 2  # request the frame, then collect the error
+    assert rig.failure.code == FailureCode.SENSOR_TIMEOUT
+    assert "segmentation" in rig.failure.message
+    assert rig.get("views") is None

@@ -1,0 +1,278 @@
+"""Motion leaves against the simulator: approach, move toward, corner check, turn, opening,
+arrive, and that an interrupted motion stops the base."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import pytest
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.localize import Explore
+from pmnav_bt.behaviours.motion import (
+    Approach,
+    Arrive,
+    CheckOpening,
+    DriveToWaypoint,
+    MoveToward,
+    TurnOnto,
+    approach_point,
+    out_heading,
+)
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.geometry import Action
+from pmnav_bt.seams import Pose2D
+
+SOUTH, EAST = math.radians(-90), 0.0
+
+
+def room4_step(rig):
+    """{room4: go straight}: node (0, 22) on the centre line, door (1.2, 22)."""
+    step = rig.plan("0,29,-90", "room3").steps[0]
+    assert (step.landmark, step.position, step.target) == ("room4", (0.0, 22.0), (1.2, 22.0))
+    return step
+
+
+def turn1(rig):
+    """{turn1: turn left} at (0, 0), arriving southward; the plan goes on east."""
+    plan = rig.plan("0,5,-90", "room11")
+    step = plan.steps[0]
+    assert (step.landmark, step.kind, step.position) == ("turn1", "turn", (0.0, 0.0))
+    return plan, step
+
+
+def test_approach_point_and_out_heading(make_rig):
+    assert approach_point((1.2, 22.0), (0.0, 22.0), 1.0) == pytest.approx((0.2, 22.0))
+    assert approach_point((1.2, 22.0), (0.0, 22.0), 5.0) == pytest.approx((0.0, 22.0))  # capped
+    assert approach_point((0.0, 22.0), (0.0, 22.0), 1.0) == (0.0, 22.0)
+    rig = make_rig(Pose2D(0.0, 5.0, SOUTH))
+    plan, step = turn1(rig)
+    assert out_heading(plan, step) == pytest.approx(EAST)  # leaves turn1 eastward
+    assert out_heading(plan, plan.steps[-1]) == pytest.approx(plan.steps[-1].heading)
+
+
+def test_approach_reaches_the_approach_point(make_rig):
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+    step = room4_step(rig)
+    rig.set(target=step)
+    approach = Approach("Approach", rig.ctx)
+    seen = rig.run(approach, max_ticks=400)
+    rig.expect(seen, Status.SUCCESS)
+    goal = approach_point(step.target, step.position, rig.ctx.config.tree.approach_offset)
+    assert goal == pytest.approx((0.2, 22.0))
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), goal) < 0.2
+    assert len(seen) * 0.1 > 4.3 / rig.body.max_linear  # it drove there, at most at top speed
+    assert rig.stopped()
+    assert rig.body.stats.collisions == 0
+    assert rig.failure is None
+
+
+def test_approach_to_the_goal_room_stops_at_the_goal_offset(make_rig):
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+    goal_step = rig.plan("0,26.5,-90", "room4").steps[-1]
+    assert goal_step.action == Action.ARRIVE and goal_step.target == (1.2, 22.0)
+    rig.set(target=goal_step)
+    rig.expect(rig.run(Approach("Approach", rig.ctx), max_ticks=400), Status.SUCCESS)
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), (1.2 - 0.6, 22.0)) < 0.2  # goal_offset 0.6 m from the door
+
+
+def test_approach_drives_on_the_estimated_pose(make_rig):
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+    rig.set(target=room4_step(rig), map_T_odom=(0.0, 0.5, 0.0))  # believes it is 0.5 m north
+    rig.expect(rig.run(Approach("Approach", rig.ctx), max_ticks=400), Status.SUCCESS)
+    est, p = rig.estimate(), rig.true_pose()
+    assert math.dist((est.x, est.y), (0.2, 22.0)) < 0.2
+    assert p.y == pytest.approx(est.y - 0.5)
+
+
+def test_approach_with_an_obstacle_in_the_way_fails_blocked(make_rig):
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+    rig.add_obstacle(0.1, 24.0, size=0.8)
+    rig.set(target=room4_step(rig))
+    seen = rig.run(Approach("Approach", rig.ctx), max_ticks=400)
+    rig.expect(seen, Status.FAILURE)
+    # A 1 m box leaves the camera's view (1.6 m up, 47 deg vertical field) 1.4 m before
+    # it, and the depth watch only judges what is nearer than 0.9 m: this one is found by
+    # bumping into it (MAX_BUMPS ticks of BLOCKED), not by depth. See the tall box below.
+    assert rig.failure.code == FailureCode.BLOCKED
+    assert rig.stopped()
+    p = rig.true_pose()
+    assert p.y > 24.4 + 0.17 - 1e-6  # short of the box
+    rig.base.clock.wait(1.0)
+    assert rig.true_pose() == p  # and it stays there
+
+
+def test_approach_stops_before_a_tall_obstacle_seen_in_depth(make_rig):
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+    rig.add_obstacle(0.1, 24.0, size=0.8, height=1.9)  # a cabinet: in view up close
+    rig.set(target=room4_step(rig))
+    seen = rig.run(Approach("Approach", rig.ctx), max_ticks=400)
+    rig.expect(seen, Status.FAILURE)
+    assert rig.failure.code == FailureCode.BLOCKED
+    assert "obstacle" in rig.failure.message and "ahead" in rig.failure.message
+    assert rig.body.stats.collisions == 0  # stopped before touching it
+    assert rig.stopped()
+    assert [e.kind for e in rig.ctx.trace][-1] == "obstacle"
+
+
+def test_move_toward_stops_keep_short_or_after_distance(make_rig):
+    rig = make_rig(Pose2D(0.0, 29.0, SOUTH))
+    rig.set(target=room4_step(rig))
+    rig.expect(rig.run(MoveToward("IntoSearchRange", rig.ctx, keep=4.5), 400), Status.SUCCESS)
+    assert rig.true_pose().y == pytest.approx(22.0 + 4.5, abs=0.2)
+    y0 = rig.true_pose().y
+    rig.expect(rig.run(MoveToward("MoveOn", rig.ctx, keep=1.0, distance=2.0), 400), Status.SUCCESS)
+    assert rig.true_pose().y == pytest.approx(y0 - 2.0, abs=0.2)
+    seen = rig.run(MoveToward("AlreadyThere", rig.ctx, keep=5.0), 10)
+    assert seen == [Status.SUCCESS]  # already closer than keep: nothing to do
+
+
+def test_drive_to_waypoint_corner_check_stops_at_turn1_despite_a_bad_estimate(make_rig):
+    rig = make_rig(Pose2D(0.0, 5.0, SOUTH))
+    plan, step = turn1(rig)
+    # The estimate is 1.5 m north of the truth: by the map alone it would drive into the
+    # wall past the corner. The corner check sees the wall ahead and stops at the corner.
+    rig.set(plan=plan, target=step, map_T_odom=(0.0, 1.5, 0.0))
+    seen = rig.run(DriveToWaypoint("CornerCheck", rig.ctx), max_ticks=400)
+    rig.expect(seen, Status.SUCCESS)
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), (0.0, 0.0)) < 0.3
+    assert rig.body.stats.collisions == 0
+    assert rig.stopped()
+    corners = [e for e in rig.ctx.trace if e.kind == "corner"]
+    assert len(corners) == 1 and corners[0].label == "turn1"
+    assert corners[0].data["wall"] >= 0.5 and corners[0].data["floor"] <= 0.15
+
+
+def test_drive_to_waypoint_without_the_corner_check_hits_the_wall(make_rig):
+    # The same bad estimate at a waypoint that is no turn: nothing corrects it.
+    rig = make_rig(Pose2D(0.0, 5.0, SOUTH))
+    plan, step = turn1(rig)
+    rig.set(plan=plan, target=replace(step, kind="branch"), map_T_odom=(0.0, 1.5, 0.0))
+    seen = rig.run(DriveToWaypoint("CornerCheck", rig.ctx), max_ticks=400)
+    rig.expect(seen, Status.FAILURE)
+    assert rig.failure.code == FailureCode.BLOCKED
+    assert rig.body.stats.collisions >= 1
+    assert rig.true_pose().y == pytest.approx(-1.2 + rig.body.radius, abs=0.01)
+    assert not [e for e in rig.ctx.trace if e.kind == "corner"]
+    assert rig.stopped()
+
+
+def test_drive_to_waypoint_with_a_good_estimate(make_rig):
+    rig = make_rig(Pose2D(0.0, 5.0, SOUTH))
+    plan, step = turn1(rig)
+    rig.set(plan=plan, target=step)
+    rig.expect(rig.run(DriveToWaypoint("CornerCheck", rig.ctx), max_ticks=400), Status.SUCCESS)
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), (0.0, 0.0)) < 0.3
+
+
+def test_turn_onto_turns_to_the_plan_heading_after_the_target(make_rig):
+    rig = make_rig(Pose2D(0.0, 0.0, SOUTH))
+    plan, step = turn1(rig)
+    rig.set(plan=plan, target=step, map_T_odom=(0.0, 0.0, math.radians(10)))
+    seen = rig.run(TurnOnto("TurnOnto", rig.ctx), max_ticks=100)
+    rig.expect(seen, Status.SUCCESS)
+    assert len(seen) > 3  # a quarter turn takes a while
+    assert rig.yaw_error(rig.estimate().yaw, EAST) <= 0.03  # east, by the estimate
+    assert rig.yaw_error(rig.true_pose().yaw, math.radians(-10)) <= 0.03
+    assert (rig.true_pose().x, rig.true_pose().y) == (0.0, 0.0)  # on the spot
+    assert rig.stopped()
+    assert rig.ctx.trace[-1].kind == "turn" and rig.ctx.trace[-1].data["action"] == "turn left"
+
+
+@pytest.mark.parametrize(
+    "yaw, opening",
+    [(EAST, True), (SOUTH, False), (math.radians(180), False), (math.radians(90), True)],
+)
+def test_check_opening_at_turn1(make_rig, yaw, opening):
+    # turn1: the corridor goes north (where it came from) and east; walls south and west.
+    rig = make_rig(Pose2D(0.0, 0.0, yaw))
+    _, step = turn1(rig)
+    rig.set(target=step)
+    release = rig.hold_worker()
+    check = CheckOpening("ForkChoice", rig.ctx)
+    assert rig.tick(check) == Status.RUNNING  # the frame is taken in the worker
+    release.set()
+    rig.wait()
+    if opening:
+        assert rig.tick(check) == Status.SUCCESS
+        assert check.feedback_message.startswith("open")
+        assert rig.failure is None
+    else:
+        assert rig.tick(check) == Status.FAILURE
+        assert rig.failure.code == FailureCode.TARGET_NOT_FOUND
+        assert "no corridor to take at turn1" in rig.failure.message
+
+
+def test_arrive_stops_and_logs(make_rig):
+    rig = make_rig(Pose2D(0.0, 22.0, SOUTH))
+    rig.set(plan=rig.plan("0,26,-90", "room4"))
+    rig.body.set_velocity(0.2, 0.0)
+    assert rig.tick(Arrive("Arrive", rig.ctx)) == Status.SUCCESS
+    assert rig.stopped()
+    assert rig.ctx.trace[-1].kind == "arrive" and rig.ctx.trace[-1].label == "room4"
+
+
+MOVERS = {
+    "Approach": lambda ctx: Approach("Approach", ctx),
+    "MoveToward": lambda ctx: MoveToward("MoveOn", ctx, keep=1.0),
+    "DriveToWaypoint": lambda ctx: DriveToWaypoint("CornerCheck", ctx),
+    "TurnOnto": lambda ctx: TurnOnto("TurnOnto", ctx),
+    "Explore": lambda ctx: Explore("Walk", ctx, distance=2.0),
+}
+
+
+@pytest.mark.parametrize("kind", list(MOVERS))
+def test_terminate_of_a_motion_stops_the_base(make_rig, kind):
+    rig = make_rig(Pose2D(0.0, 8.0, math.radians(-150)))  # 60 deg off the corridor
+    plan, step = turn1(rig)
+    rig.set(plan=plan, target=step, views=[])
+    b = MOVERS[kind](rig.ctx)
+    seen = rig.run(b, max_ticks=5)
+    assert seen == [Status.RUNNING] * 5
+    assert rig.body.velocity_command != (0.0, 0.0)  # moving when interrupted
+    b.stop(Status.INVALID)  # an interrupt, or a higher-priority branch taking over
+    assert b.status == Status.INVALID
+    assert rig.stopped()
+    p = rig.true_pose()
+    rig.wait(1.0)
+    assert rig.true_pose() == p
+
+
+def test_terminate_cancels_the_depth_watch_in_flight(make_rig):
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+    rig.set(target=room4_step(rig))
+    release = rig.hold_worker()
+    approach = Approach("Approach", rig.ctx)
+    assert rig.tick(approach) == Status.RUNNING  # drives, and asks for a watch frame
+    watch = approach._watch_job
+    assert watch is not None and not watch.done()
+    assert rig.body.velocity_command != (0.0, 0.0)
+    approach.stop(Status.INVALID)
+    assert watch.cancelled.is_set()
+    assert rig.stopped()
+    release.set()
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda ctx: CheckOpening("ForkChoice", ctx),
+        lambda ctx: TurnOnto("TurnOnto", ctx),
+        lambda ctx: Approach("Approach", ctx),
+        lambda ctx: DriveToWaypoint("CornerCheck", ctx),
+        lambda ctx: Explore("Walk", ctx, distance=1.0),
+    ],
+    ids=["CheckOpening", "TurnOnto", "Approach", "DriveToWaypoint", "Explore"],
+)
+def test_stop_before_the_first_tick_is_harmless(make_rig, make):
+    # A decorator's stop(INVALID) reaches its child even if the child never ran.
+    rig = make_rig(Pose2D(0.0, 8.0, SOUTH))
+    b = make(rig.ctx)
+    b.stop(Status.INVALID)
+    assert b.status == Status.INVALID
+    assert rig.stopped()
