@@ -47,17 +47,26 @@ class FixPosition(PmNavBehaviour):
     READS = ("views", "fix_attempts")
     WRITES = ("map_T_odom", "fix_attempts")
 
+    def initialise(self) -> None:
+        b, views = self.ctx.pm.building, self.get("views") or []
+
+        def locate(cancelled):
+            sightings = [
+                s
+                for v in views
+                for d in v.detections
+                if (s := sighting(b, v.observation, d)) is not None
+            ]
+            return sightings, fix_pose(sightings)
+
+        self._job = self.ctx.worker.submit(locate)
+
     def update(self) -> Status:
+        if not self._job.done():
+            return Status.RUNNING
+        sightings, fix = self._job.result()
         attempts = (self.get("fix_attempts") or 0) + 1
         self.bb.set("fix_attempts", attempts)
-        b = self.ctx.pm.building
-        sightings = []
-        for v in self.get("views") or []:
-            for d in v.detections:
-                s = sighting(b, v.observation, d)
-                if s is not None:
-                    sightings.append(s)
-        fix = fix_pose(sightings)
         if fix is None:
             seen = sorted({s.entity for s in sightings})
             return self.fail(
@@ -82,6 +91,10 @@ class FixPosition(PmNavBehaviour):
             f"at {where} from {', '.join(fix.entities)} (rms {fix.residual:.2f} m)"
         )
         return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
+            self._job.cancel()
 
 
 class Explore(PmNavBehaviour):

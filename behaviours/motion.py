@@ -40,8 +40,12 @@ class DriveTo(PmNavBehaviour):
     def goal(self) -> tuple[float, float]:
         raise NotImplementedError
 
-    def on_watch(self, obs) -> None:
-        """Called with each watch frame (in the tick, after the worker took it)."""
+    def inspect(self, obs, est, target) -> dict:
+        """Extra analysis of a watch frame, in the worker (no blackboard access here)."""
+        return {}
+
+    def on_watch(self, found: dict, obs) -> None:
+        """Use what ``inspect`` found, in the tick (cheap)."""
 
     def initialise(self) -> None:
         self._goal = self.goal()
@@ -84,29 +88,33 @@ class DriveTo(PmNavBehaviour):
         return Status.RUNNING
 
     def _poll_watch(self, now: float) -> str | None:
-        """Start or collect a depth check of the way ahead; a reason when blocked."""
+        """Start or collect a depth check of the way ahead; a reason when blocked.
+
+        The frame is taken and analysed in the worker; the tick only reads the verdict.
+        """
         if self._watch_job is None:
             if now - self._watch_t >= WATCH_PERIOD_S:
                 self._watch_t = now
-                base = self.ctx.base
-                self._watch_job = self.ctx.worker.submit(lambda c: base.observe())
+                base, goal, target = self.ctx.base, self._goal, self.get("target")
+                tf = self.get("map_T_odom")
+
+                def watch(cancelled):
+                    obs = base.observe()
+                    est = map_pose(tf, obs.pose)
+                    return obs, _free_ahead(obs, est, goal), self.inspect(obs, est, target)
+
+                self._watch_job = self.ctx.worker.submit(watch)
             return None
         if not self._watch_job.done():
             return None
         try:
-            obs = self._watch_job.result()
+            obs, free, found = self._watch_job.result()
         except Exception as err:  # noqa: BLE001
             return f"no camera frame: {err}"
         finally:
             self._watch_job = None
-        self.on_watch(obs)
-        est = map_pose(self.get("map_T_odom"), obs.pose)
-        to_goal = math.hypot(self._goal[0] - est.x, self._goal[1] - est.y)
-        bearing = heading((est.x, est.y), self._goal) - est.yaw
-        if abs(math.atan2(math.sin(bearing), math.cos(bearing))) > math.radians(25):
-            return None  # still turning towards the goal: nothing to judge yet
-        free = free_distance(obs, bearing)
-        if free < min(to_goal, OBSTACLE_RANGE) - 0.3:
+        self.on_watch(found, obs)
+        if free is not None:
             self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)
             return f"obstacle {free:.1f} m ahead"
         return None
@@ -117,6 +125,16 @@ class DriveTo(PmNavBehaviour):
             self._watch_job = None
         if new_status == Status.INVALID:
             self.ctx.base.stop()
+
+
+def _free_ahead(obs, est, goal) -> float | None:
+    """The free distance towards ``goal`` when something stands closer than the goal."""
+    to_goal = math.hypot(goal[0] - est.x, goal[1] - est.y)
+    bearing = heading((est.x, est.y), goal) - est.yaw
+    if abs(math.atan2(math.sin(bearing), math.cos(bearing))) > math.radians(25):
+        return None  # still turning towards the goal: nothing to judge yet
+    free = free_distance(obs, bearing)
+    return free if free < min(to_goal, OBSTACLE_RANGE) - 0.3 else None
 
 
 class Approach(DriveTo):
@@ -177,27 +195,31 @@ class DriveToWaypoint(DriveTo):
         self._corner_seen = False
         return float(t.position[0]), float(t.position[1])
 
-    def on_watch(self, obs) -> None:
-        t = self.get("target")
-        if t.kind != "turn" or self._corner_seen or obs.depth is None:
-            return
-        est = map_pose(self.get("map_T_odom"), obs.pose)
-        if heading_error(est.yaw, t.heading) > math.radians(15):
-            return  # not looking along the corridor (still turning): the wall ahead is no corner
+    def inspect(self, obs, est, target) -> dict:
+        if target.kind != "turn" or obs.depth is None:
+            return {}
+        if heading_error(est.yaw, target.heading) > math.radians(15):
+            return {}  # not looking along the corridor (still turning): no corner to judge
         ratios = mask_ratios(obs, self.ctx.grounder)
         if not is_corner(ratios):
-            return
+            return {}
         h, w = obs.depth.shape
         wall = float(np.median(obs.depth[h // 2 : h // 2 + max(2, h // 20), w // 3 : 2 * w // 3]))
-        width = self.ctx.pm.segment(t.segment).width
+        width = self.ctx.pm.segment(target.segment).width
         ahead = max(0.0, wall - width / 2.0)
-        p = (est.x + ahead * math.cos(t.heading), est.y + ahead * math.sin(t.heading))
+        p = (est.x + ahead * math.cos(target.heading), est.y + ahead * math.sin(target.heading))
+        return {"corner": p, "ratios": ratios}
+
+    def on_watch(self, found: dict, obs) -> None:
+        t = self.get("target")
+        p = found.get("corner")
+        if p is None or self._corner_seen:
+            return
         if math.dist(p, t.position) <= 2.0:  # agrees with the map: trust the eyes
             self._goal = p
             self._corner_seen = True
-            self.ctx.log(
-                "corner", t.landmark, thumbnail(obs.rgb), wall=ratios.wall, floor=ratios.floor
-            )
+            r = found["ratios"]
+            self.ctx.log("corner", t.landmark, thumbnail(obs.rgb), wall=r.wall, floor=r.floor)
 
 
 def out_heading(plan, step) -> float:

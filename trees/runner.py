@@ -9,6 +9,7 @@ the machine's speed; on the robot it never waits.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TextIO
@@ -99,8 +100,12 @@ def run_tree(
     log: TextIO | None = None,
     on_tick: Callable[[py_trees.trees.BehaviourTree], None] | None = None,
     sync_workers: bool = True,
+    tick_durations: list[float] | None = None,
 ) -> RunOutcome:
-    """Build the tree for ``goal`` and tick it until it succeeds or fails."""
+    """Build the tree for ``goal`` and tick it until it succeeds or fails.
+
+    ``tick_durations`` (optional) collects the wall time of every tick, in seconds.
+    """
     py_trees.blackboard.Blackboard.clear()
     tree = build_pmnav_tree(ctx, goal)
     if log is not None:
@@ -112,7 +117,10 @@ def run_tree(
     try:
         tree.setup()
         while tree.count < max_ticks:
+            t0 = time.perf_counter()
             tree.tick()
+            if tick_durations is not None:
+                tick_durations.append(time.perf_counter() - t0)
             status = tree.root.status
             if status != py_trees.common.Status.RUNNING:
                 break

@@ -47,7 +47,9 @@ def test_fix_from_doors_in_view_maps_drifted_odometry_onto_the_true_pose(make_ri
     ctx = rig.ctx
     capture(rig, enough=lambda views: enough_doors(ctx, views))
     fix = FixPosition("Fix", ctx)
-    assert rig.tick(fix) == Status.SUCCESS  # no motion, no worker: one tick
+    seen = rig.run(fix)  # the fix is computed in the worker: RUNNING, then SUCCESS
+    rig.expect(seen, Status.SUCCESS)
+    assert seen[0] == Status.RUNNING
     assert rig.get("fix_attempts") == 1
     tf = rig.get("map_T_odom")
     assert tf is not None and len(tf) == 3
@@ -67,12 +69,12 @@ def test_fix_facing_a_blank_wall_fails_localization_failed(make_rig):
     views = capture(rig, yaws=lambda b: [0.0, math.radians(10)])
     assert all(v.detections == [] for v in views)
     fix = FixPosition("Fix", rig.ctx)
-    assert rig.tick(fix) == Status.FAILURE
+    rig.expect(rig.run(fix), Status.FAILURE)
     assert rig.failure.code == FailureCode.LOCALIZATION_FAILED
     assert "0 landmark(s)" in rig.failure.message and "two are needed" in rig.failure.message
     assert rig.get("map_T_odom") is None
     assert rig.get("fix_attempts") == 1
-    assert rig.tick(fix) == Status.FAILURE  # each try counts (SDF's d)
+    rig.expect(rig.run(fix), Status.FAILURE)  # each try counts (SDF's d)
     assert rig.get("fix_attempts") == 2
 
 
@@ -80,7 +82,7 @@ def test_fix_without_views_fails_localization_failed(make_rig):
     rig = make_rig(Pose2D(0.0, 20.0, SOUTH))
     rig.set(fix_attempts=3)
     fix = FixPosition("Fix", rig.ctx)
-    assert rig.tick(fix) == Status.FAILURE
+    rig.expect(rig.run(fix), Status.FAILURE)
     assert rig.failure.code == FailureCode.LOCALIZATION_FAILED
     assert rig.get("fix_attempts") == 4
 

@@ -1,0 +1,72 @@
+"""Tick latency and episode wall time of the PM-Nav tree in the simulator.
+
+Target (DESIGN.md, a tick never blocks): p99 tick duration < 5 ms while workers are
+busy. Two worker modes are measured:
+
+- deferred (the simulator's mode): background jobs run between ticks;
+- immediate (the robot's mode): jobs run in a worker thread *during* ticks. Here the
+  worker renders pybullet frames, which hold Python's interpreter lock, so this is
+  a pessimistic figure for the robot, whose worker decodes images and runs models.
+
+    python benchmarks/bench_tree.py [--episodes 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+from pmnav_bt.config import load_config
+from pmnav_bt.evaluation import custom_episode
+
+
+def run(ep, deferred: bool) -> tuple[list[float], float, bool, int]:
+    from pmnav_bt.building import load_building
+    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.sim.odometry import NoisyOdometry
+    from pmnav_bt.sim.robot import SimBase
+    from pmnav_bt.sim.world import SimWorld
+    from pmnav_bt.trees.runner import make_context, run_tree
+
+    cfg = load_config()
+    b = load_building(ep.building)
+    pm = parse_building(b)
+    durations: list[float] = []
+    t0 = time.perf_counter()
+    with SimWorld(b) as world:
+        inner = SimBase(world, pose=ep.start_pose, width=cfg.sim.width, height=cfg.sim.height)
+        base = NoisyOdometry(inner, cfg.sim.odometry_noise, seed=ep.seed)
+        ctx = make_context(base, pm, cfg, seed=ep.seed, budget=ep.step_budget * 2,
+                           deferred_work=deferred)
+        out = run_tree(ctx, ep.goal, tick_durations=durations)
+    return durations, time.perf_counter() - t0, out.success, out.ticks
+
+
+def pct(xs: list[float], q: float) -> float:
+    xs = sorted(xs)
+    return xs[min(len(xs) - 1, int(q * (len(xs) - 1) + 0.5))]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--episodes", type=int, default=3)
+    args = ap.parse_args()
+    cases = [("fig2_hospital", "room17", "22,0,0"), ("fig2_hospital", "room17", None),
+             ("loop_school", "room10", None)][: args.episodes]
+    print(f"{'episode':<34} {'mode':<9} {'ticks':>6} {'median ms':>9} {'p99 ms':>7} "
+          f"{'max ms':>7} {'wall s':>7} {'sim s/wall s':>12} ok")
+    for building, goal, start in cases:
+        ep = custom_episode(building, goal, start)
+        for deferred in (True, False):
+            d, wall, ok, ticks = run(ep, deferred)
+            ms = [1e3 * x for x in d]
+            name = f"{building}:{goal} from {start or 'start'}"
+            print(f"{name:<34} {'deferred' if deferred else 'immediate':<9} {ticks:>6} "
+                  f"{statistics.median(ms):>9.3f} {pct(ms, 0.99):>7.2f} {max(ms):>7.1f} "
+                  f"{wall:>7.1f} {ticks * 0.1 / wall:>12.1f} {ok}")
+    print("target: p99 tick < 5 ms")
+
+
+if __name__ == "__main__":
+    main()
