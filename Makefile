@@ -22,7 +22,8 @@ demo: setup
 	mkdir -p $(OUT)
 	$(BIN)/pmnav map fig2_hospital --image $(OUT)/fig2_hospital_map.png > $(OUT)/fig2_hospital_map.txt
 	$(BIN)/pmnav plan fig2_hospital --from seg13 --to "One-Stop Service Centre" \
-		--image $(OUT)/fig2_hospital_plan.png
+		--image $(OUT)/fig2_hospital_plan.png > $(OUT)/fig2_hospital_plan.txt
+	$(BIN)/pmnav sim run --building fig2_hospital --goal "One-Stop Service Centre" --out $(OUT)/run
 
 lint: setup
 	$(BIN)/ruff check .
@@ -32,6 +33,8 @@ test: lint
 
 bench: setup
 	$(BIN)/python benchmarks/bench_plan.py
+	$(BIN)/python benchmarks/bench_sim.py
+	$(BIN)/python benchmarks/bench_tree.py
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache .ruff_cache .hypothesis

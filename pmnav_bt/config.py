@@ -21,62 +21,65 @@ class _Section(BaseModel):
 
 
 class GrounderConfig(_Section):
-    backend: Literal["sim_gt"] = "sim_gt"
-    miss_rate: float = Field(0.0, ge=0.0, le=1.0)
-    false_positive_rate: float = Field(0.0, ge=0.0, le=1.0)
-    mask_noise_px: int = Field(0, ge=0)
-    min_sign_pixels: int = Field(40, ge=1)
-    max_range: float = Field(9.0, gt=0.0)
+    backend: Literal["sim_gt"] = Field("sim_gt", description="text query -> box + mask")
+    miss_rate: float = Field(0.0, ge=0.0, le=1.0, description="chance a readable sign is missed")
+    false_positive_rate: float = Field(
+        0.0, ge=0.0, le=1.0, description="chance another visible sign is read as the target"
+    )
+    mask_noise_px: int = Field(0, ge=0, description="random erosion/dilation and shift of masks")
+    min_sign_pixels: int = Field(40, ge=1, description="a sign smaller than this is unreadable")
+    max_range: float = Field(9.0, gt=0.0, description="a sign farther than this (m) is unreadable")
     hidden: list[str] = Field(
         default_factory=list, description="room/landmark IDs whose signs are never read"
     )
 
 
 class CoarseConfig(_Section):
-    backend: Literal["detector"] = "detector"
-    min_score: float = Field(0.3, ge=0.0, le=1.0)
+    backend: Literal["detector"] = Field("detector", description="panorama views -> view")
+    min_score: float = Field(0.3, ge=0.0, le=1.0, description="weaker detections are ignored")
 
 
 class RefinerConfig(_Section):
-    backend: Literal["geometric"] = "geometric"
+    backend: Literal["geometric"] = Field("geometric", description="goal pixel -> bearing")
 
 
 class PlannerConfig(_Section):
-    backend: Literal["graph"] = "graph"
-    max_gap: float = Field(8.0, gt=0.0)
+    backend: Literal["graph"] = Field("graph", description="priori-map + start + goal -> plan")
+    max_gap: float = Field(8.0, gt=0.0, description="most metres between plan steps")
 
 
 class TreeConfig(_Section):
-    variant: Literal["pmnav", "coarse_only"] = "pmnav"
-    tick_hz: float = Field(10.0, gt=0.0)
-    budget_actions: int = Field(500, ge=1)
+    variant: Literal["pmnav", "coarse_only"] = Field(
+        "pmnav", description="coarse_only: no grounding or refinement (paper Table 4)"
+    )
+    tick_hz: float = Field(10.0, gt=0.0, description="tree ticks per second of the clock")
+    budget_actions: int = Field(500, ge=1, description="action budget (Habitat ObjectNav)")
     budget_path_factor: float = Field(
         3.0, gt=0.0, description="budget = max(budget_actions, factor * shortest path in actions)"
     )
-    localization_attempts: int = Field(4, ge=1)
-    explore_distance: float = Field(2.0, gt=0.0)
+    localization_attempts: int = Field(4, ge=1, description="localization tries")
+    explore_distance: float = Field(2.0, gt=0.0, description="m explored between tries")
     search_range: float = Field(
         4.5, gt=0.0, description="drive until a target is this close (by the map) before searching"
     )
-    search_attempts: int = Field(3, ge=1)
+    search_attempts: int = Field(3, ge=1, description="searches for one landmark")
     research_distance: float = Field(
         2.0, gt=0.0, description="move this far towards a target not found before searching again"
     )
-    replans: int = Field(2, ge=0)
+    replans: int = Field(2, ge=0, description="re-localize-and-replan recoveries")
     approach_offset: float = Field(1.0, ge=0.0, description="stop this far from a landmark door")
     goal_offset: float = Field(0.6, ge=0.0, description="stop this far from the goal door")
     step_timeout_s: float = Field(180.0, gt=0.0, description="clock seconds per plan step")
-    max_linear: float = Field(0.306, gt=0.0)
-    max_angular: float = Field(1.9, gt=0.0)
+    max_linear: float = Field(0.306, gt=0.0, description="m/s (Create 3)")
+    max_angular: float = Field(1.9, gt=0.0, description="rad/s (Create 3)")
 
 
 class SimConfig(_Section):
-    width: int = Field(320, ge=16)
-    height: int = Field(240, ge=16)
+    width: int = Field(320, ge=16, description="camera pixels (60 deg horizontal field)")
+    height: int = Field(240, ge=16, description="camera pixels")
     odometry_noise: float = Field(
         0.02, ge=0.0, description="std of the relative error of each odometry increment"
     )
-    seed: int = 0
 
 
 class Config(_Section):
