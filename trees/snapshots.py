@@ -19,6 +19,8 @@ import py_trees
 
 from pmnav_bt.errors import PmNavError
 
+TICK_FIELDS = frozenset({"tick", "time", "status", "feedback", "blackboard"})
+NODE_FIELDS = frozenset({"id", "name", "class", "parent"})
 STATUS_MARK = {"SUCCESS": "✔", "FAILURE": "✘", "RUNNING": "*", "INVALID": "-"}
 
 
@@ -112,11 +114,14 @@ class Replay:
 
     @classmethod
     def load(cls, path: str | Path) -> Replay:
+        """Read and check a log; PmNavError names the file and what is wrong."""
         path = Path(path)
         try:
             lines = path.read_text(encoding="utf-8").splitlines()
         except OSError as err:
             raise PmNavError(f"{path}: cannot read tree log: {err.strerror}") from None
+        except UnicodeDecodeError:
+            raise PmNavError(f"{path}: not a tree log (not UTF-8 text)") from None
         nodes, ticks = None, []
         for i, line in enumerate(lines, 1):
             if not line.strip():
@@ -125,12 +130,23 @@ class Replay:
                 rec = json.loads(line)
             except json.JSONDecodeError as err:
                 raise PmNavError(f"{path}: line {i}: not JSON ({err.msg})") from None
+            if not isinstance(rec, dict):
+                raise PmNavError(f"{path}: line {i}: not a tree log record (not a JSON object)")
             if rec.get("type") == "tree":
-                nodes = rec["nodes"]
+                nodes = rec.get("nodes")
             elif rec.get("type") == "tick":
+                missing = TICK_FIELDS - rec.keys()
+                if missing:
+                    raise PmNavError(
+                        f"{path}: line {i}: a tick record lacks {', '.join(sorted(missing))}"
+                    )
                 ticks.append(rec)
         if nodes is None:
             raise PmNavError(f"{path}: not a tree log (no tree record); write one with --tree-log")
+        if not isinstance(nodes, list) or not all(
+            isinstance(n, dict) and n.keys() >= NODE_FIELDS for n in nodes
+        ):
+            raise PmNavError(f"{path}: the tree record's nodes lack id/name/class/parent")
         return cls(nodes, ticks)
 
     def render(self, tick: dict, visited_only: bool = False) -> str:
@@ -138,7 +154,8 @@ class Replay:
         children: dict[str | None, list[dict]] = {}
         for n in self.nodes:
             children.setdefault(n["parent"], []).append(n)
-        lines = [f"tick {tick['tick']}  t={tick['time']}"]
+        t = tick["time"]
+        lines = [f"tick {tick['tick']}  t={t} s" if t is not None else f"tick {tick['tick']}"]
 
         def walk(n: dict, depth: int) -> None:
             st = tick["status"].get(n["id"])

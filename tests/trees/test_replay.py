@@ -83,7 +83,7 @@ def test_replay_one_tick_shows_statuses_and_feedback(log):
     res = invoke("replay", log, "--tick", 2)
     assert res.exit_code == 0, res.output
     lines = res.stdout.splitlines()
-    assert lines[0] == "tick 2  t=0.2"
+    assert lines[0] == "tick 2  t=0.2 s"
     assert "    * Job [Sequence]" in lines
     assert "        ✔ First [Countdown] -- done" in lines
     assert "            * Choose [Selector]" in lines
@@ -96,7 +96,7 @@ def test_replay_range_prints_each_tick_in_order(log):
     res = invoke("replay", log, "--from", 1, "--to", 3, "--visited-only")
     assert res.exit_code == 0, res.output
     headers = [ln for ln in res.stdout.splitlines() if ln.startswith("tick ")]
-    assert headers == ["tick 1  t=0.1", "tick 2  t=0.2", "tick 3  t=0.3"]
+    assert headers == ["tick 1  t=0.1 s", "tick 2  t=0.2 s", "tick 3  t=0.3 s"]
     assert "· " not in res.stdout  # visited only: no untouched nodes
     last = res.stdout.split("tick 3")[1]
     assert "✔ Root [Parallel]" in last and "✔ Same [Success]" in last
@@ -105,7 +105,7 @@ def test_replay_range_prints_each_tick_in_order(log):
 def test_replay_changes_skips_ticks_where_nothing_changed(log):
     res = invoke("replay", log, "--changes")
     headers = [ln for ln in res.stdout.splitlines() if ln.startswith("tick ")]
-    assert headers == ["tick 0  t=0.0", "tick 2  t=0.2", "tick 3  t=0.3"]  # tick 1 = tick 0
+    assert headers == ["tick 0  t=0.0 s", "tick 2  t=0.2 s", "tick 3  t=0.3 s"]  # tick 1 = tick 0
 
 
 def test_step_waits_between_ticks_and_stops_on_q(log):
@@ -134,7 +134,11 @@ def test_step_without_a_terminal_prints_everything(log):
     [
         (None, "cannot read tree log"),
         ('{"type": "tree", "nodes": [\n', "line 1: not JSON"),
-        ('{"type": "tick", "tick": 0}\n', "not a tree log"),
+        (
+            '{"type": "tick", "tick": 0, "time": 0, "status": {}, "feedback": {}, '
+            '"blackboard": {}}\n',
+            "not a tree log",
+        ),
         ("[1, 2]\n", "not a tree log"),
         (b"\x89PNG\r\n\x1a\n\xff\xfe", "not a tree log"),
     ],
@@ -167,7 +171,7 @@ def test_tick_record_missing_a_field(tmp_path, log):
     bad = tmp_path / "bad.jsonl"
     bad.write_text("\n".join([lines[0], '{"type": "tick", "tick": 5, "status": {}}']))
     res = invoke("replay", bad)
-    assert "a tick record (5) lacks blackboard, feedback, time" in str(res.exception)
+    assert "line 2: a tick record lacks blackboard, feedback, time" in str(res.exception)
 
 
 @pytest.fixture(scope="module")
