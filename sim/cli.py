@@ -90,7 +90,7 @@ def show(
 
 
 def _hold_gui(world) -> None:  # pragma: no cover - needs a display
-    import pybullet as p
+    from pmnav_bt.sim._pybullet import p
 
     try:
         while True:

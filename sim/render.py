@@ -8,9 +8,9 @@ from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
-import pybullet as p
 
 from pmnav_bt.seams import CameraIntrinsics, Pose2D
+from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.world import LIGHT_AMBIENT, LIGHT_DIFFUSE, LIGHT_DIRECTION
 
 if TYPE_CHECKING:  # pragma: no cover

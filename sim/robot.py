@@ -14,8 +14,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import pybullet as p
-
 from pmnav_bt.seams import (
     FORWARD_STEP_M,
     TURN_STEP_RAD,
@@ -25,6 +23,7 @@ from pmnav_bt.seams import (
     Observation,
     Pose2D,
 )
+from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.render import render_camera
 from pmnav_bt.sim.world import ROBOT, SimWorld

@@ -22,7 +22,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pybullet as p
 import shapely
 from shapely.geometry import LineString, MultiPolygon, Polygon
 from shapely.geometry.polygon import orient
@@ -30,6 +29,7 @@ from shapely.geometry.polygon import orient
 from pmnav_bt.building import Building, Landmark, WaypointKind, load_building
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.seams import Pose2D
+from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.textures import make_sign, write_png
 
 log = logging.getLogger(__name__)
