@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 from pmnav_bt.config import Config
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.metrics import EpisodeResult, aggregate_by_tier, spl, success
+from pmnav_bt.metrics import EpisodeResult, aggregate_by_tier
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.sim.episodes import Episode
@@ -31,7 +31,6 @@ class EpisodeRun:
     result: EpisodeResult
     plot: Path | None = None
     tree_log: Path | None = None
-    stop_distance: float = math.nan
 
 
 def custom_episode(building: str, goal: str, start: str | None = None, seed: int = 0) -> Episode:
@@ -92,7 +91,7 @@ def run_episode(
     """
     from pmnav_bt.building import load_building
     from pmnav_bt.priori_map import parse_building
-    from pmnav_bt.sim.episodes import goal_door
+    from pmnav_bt.sim.episodes import score_episode
     from pmnav_bt.sim.odometry import NoisyOdometry
     from pmnav_bt.sim.robot import SimBase
     from pmnav_bt.sim.world import SimWorld
@@ -130,33 +129,21 @@ def run_episode(
         final = inner.pose()
         stats = inner.stats
     wall = time.perf_counter() - t0
-    door = goal_door(pm, episode.goal)
-    stop = math.dist((final.x, final.y), door)
-    ok = outcome.success and success((final.x, final.y), door)
-    reason = None
-    if not outcome.success:
-        reason = str(outcome.failure)
-    elif not ok:
-        reason = f"STOPPED_AWAY: stopped {stop:.2f} m from the door"
-    result = EpisodeResult(
-        episode_id=episode.id,
-        tier=episode.tier,
-        success=ok,
-        spl=spl(ok, episode.geodesic_length, stats.path_length),
+    result = score_episode(
+        pm,
+        episode,
+        (final.x, final.y),
         path_length=stats.path_length,
         steps=outcome.actions,
         collisions=stats.collisions,
         wall_time=wall,
-        failure_reason=reason,
-        shortest_path_length=episode.geodesic_length,
-        distance_to_goal=stop,
-        building=episode.building,
+        failure=None if outcome.success else str(outcome.failure),
     )
     plot_path = None
     if out_dir is not None and plot:
         plot_path = out_dir / f"{episode.id}.trajectory.png"
         _plot(pm, ctx.trace, truth, plot_path, result, config, outcome)
-    return EpisodeRun(result, plot_path, log_path, stop)
+    return EpisodeRun(result, plot_path, log_path)
 
 
 class _null:

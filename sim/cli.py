@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 import time
 from pathlib import Path
 
@@ -243,14 +244,24 @@ def eval_(
         typer.echo(f"note: {note}", err=True)
     if not eps:
         raise PmNavError("no episodes to run")
-    with Progress(transient=False) as bar:
-        task = bar.add_task("episodes", total=len(eps) * len(configs))
-        results = evaluate(
-            eps,
-            configs,
-            jobs=jobs,
-            progress=lambda name, done, total: bar.update(task, completed=done),
-        )
+    total = len(eps) * len(configs)
+    if sys.stderr.isatty():
+        with Progress(transient=False) as bar:
+            task = bar.add_task("episodes", total=total)
+            results = evaluate(
+                eps,
+                configs,
+                jobs=jobs,
+                progress=lambda name, done, _: bar.update(task, completed=done),
+            )
+    else:  # a log: a line every tenth of the way
+        step = max(1, total // 10)
+
+        def report(name: str, done: int, _total: int) -> None:
+            if done % step == 0 or done == total:
+                typer.echo(f"{done}/{total} episodes ({name})", err=True)
+
+        results = evaluate(eps, configs, jobs=jobs, progress=report)
     g = cfg.grounder
     header = (
         f"# PM-Nav evaluation\n\nbuildings: {building}; tiers: {tier}; {n} per tier per "

@@ -27,7 +27,7 @@ import numpy as np
 from pmnav_bt.building import Building, load_building
 from pmnav_bt.errors import PmNavError, Problem
 from pmnav_bt.geometry import Action, heading, relative_action, wrap_angle
-from pmnav_bt.metrics import SUCCESS_RADIUS_M
+from pmnav_bt.metrics import SUCCESS_RADIUS_M, EpisodeResult, spl, success
 from pmnav_bt.priori_map import PrioriMap, parse_building
 from pmnav_bt.resolve import resolve_room
 from pmnav_bt.seams import FORWARD_STEP_M, Pose2D
@@ -631,3 +631,40 @@ def _route_fits(pm: PrioriMap, gf: _GoalField, spec: TierSpec, xy, end: str) -> 
     if spec.goal_visible:  # needs a straight run with no key waypoint between
         ok = ok and not any(pm.nodes[k].is_key for k in f.route[:-1])
     return ok
+
+
+def score_episode(
+    pm: PrioriMap,
+    episode: Episode,
+    stop_xy: Sequence[float],
+    *,
+    path_length: float,
+    steps: int,
+    collisions: int,
+    wall_time: float,
+    failure: str | None = None,
+    trace: list | None = None,
+) -> EpisodeResult:
+    """Score a run that stopped at ``stop_xy``: success within the radius of the goal door
+    (and no ``failure`` reported), SPL against the episode's geodesic."""
+    door = goal_door(pm, episode.goal)
+    dist = math.dist((float(stop_xy[0]), float(stop_xy[1])), door)
+    ok = failure is None and success(stop_xy, door)
+    reason = failure
+    if failure is None and not ok:
+        reason = f"STOPPED_AWAY: stopped {dist:.2f} m from the door"
+    return EpisodeResult(
+        episode_id=episode.id,
+        tier=episode.tier,
+        success=ok,
+        spl=spl(ok, episode.geodesic_length, path_length),
+        path_length=path_length,
+        steps=steps,
+        collisions=collisions,
+        wall_time=wall_time,
+        failure_reason=reason,
+        shortest_path_length=episode.geodesic_length,
+        distance_to_goal=dist,
+        building=episode.building,
+        trace=trace,
+    )

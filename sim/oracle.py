@@ -19,7 +19,7 @@ from pathlib import Path
 
 from pmnav_bt.building import Building, builtin_buildings, load_building
 from pmnav_bt.geometry import heading, wrap_angle
-from pmnav_bt.metrics import EpisodeResult, aggregate_by_tier, spl, success
+from pmnav_bt.metrics import EpisodeResult, aggregate_by_tier
 from pmnav_bt.priori_map import PrioriMap, parse_building
 from pmnav_bt.seams import FORWARD_STEP_M, DiscreteAction, MotionStatus
 from pmnav_bt.sim.clock import SimClock
@@ -28,7 +28,7 @@ from pmnav_bt.sim.episodes import (
     Episode,
     EpisodeGenerationError,
     generate_episodes,
-    goal_door,
+    score_episode,
     shortest_path_points,
 )
 from pmnav_bt.sim.robot import SimBase
@@ -140,30 +140,20 @@ def run_oracle(
     follow(runner, shortest_path_points(pm, (episode.start_x, episode.start_y), episode.goal))
     base.stop()
     q = base.pose()
-    door = goal_door(pm, episode.goal)
-    ok = success((q.x, q.y), door) and not runner.exhausted
-    dist = math.dist((q.x, q.y), door)
     reason = None
-    if not ok:
-        if runner.blocked >= MAX_BLOCKED:
-            reason = f"blocked {runner.blocked} times near ({q.x:.2f}, {q.y:.2f})"
-        elif runner.actions >= runner.budget:
-            reason = f"step budget of {runner.budget} actions exhausted"
-        else:
-            reason = f"stopped {dist:.2f} m from the door"
-    return EpisodeResult(
-        episode_id=episode.id,
-        tier=episode.tier,
-        success=ok,
-        spl=spl(ok, episode.geodesic_length, runner.travelled),
+    if runner.blocked >= MAX_BLOCKED:
+        reason = f"blocked {runner.blocked} times near ({q.x:.2f}, {q.y:.2f})"
+    elif runner.exhausted:
+        reason = f"step budget of {runner.budget} actions exhausted"
+    return score_episode(
+        pm,
+        episode,
+        (q.x, q.y),
         path_length=runner.travelled,
         steps=runner.actions,
         collisions=base.stats.collisions - collisions0,
         wall_time=time.perf_counter() - t0,
-        failure_reason=reason,
-        shortest_path_length=episode.geodesic_length,
-        distance_to_goal=dist,
-        building=episode.building,
+        failure=reason,
         trace=runner.trace,
     )
 
