@@ -203,9 +203,23 @@ def episodes_for(buildings: Iterable[str], tiers: Iterable[str], n: int, seed: i
 
 
 def _run_one(args) -> dict:
+    """One episode in a pool process; a crash becomes a failed result, not a lost run."""
     episode, config_json = args
     config = Config.model_validate_json(config_json)
-    run = run_episode(episode, config, out_dir=None, plot=False)
+    try:
+        run = run_episode(episode, config, out_dir=None, plot=False)
+    except Exception as err:  # noqa: BLE001 - reported in the results, with its type
+        return EpisodeResult(
+            episode_id=episode.id,
+            tier=episode.tier,
+            success=False,
+            spl=0.0,
+            path_length=0.0,
+            steps=0,
+            failure_reason=f"ERROR: {type(err).__name__}: {err}",
+            shortest_path_length=episode.geodesic_length,
+            building=episode.building,
+        ).to_dict()
     return run.result.to_dict()
 
 
