@@ -1,6 +1,6 @@
 # Quick start: `make demo` runs the main job on a built-in building; `make test` runs the tests.
 # Both create .venv on first use: torch 2.13.0 (CPU) first, so the project's torch range
-# installs nothing more, then the project with its dev extras.
+# installs nothing more, then the project with its dev and ROS 2 (rclpy, Fast DDS) extras.
 
 PY ?= python3
 VENV := .venv
@@ -15,7 +15,7 @@ $(VENV)/.installed: pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet torch==2.13.0
-	$(BIN)/pip install --quiet -e ".[dev]"
+	$(BIN)/pip install --quiet -e ".[dev,ros]"
 	touch $@
 
 demo: setup

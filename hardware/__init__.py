@@ -1,1 +1,11 @@
-"""pmnav_bt.hardware."""
+"""pmnav_bt.hardware: PM-Nav on ROS 2 (docs/ros2.md).
+
+- ``create3``: the iRobot Create 3 as a ``Base`` over rclpy (cmd_vel heartbeat, odom,
+  camera, safety stops); ``clock``: ``RosClock``;
+- ``node``: the ``pmnav-ros`` controller node; ``goal``: ``pmnav-ros-goal``;
+- ``sim_create3``: ``pmnav-sim-create3``, the pybullet simulator behind the robot's topics;
+- ``env``, ``runtime``, ``qos``, ``messages``, ``testing``: environment, executor, QoS,
+  message conversions, subprocess helpers.
+
+Nothing here imports rclpy at import time; the functions that need it import it.
+"""

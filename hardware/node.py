@@ -1,0 +1,520 @@
+"""``pmnav-ros``: the PM-Nav controller node for a Create 3 (real, or ``pmnav-sim-create3``).
+
+API (all standard messages; names relative to the node's namespace):
+
+- in ``goal`` (std_msgs/String): a room name, id or alias. A new goal preempts the
+  one running (its result says CANCELLED). In ``cancel`` (std_msgs/Empty).
+- out ``result`` (std_msgs/String, JSON): ``{"id", "goal", "success", "code",
+  "message", "duration_s", "ticks", "actions", "fix_attempts", "replans",
+  "pose_odom", "pose_map"}``; ``code`` is a FailureCode (INVALID_GOAL,
+  SENSOR_TIMEOUT, ...) or null.
+- out ``status`` (std_msgs/String, JSON, ``status_hz``): idle/running, the goal,
+  sensor ages, the current fault.
+- out ``tree`` (std_msgs/String, JSON): one snapshot per tick (statuses, feedback,
+  blackboard changes; the format of ``pmnav tree replay``); ``tree/structure``
+  (latched) holds the tree's nodes.
+- out ``plan`` (nav_msgs/Path, latched, frame ``map``), ``trajectory`` (nav_msgs/Path,
+  the driven odometry poses put in the map frame with the latest localization),
+  ``pose`` (geometry_msgs/PoseStamped, the estimated map pose), ``markers``
+  (visualization_msgs/MarkerArray, latched: doors, landmarks, plan steps),
+  ``map_to_odom`` (geometry_msgs/TransformStamped), and ``/tf`` map -> odom when
+  tf2_msgs can be imported.
+
+The tree runs in the main thread (``run_tree`` with ``sync_workers=False`` and a
+RosClock); rclpy spins in a background executor. Parameters: see ``PARAMETERS``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import queue
+import sys
+import threading
+import traceback
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.hardware.create3 import Create3Options
+from pmnav_bt.seams import Pose2D
+
+# name -> (default, description). Types follow the defaults.
+PARAMETERS: dict[str, tuple[Any, str]] = {
+    "building": ("fig2_hospital", "building file (YAML) or built-in name"),
+    "config": ("", "PM-Nav config file (YAML); empty: defaults"),
+    "overrides": ("", "config overrides 'section.key=value', separated by ';'"),
+    "tick_hz": (0.0, "tree tick rate; 0: the config's tree.tick_hz"),
+    "budget": (0, "action budget; 0: the config's tree.budget_actions"),
+    "seed": (0, "seed of the perception back ends"),
+    "max_duration_s": (900.0, "a mission ends with TIMEOUT after this long"),
+    "cmd_vel_topic": ("cmd_vel", ""),
+    "odom_topic": ("odom", ""),
+    "image_topic": ("camera/image_raw", "sensor_msgs/Image rgb8 or bgr8"),
+    "camera_info_topic": ("camera/camera_info", ""),
+    "depth_topic": ("camera/depth/image_raw", "32FC1 m or 16UC1 mm; empty: none"),
+    "segmentation_topic": ("camera/segmentation", "simulator labels; empty: none"),
+    "labels_topic": ("camera/segmentation_labels", "the segmentation's id -> label JSON"),
+    "hazard_topic": ("hazard_detection", "used only if irobot_create_msgs imports"),
+    "cmd_rate_hz": (20.0, "cmd_vel republish rate while moving"),
+    "odom_timeout": (0.3, "hold the robot stopped when odometry is older than this (s)"),
+    "odom_fault_s": (1.0, "fail the mission (SENSOR_TIMEOUT) after this long without odometry"),
+    "camera_timeout": (2.0, "stop and fail when the camera is silent this long (s)"),
+    "sync_slop": (0.05, "depth/segmentation match the colour frame within this (s)"),
+    "max_linear": (0.306, "m/s"),
+    "max_angular": (1.9, "rad/s"),
+    "camera_height": (1.6, "m above the floor"),
+    "hfov_deg": (60.0, "horizontal field of view until a CameraInfo arrives"),
+    "stall_s": (2.0, "a motion without progress for this long is BLOCKED"),
+    "map_frame": ("map", ""),
+    "odom_frame": ("odom", ""),
+    "publish_tf": (True, "publish map -> odom on /tf (needs tf2_msgs)"),
+    "tree_log": ("", "also write the tree snapshots (JSON lines) to this file"),
+    "status_hz": (1.0, "status topic rate"),
+    "viz_hz": (2.0, "pose, trajectory and map -> odom publish rate"),
+}
+
+_OPTION_NAMES = {f.name for f in fields(Create3Options)}
+
+
+class Cancelled(Exception):  # noqa: N818 - raised out of run_tree to end a run
+    """Raised from the tick handler to end a run early."""
+
+
+def read_parameters(node) -> dict[str, Any]:
+    """Declare every parameter of ``PARAMETERS`` on ``node`` and return their values."""
+    return declare_parameters(node, PARAMETERS)
+
+
+def declare_parameters(node, spec: dict[str, tuple[Any, str]]) -> dict[str, Any]:
+    """Declare ``spec``'s parameters; a value of the wrong type is a PmNavError."""
+    from rcl_interfaces.msg import ParameterDescriptor
+    from rclpy.exceptions import InvalidParameterTypeException
+
+    out = {}
+    for name, (default, desc) in spec.items():
+        try:
+            node.declare_parameter(name, default, ParameterDescriptor(description=desc))
+        except InvalidParameterTypeException as err:
+            kind = type(default).__name__
+            raise PmNavError(
+                f"parameter {name!r}: expected a {kind} like {default!r} ({err})"
+            ) from None
+        out[name] = node.get_parameter(name).value
+    return out
+
+
+def create3_options(params: dict[str, Any]) -> Create3Options:
+    kw = {k: v for k, v in params.items() if k in _OPTION_NAMES}
+    for k in ("depth_topic", "segmentation_topic", "labels_topic", "hazard_topic"):
+        kw[k] = str(kw.get(k) or "")
+    return Create3Options(**kw)
+
+
+@dataclass
+class _Run:
+    id: int
+    goal: str
+    cancel: threading.Event = field(default_factory=threading.Event)
+    reason: str = ""
+
+
+class _SnapshotWriter:
+    """A text sink for SnapshotLogger: the structure record goes to ``tree/structure``
+    (latched), tick records to ``tree``; optionally tee'd to a file."""
+
+    def __init__(self, tick_pub, structure_pub, tee=None) -> None:
+        from std_msgs.msg import String
+
+        self._String = String
+        self._tick, self._structure, self._tee = tick_pub, structure_pub, tee
+
+    def write(self, text: str) -> int:
+        if self._tee is not None:
+            self._tee.write(text)
+        line = text.strip()
+        if line:
+            pub = self._structure if line.startswith('{"type": "tree"') else self._tick
+            pub.publish(self._String(data=line))
+        return len(text)
+
+    def flush(self) -> None:
+        if self._tee is not None:
+            self._tee.flush()
+
+
+class PmNavController:
+    """The pmnav-ros node's logic: parameters, topics, the goal queue and the mission loop."""
+
+    def __init__(self, node, runtime) -> None:
+        from geometry_msgs.msg import PoseStamped, TransformStamped
+        from nav_msgs.msg import Path
+        from std_msgs.msg import Empty, String
+        from visualization_msgs.msg import MarkerArray
+
+        from pmnav_bt.building import load_building
+        from pmnav_bt.config import load_config
+        from pmnav_bt.hardware import qos
+        from pmnav_bt.hardware.create3 import Create3Base
+        from pmnav_bt.priori_map import parse_building
+        from pmnav_bt.trees import runner  # noqa: F401 - import the tree now, not at the first
+        # goal: a long import holds the GIL and would starve the executor (odometry "stale")
+
+        self.node = node
+        self.runtime = runtime
+        self.log = node.get_logger()
+        self.params = p = read_parameters(node)
+        overrides = [s.strip() for s in str(p["overrides"]).split(";") if s.strip()]
+        if p["tick_hz"] > 0:
+            overrides.append(f"tree.tick_hz={float(p['tick_hz'])}")
+        self.config = load_config(p["config"] or None, overrides)
+        if self.config.grounder.backend == "sim_gt" and not p["segmentation_topic"]:
+            raise PmNavError(
+                "grounder.backend 'sim_gt' reads the simulator's segmentation, but the "
+                "segmentation_topic parameter is empty; run against pmnav-sim-create3 "
+                "(it publishes camera/segmentation) or configure a real grounder back end"
+            )
+        self.building = load_building(p["building"])
+        self.pm = parse_building(self.building)
+        self.base = Create3Base(node, create3_options(p))
+        self.map_frame, self.odom_frame = p["map_frame"], p["odom_frame"]
+
+        self._String = String
+        self._goals: queue.Queue[str] = queue.Queue()
+        self._run: _Run | None = None
+        self._runs = 0
+        self._lock = threading.Lock()
+
+        ev, latched = qos.events(), qos.latched()
+        self.pub_result = node.create_publisher(String, "result", ev)
+        self.pub_status = node.create_publisher(String, "status", ev)
+        self.pub_tree = node.create_publisher(String, "tree", ev)
+        self.pub_structure = node.create_publisher(String, "tree/structure", latched)
+        self.pub_plan = node.create_publisher(Path, "plan", latched)
+        self.pub_traj = node.create_publisher(Path, "trajectory", ev)
+        self.pub_pose = node.create_publisher(PoseStamped, "pose", ev)
+        self.pub_markers = node.create_publisher(MarkerArray, "markers", latched)
+        self.pub_map_odom = node.create_publisher(TransformStamped, "map_to_odom", ev)
+        self.pub_tf = None
+        if p["publish_tf"]:
+            try:
+                from tf2_msgs.msg import TFMessage
+            except ImportError:
+                self.log.info("tf2_msgs is not installed: map -> odom only on map_to_odom")
+            else:
+                self.pub_tf = node.create_publisher(TFMessage, "/tf", qos.events(100))
+        node.create_subscription(String, "goal", self._on_goal, ev)
+        node.create_subscription(Empty, "cancel", self._on_cancel, ev)
+        node.create_timer(1.0 / max(0.1, float(p["status_hz"])), self._publish_status)
+        self._publish_map_markers()
+        self.log.info(
+            f"pmnav-ros ready: building {self.building.name}, "
+            f"{len(self.building.rooms)} rooms; send a room name on "
+            f"{node.resolve_topic_name('goal')}"
+        )
+
+    # -- goals -------------------------------------------------------------------------------
+
+    def _on_goal(self, msg) -> None:
+        goal = msg.data.strip()
+        self.log.info(f"goal {goal!r} received")
+        with self._lock:
+            if self._run is not None:
+                self._run.reason = f"preempted by goal {goal!r}"
+                self._run.cancel.set()
+                self.base.clock.interrupt()
+            self._goals.put(goal)
+
+    def _on_cancel(self, _msg) -> None:
+        with self._lock:
+            if self._run is not None:
+                self._run.reason = "cancelled on request"
+                self._run.cancel.set()
+                self.base.clock.interrupt()
+            while not self._goals.empty():
+                self._goals.get_nowait()
+
+    def request_stop(self) -> None:
+        """Signal handler side: end the current run (the main loop then exits)."""
+        run = self._run
+        if run is not None:
+            run.reason = "the node is shutting down"
+            run.cancel.set()
+        self.base.clock.interrupt()
+
+    def spin(self) -> None:
+        """The mission loop: wait for goals, run the tree, publish results; until stopped."""
+        stop = self.runtime.stop_requested
+        while not stop.is_set():
+            try:
+                goal = self._goals.get(timeout=0.1)
+            except queue.Empty:
+                continue
+            if stop.is_set():
+                break
+            try:
+                self.execute(goal)
+            except Exception:  # noqa: BLE001 - one bad run must not end the node
+                self.log.error(f"goal {goal!r} failed:\n{traceback.format_exc()}")
+                self.base.stop()
+
+    def execute(self, goal: str) -> dict:
+        """Run the tree for one goal and publish its result."""
+        from pmnav_bt.trees.runner import make_context, run_tree
+
+        with self._lock:
+            self._runs += 1
+            run = self._run = _Run(self._runs, goal)
+        p, cfg = self.params, self.config
+        self.base.clock.clear()
+        t0 = self.base.clock.now()
+        budget = int(p["budget"]) or None
+        ctx = make_context(self.base, self.pm, cfg, seed=int(p["seed"]), budget=budget)
+        viz = _Viz(self, ctx)
+        tee = open(p["tree_log"], "a", encoding="utf-8") if p["tree_log"] else None  # noqa: SIM115
+        writer = _SnapshotWriter(self.pub_tree, self.pub_structure, tee)
+
+        def on_tick(tree) -> None:
+            viz.update()
+            if run.cancel.is_set():
+                raise Cancelled(run.reason or "cancelled")
+
+        result: dict[str, Any] = {"id": run.id, "goal": goal}
+        try:
+            max_ticks = max(1, int(float(p["max_duration_s"]) * cfg.tree.tick_hz))
+            out = run_tree(ctx, goal, max_ticks, log=writer, on_tick=on_tick, sync_workers=False)
+            result.update(
+                success=out.success,
+                code=out.failure.code.value if out.failure else None,
+                message=out.failure.message if out.failure else "arrived",
+                ticks=out.ticks,
+                actions=out.actions,
+                fix_attempts=out.fix_attempts,
+                replans=out.replans,
+            )
+        except Cancelled as c:
+            result.update(success=False, code="CANCELLED", message=str(c))
+        except PmNavError as err:
+            result.update(success=False, code="ERROR", message=str(err))
+        except Exception as err:  # noqa: BLE001 - reported, the node goes on
+            self.log.error(traceback.format_exc())
+            result.update(
+                success=False, code="INTERNAL_ERROR", message=f"{type(err).__name__}: {err}"
+            )
+        finally:
+            self.base.stop()
+            if tee is not None:
+                tee.close()
+            with self._lock:
+                self._run = None
+        viz.update(force=True)
+        odom = self.base.pose()
+        est = viz.map_pose(odom)
+        result.update(
+            duration_s=round(self.base.clock.now() - t0, 3),
+            pose_odom=[round(odom.x, 3), round(odom.y, 3), round(odom.yaw, 4)],
+            pose_map=[round(est.x, 3), round(est.y, 3), round(est.yaw, 4)],
+        )
+        self.pub_result.publish(self._String(data=json.dumps(result)))
+        # (rclpy ties a severity to each call site: one call per severity)
+        if result["success"]:
+            self.log.info(f"goal {goal!r}: SUCCESS: {result['message']}")
+        else:
+            self.log.warn(f"goal {goal!r}: {result['code']}: {result['message']}")
+        return result
+
+    # -- status and visualisation -------------------------------------------------------------
+
+    def _publish_status(self) -> None:
+        run = self._run
+        fault = self.base.fault()
+        s = self.base.sensors()
+        status = {
+            "state": "running" if run is not None else "idle",
+            "goal": run.goal if run is not None else None,
+            "runs": self._runs,
+            "odom_age": None if s["odom_age"] is None else round(s["odom_age"], 3),
+            "camera_age": None if s["camera_age"] is None else round(s["camera_age"], 3),
+            "max_odom_gap": round(s["max_odom_gap"], 3),
+            "fault": str(fault) if fault is not None else None,
+            "motion": self.base.motion_status().value,
+        }
+        per = sorted(self.base.cmd_periods()[-1000:])
+        if per:
+            status["cmd_period_ms"] = {
+                "n": len(per),
+                "median": round(1000 * per[len(per) // 2], 1),
+                "p99": round(1000 * per[min(len(per) - 1, int(0.99 * len(per)))], 1),
+                "max": round(1000 * per[-1], 1),
+            }
+        self.pub_status.publish(self._String(data=json.dumps(status)))
+
+    def _publish_map_markers(self) -> None:
+        from visualization_msgs.msg import MarkerArray
+
+        arr = MarkerArray()
+        stamp = self.node.get_clock().now().to_msg()
+        i = 0
+        for room in self.building.rooms:
+            arr.markers += _marker_pair(
+                i, "doors", stamp, self.map_frame, room.door, room.sign_text, (0.2, 0.5, 1.0), 0.3
+            )
+            i += 2
+        for lm in self.building.landmarks:
+            arr.markers += _marker_pair(
+                i, "landmarks", stamp, self.map_frame, lm.pos, lm.display_name, (1.0, 0.6, 0.1), 0.5
+            )
+            i += 2
+        self.pub_markers.publish(arr)
+        self._map_markers = list(arr.markers)
+
+
+class _Viz:
+    """Per-run publishing from the tick handler: pose, trajectory, plan, map -> odom."""
+
+    def __init__(self, ctl: PmNavController, ctx) -> None:
+        self.ctl, self.ctx = ctl, ctx
+        self._plan = None
+        self._traj: list[Pose2D] = []
+        self._last_pub = -math.inf
+        self._period = 1.0 / max(0.1, float(ctl.params["viz_hz"]))
+
+    @staticmethod
+    def _bb(key: str):
+        import py_trees
+
+        return py_trees.blackboard.Blackboard.storage.get(f"/pmnav/{key}")
+
+    def map_pose(self, odom: Pose2D) -> Pose2D:
+        from pmnav_bt.behaviours.context import map_pose
+
+        return map_pose(self._bb("map_T_odom"), odom)
+
+    def update(self, force: bool = False) -> None:
+        from pmnav_bt.hardware.messages import path_message, pose_stamped, transform_stamped
+
+        ctl = self.ctl
+        odom = ctl.base.pose()
+        if not self._traj or _moved(self._traj[-1], odom):
+            self._traj.append(odom)
+        plan = self._bb("plan")
+        stamp = ctl.node.get_clock().now().to_msg()
+        if plan is not None and plan is not self._plan:
+            self._plan = plan
+            ctl.pub_plan.publish(path_message(_plan_poses(plan), stamp, ctl.map_frame))
+            self._publish_plan_markers(plan, stamp)
+        now = ctl.base.clock.now()
+        if not force and now - self._last_pub < self._period:
+            return
+        self._last_pub = now
+        m = self._bb("map_T_odom")
+        frame = ctl.map_frame if m is not None else ctl.odom_frame
+        ctl.pub_pose.publish(pose_stamped(self.map_pose(odom), stamp, frame))
+        ctl.pub_traj.publish(path_message([self.map_pose(q) for q in self._traj], stamp, frame))
+        if m is not None:
+            tf = transform_stamped(Pose2D(*m), stamp, ctl.map_frame, ctl.odom_frame)
+            ctl.pub_map_odom.publish(tf)
+            if ctl.pub_tf is not None:
+                from tf2_msgs.msg import TFMessage
+
+                ctl.pub_tf.publish(TFMessage(transforms=[tf]))
+
+    def _publish_plan_markers(self, plan, stamp) -> None:
+        from visualization_msgs.msg import Marker, MarkerArray
+
+        ctl = self.ctl
+        arr = MarkerArray()
+        clear = Marker()
+        clear.header.frame_id = ctl.map_frame
+        clear.ns = "plan_steps"
+        clear.action = Marker.DELETEALL
+        arr.markers.append(clear)
+        for k, step in enumerate(plan.steps):
+            arr.markers += _marker_pair(
+                1000 + 2 * k,
+                "plan_steps",
+                stamp,
+                ctl.map_frame,
+                step.position,
+                f"{k + 1}. {step.landmark}: {step.action.value}",
+                (0.1, 0.8, 0.2),
+                0.25,
+            )
+        ctl.pub_markers.publish(MarkerArray(markers=ctl._map_markers + arr.markers))
+
+
+def _moved(a: Pose2D, b: Pose2D) -> bool:
+    return math.hypot(a.x - b.x, a.y - b.y) > 0.05 or abs(a.yaw - b.yaw) > 0.17
+
+
+def _plan_poses(plan) -> list[Pose2D]:
+    pts = [tuple(p) for p in plan.path]
+    out = []
+    for i, (x, y) in enumerate(pts):
+        nx_, ny_ = pts[min(i + 1, len(pts) - 1)]
+        px, py = pts[max(i - 1, 0)]
+        dx, dy = (nx_ - x, ny_ - y) if i + 1 < len(pts) else (x - px, y - py)
+        out.append(Pose2D(float(x), float(y), math.atan2(dy, dx) if (dx or dy) else 0.0))
+    return out
+
+
+def _marker_pair(mid, ns, stamp, frame, xy, text, rgb, size):
+    """A sphere and a text label at ``xy``."""
+    from visualization_msgs.msg import Marker
+
+    out = []
+    for k, kind in enumerate((Marker.SPHERE, Marker.TEXT_VIEW_FACING)):
+        m = Marker()
+        m.header.stamp = stamp
+        m.header.frame_id = frame
+        m.ns, m.id, m.type, m.action = ns, mid + k, kind, Marker.ADD
+        m.pose.position.x, m.pose.position.y = float(xy[0]), float(xy[1])
+        m.pose.position.z = 0.2 if kind == Marker.SPHERE else 0.8
+        m.pose.orientation.w = 1.0
+        m.scale.x = m.scale.y = size
+        m.scale.z = size if kind == Marker.SPHERE else 0.3
+        m.color.r, m.color.g, m.color.b, m.color.a = (*map(float, rgb), 1.0)
+        if kind == Marker.TEXT_VIEW_FACING:
+            m.text = text
+        out.append(m)
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console script ``pmnav-ros``: ``pmnav-ros --ros-args -p building:=fig2_hospital``."""
+    from pmnav_bt.hardware.runtime import RosRuntime
+
+    args = list(sys.argv if argv is None else argv)
+    # The cmd_vel heartbeat thread must get the GIL quickly while the tree and the
+    # perception worker run: hand it over every 1 ms instead of 5 ms.
+    sys.setswitchinterval(0.001)
+    try:
+        runtime = RosRuntime(args=args)
+    except PmNavError as err:  # rclpy missing, or bad --ros-args
+        print(f"pmnav-ros: {err}", file=sys.stderr)
+        sys.exit(2)
+    from rclpy.node import Node
+
+    node = Node("pmnav", context=runtime.context)
+    controller = None
+    code = 0
+    try:
+        controller = PmNavController(node, runtime)
+        runtime.add(node)
+        runtime.install_signals(controller.request_stop)
+        runtime.start()
+        controller.spin()
+    except PmNavError as err:
+        print(f"pmnav-ros: {err}", file=sys.stderr)
+        code = 1
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if controller is not None:
+            controller.base.close()
+        runtime.shutdown()
+    sys.exit(code)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

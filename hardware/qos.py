@@ -1,0 +1,58 @@
+"""QoS profiles for the Create 3 topics and PM-Nav's own.
+
+- ``sensor()``: best effort, keep last 5, volatile (rclpy's ``qos_profile_sensor_data``).
+  A best-effort subscriber matches both best-effort and reliable publishers, so it is
+  the right choice for odometry and cameras whatever the driver publishes with.
+- ``command()``: reliable, keep last 1: ``cmd_vel``. A reliable publisher matches the
+  Create 3's subscriber (reliable) as well as best-effort ones; only the newest
+  command matters.
+- ``latched()``: reliable, transient local, keep last 1: things a late subscriber
+  (RViz, a test) needs once: the plan, the map markers, segmentation labels,
+  the tree's structure.
+- ``events()``: reliable, volatile, keep last 10: goals, results, status, snapshots.
+"""
+
+from __future__ import annotations
+
+from pmnav_bt.hardware.env import import_rclpy
+
+
+def _qos():
+    import_rclpy()
+    from rclpy import qos
+
+    return qos
+
+
+def sensor():
+    return _qos().qos_profile_sensor_data
+
+
+def command():
+    q = _qos()
+    return q.QoSProfile(
+        depth=1,
+        history=q.HistoryPolicy.KEEP_LAST,
+        reliability=q.ReliabilityPolicy.RELIABLE,
+        durability=q.DurabilityPolicy.VOLATILE,
+    )
+
+
+def latched():
+    q = _qos()
+    return q.QoSProfile(
+        depth=1,
+        history=q.HistoryPolicy.KEEP_LAST,
+        reliability=q.ReliabilityPolicy.RELIABLE,
+        durability=q.DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+
+
+def events(depth: int = 10):
+    q = _qos()
+    return q.QoSProfile(
+        depth=depth,
+        history=q.HistoryPolicy.KEEP_LAST,
+        reliability=q.ReliabilityPolicy.RELIABLE,
+        durability=q.DurabilityPolicy.VOLATILE,
+    )

@@ -1,0 +1,111 @@
+"""An rclpy context with an executor spinning in a background thread, and signal handling.
+
+rclpy's own SIGINT handler shuts the context down at once, after which nothing can
+be published, not even the zero ``cmd_vel`` that stops the robot. ``RosRuntime``
+starts rclpy without its handlers (``SignalHandlerOptions.NO``); ``install_signals``
+sets handlers that only *request* a shutdown, so the owner can stop the robot first
+and then call ``shutdown()``. A second Ctrl-C raises KeyboardInterrupt.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Callable
+
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.hardware.env import import_rclpy
+
+
+class RosArgumentsError(PmNavError):
+    """rclpy could not start with the given arguments (a bad ``--ros-args`` rule)."""
+
+
+class RosRuntime:
+    """rclpy context + an executor (single-threaded unless ``threads`` > 1) spun by a
+    daemon thread."""
+
+    def __init__(
+        self, args: list[str] | None = None, threads: int = 1, domain_id: int | None = None
+    ) -> None:
+        rclpy = import_rclpy()
+        from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
+        from rclpy.signals import SignalHandlerOptions
+
+        self.rclpy = rclpy
+        self.context = rclpy.Context()
+        try:
+            rclpy.init(
+                args=args,
+                context=self.context,
+                domain_id=domain_id,
+                signal_handler_options=SignalHandlerOptions.NO,
+            )
+        except Exception as err:  # rclpy raises RCLError for bad --ros-args
+            msg = str(err).split(", at ")[0]
+            raise RosArgumentsError(
+                f"{msg} (an empty string parameter must be quoted: -p name:=\"''\")"
+            ) from None
+        if threads > 1:
+            self.executor = MultiThreadedExecutor(num_threads=threads, context=self.context)
+        else:
+            self.executor = SingleThreadedExecutor(context=self.context)
+        self.stop_requested = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._nodes: list = []
+        self._signals = 0
+
+    def add(self, node) -> None:
+        self._nodes.append(node)
+        self.executor.add_node(node)
+
+    def start(self) -> RosRuntime:
+        """Spin the executor in a background thread."""
+        self._thread = threading.Thread(target=self._spin, name="rclpy-executor", daemon=True)
+        self._thread.start()
+        return self
+
+    def _spin(self) -> None:
+        from rclpy.executors import ExternalShutdownException
+
+        try:
+            self.executor.spin()
+        except (ExternalShutdownException, KeyboardInterrupt):
+            pass
+        except Exception as err:  # noqa: BLE001 - a dying executor must not hang the process
+            if self.context.ok():
+                print(f"rclpy executor stopped: {err}", flush=True)
+        finally:
+            self.stop_requested.set()
+
+    def install_signals(self, on_request: Callable[[], None] | None = None) -> None:
+        """SIGINT/SIGTERM request a shutdown (``stop_requested``); a second one raises
+        KeyboardInterrupt. Call from the main thread."""
+
+        def handler(signum, _frame) -> None:
+            self._signals += 1
+            self.stop_requested.set()
+            if on_request is not None:
+                on_request()
+            if self._signals > 1:
+                raise KeyboardInterrupt
+
+        signal.signal(signal.SIGINT, handler)
+        signal.signal(signal.SIGTERM, handler)
+
+    def shutdown(self) -> None:
+        """Destroy the nodes, stop the executor and the context. Idempotent."""
+        self.stop_requested.set()
+        for node in self._nodes:
+            try:
+                self.executor.remove_node(node)
+                node.destroy_node()
+            except Exception:  # noqa: BLE001
+                pass
+        self._nodes.clear()
+        with contextlib.suppress(Exception):
+            self.executor.shutdown(timeout_sec=2.0)
+        self.rclpy.try_shutdown(context=self.context)
+        if self._thread is not None and self._thread is not threading.current_thread():
+            self._thread.join(timeout=2.0)

@@ -1,0 +1,285 @@
+"""``pmnav-sim-create3``: the pybullet simulator behind the Create 3's ROS 2 topics.
+
+A SimWorld and a SimBase (with drifting wheel odometry, ``odometry_noise``) driven in
+real time: a timer advances the SimClock by the wall time elapsed since its last
+call. It speaks the robot's topics, so ``pmnav-ros`` runs against it exactly as
+against a Create 3:
+
+- in ``cmd_vel`` (geometry_msgs/Twist); like the robot it stops ``cmd_timeout``
+  (0.5 s) after the last command;
+- out ``odom`` (nav_msgs/Odometry, ``odom_rate_hz``): odom -> base_link; with
+  ``odom_at_origin`` (default) the odometry frame starts at the start pose, as a
+  Create 3's does where it boots;
+- out ``camera/image_raw`` (rgb8), ``camera/camera_info``, ``camera/depth/image_raw``
+  (32FC1 m), ``camera/segmentation`` (16UC1 label ids) at ``camera_rate_hz``, all
+  with one stamp (the render time) and sensor-data QoS; ``camera/segmentation_labels``
+  (std_msgs/String JSON id -> label, latched);
+- out ``sim/true_pose`` (geometry_msgs/PoseStamped, frame ``map``: ground truth) and
+  ``sim/stats`` (std_msgs/String JSON: collisions, path length, rotation).
+
+Fault injection: the parameters ``publish_odom`` and ``publish_camera`` can be set to
+false at run time (``ros2 param set /sim_create3 publish_camera false``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import threading
+import time
+
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.geometry import se2_compose, se2_inverse
+from pmnav_bt.seams import Pose2D
+
+PARAMETERS = {
+    "building": ("fig2_hospital", "building file (YAML) or built-in name"),
+    "start_pose": ("", "x,y,yaw_deg in the map frame; empty: the building's start"),
+    "width": (320, "camera image width, pixels"),
+    "height": (240, "camera image height, pixels"),
+    "hfov_deg": (60.0, "horizontal field of view"),
+    "camera_height": (1.6, "m"),
+    "camera_rate_hz": (5.0, "frames per second (rendering costs ~25 ms at 320x240)"),
+    "odom_rate_hz": (20.0, ""),
+    "physics_rate_hz": (50.0, "how often sim time catches up with the wall clock"),
+    "cmd_timeout": (0.5, "stop this long after the last cmd_vel (s)"),
+    "odometry_noise": (0.02, "relative error of each odometry increment"),
+    "seed": (0, "odometry noise seed"),
+    "odom_at_origin": (True, "odometry frame starts at the start pose"),
+    "publish_odom": (True, "false: stop publishing odometry (fault injection)"),
+    "publish_camera": (True, "false: stop publishing camera frames (fault injection)"),
+    "odom_frame": ("odom", ""),
+    "base_frame": ("base_link", ""),
+    "camera_frame": ("camera_optical_frame", ""),
+    "map_frame": ("map", ""),
+}
+
+
+class SimCreate3:
+    """The node's logic on an rclpy ``node``."""
+
+    def __init__(self, node) -> None:
+        from geometry_msgs.msg import PoseStamped, Twist
+        from nav_msgs.msg import Odometry
+        from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+        from sensor_msgs.msg import CameraInfo, Image
+        from std_msgs.msg import String
+
+        from pmnav_bt.hardware import qos
+        from pmnav_bt.hardware.node import declare_parameters
+        from pmnav_bt.sim.cli import parse_pose
+        from pmnav_bt.sim.clock import SimClock
+        from pmnav_bt.sim.odometry import NoisyOdometry
+        from pmnav_bt.sim.robot import SimBase
+        from pmnav_bt.sim.world import SimWorld
+
+        self.node = node
+        self.log = node.get_logger()
+        self.p = p = declare_parameters(node, PARAMETERS)
+        self._String, self._Odometry = String, Odometry
+        self.world = SimWorld(p["building"])
+        try:
+            start = parse_pose(p["start_pose"]) if p["start_pose"] else self.world.start_pose()
+        except PmNavError:
+            self.world.close()
+            raise PmNavError(
+                f"parameter 'start_pose' {p['start_pose']!r}: expected 'x,y,yaw_deg', "
+                "e.g. -p start_pose:=0,30,-90"
+            ) from None
+        self.start = start
+        self.clock = SimClock(start=time.time())
+        self.inner = SimBase(
+            self.world,
+            self.clock,
+            pose=start,
+            width=int(p["width"]),
+            height=int(p["height"]),
+            hfov=math.radians(float(p["hfov_deg"])),
+            camera_height=float(p["camera_height"]),
+        )
+        self.base = NoisyOdometry(self.inner, float(p["odometry_noise"]), seed=int(p["seed"]))
+        self._odom_T_map = (
+            se2_inverse((start.x, start.y, start.yaw)) if p["odom_at_origin"] else (0.0, 0.0, 0.0)
+        )
+        self._lock = threading.Lock()
+        self._last_wall = time.monotonic()
+        self._last_cmd: float | None = None
+        self._last_odom: tuple[float, Pose2D] | None = None
+        self._labels_sent = -1
+        self.frames = 0
+
+        sensor, latched, ev = qos.sensor(), qos.latched(), qos.events()
+        self.pub_odom = node.create_publisher(Odometry, "odom", ev)
+        self.pub_rgb = node.create_publisher(Image, "camera/image_raw", sensor)
+        self.pub_info = node.create_publisher(CameraInfo, "camera/camera_info", sensor)
+        self.pub_depth = node.create_publisher(Image, "camera/depth/image_raw", sensor)
+        self.pub_seg = node.create_publisher(Image, "camera/segmentation", sensor)
+        self.pub_labels = node.create_publisher(String, "camera/segmentation_labels", latched)
+        self.pub_true = node.create_publisher(PoseStamped, "sim/true_pose", ev)
+        self.pub_stats = node.create_publisher(String, "sim/stats", ev)
+        motion = MutuallyExclusiveCallbackGroup()
+        camera = MutuallyExclusiveCallbackGroup()
+        node.create_subscription(
+            Twist, "cmd_vel", self._on_cmd, qos.events(), callback_group=motion
+        )
+        node.create_timer(1.0 / float(p["physics_rate_hz"]), self._physics, callback_group=motion)
+        node.create_timer(1.0 / float(p["odom_rate_hz"]), self._odom, callback_group=motion)
+        node.create_timer(1.0 / float(p["camera_rate_hz"]), self._camera, callback_group=camera)
+        node.create_timer(1.0, self._stats, callback_group=motion)
+        self._publish_labels()
+        self.log.info(
+            f"simulated Create 3 in {self.world.building.name} at "
+            f"({start.x:.2f}, {start.y:.2f}, {math.degrees(start.yaw):.0f} deg), camera "
+            f"{p['width']}x{p['height']} at {p['camera_rate_hz']} Hz"
+        )
+
+    # -- motion ---------------------------------------------------------------------------
+
+    def _on_cmd(self, msg) -> None:
+        with self._lock:
+            self._physics_locked()
+            self._last_cmd = time.monotonic()
+            self.inner.set_velocity(float(msg.linear.x), float(msg.angular.z))
+
+    def _physics(self) -> None:
+        with self._lock:
+            self._physics_locked()
+
+    def _physics_locked(self) -> None:
+        now = time.monotonic()
+        dt, self._last_wall = now - self._last_wall, now
+        if dt > 0.25:
+            self.log.warn(f"the simulator did not run for {dt:.2f} s (CPU starved?)")
+        if dt > 0.0:
+            self.clock.wait(min(dt, 0.5))  # a stalled process does not teleport the body
+        stale = self._last_cmd is None or now - self._last_cmd > float(self.p["cmd_timeout"])
+        if stale and self.inner.velocity_command != (0.0, 0.0):
+            self.inner.stop()
+            self.log.info("cmd_vel timeout: stopping")
+
+    def odom_pose(self) -> Pose2D:
+        q = self.base.pose()
+        x, y, yaw = se2_compose(self._odom_T_map, (q.x, q.y, q.yaw))
+        return Pose2D(x, y, yaw)
+
+    # -- publishing -------------------------------------------------------------------------
+
+    def _stamp(self):
+        """Now on the node's ROS clock (the controller's clock domain)."""
+        return self.node.get_clock().now().to_msg()
+
+    def _odom(self) -> None:
+        from pmnav_bt.hardware.messages import pose_stamped, quaternion_from_yaw
+
+        with self._lock:
+            self._physics_locked()
+            t = self.clock.now()
+            pose = self.odom_pose()
+            true = self.inner.pose()
+        stamp = self._stamp()
+        self.pub_true.publish(pose_stamped(true, stamp, self.p["map_frame"]))
+        if not self.node.get_parameter("publish_odom").value:
+            return
+        v = w = 0.0
+        if self._last_odom is not None:
+            t0, q0 = self._last_odom
+            if t > t0:
+                dx, dy = pose.x - q0.x, pose.y - q0.y
+                v = (math.cos(q0.yaw) * dx + math.sin(q0.yaw) * dy) / (t - t0)
+                w = math.atan2(math.sin(pose.yaw - q0.yaw), math.cos(pose.yaw - q0.yaw)) / (t - t0)
+        self._last_odom = (t, pose)
+        msg = self._Odometry()
+        msg.header.stamp = stamp
+        msg.header.frame_id = self.p["odom_frame"]
+        msg.child_frame_id = self.p["base_frame"]
+        msg.pose.pose.position.x, msg.pose.pose.position.y = pose.x, pose.y
+        msg.pose.pose.orientation = quaternion_from_yaw(pose.yaw)
+        msg.twist.twist.linear.x, msg.twist.twist.angular.z = v, w
+        self.pub_odom.publish(msg)
+
+    def _camera(self) -> None:
+        from pmnav_bt.hardware.messages import camera_info_message, image_message
+
+        if not self.node.get_parameter("publish_camera").value:
+            return
+        with self._lock:
+            self._physics_locked()
+        stamp = self._stamp()
+        obs = self.inner.observe()  # renders under the world's lock (~25 ms at 320x240)
+        frame = self.p["camera_frame"]
+        self.pub_rgb.publish(image_message(obs.rgb, "rgb8", stamp, frame))
+        self.pub_info.publish(camera_info_message(obs.intrinsics, stamp, frame))
+        if obs.depth is not None:
+            self.pub_depth.publish(image_message(obs.depth, "32FC1", stamp, frame))
+        if obs.segmentation is not None:
+            seg = obs.segmentation
+            if int(seg.max(initial=0)) < 65536:
+                self.pub_seg.publish(image_message(seg.astype("<u2"), "16UC1", stamp, frame))
+            else:
+                self.pub_seg.publish(image_message(seg.astype("<i4"), "32SC1", stamp, frame))
+        self.frames += 1
+        self._publish_labels()
+
+    def _publish_labels(self) -> None:
+        labels = dict(self.world.labels)
+        if len(labels) != self._labels_sent:
+            self._labels_sent = len(labels)
+            data = json.dumps({str(k): v for k, v in labels.items()})
+            self.pub_labels.publish(self._String(data=data))
+
+    def _stats(self) -> None:
+        s = self.inner.stats
+        q = self.inner.pose()
+        stats = {
+            "collisions": s.collisions,
+            "path_length": round(s.path_length, 3),
+            "rotation": round(s.rotation, 3),
+            "true_pose": [round(q.x, 3), round(q.y, 3), round(q.yaw, 4)],
+            "frames": self.frames,
+            "command": list(self.inner.velocity_command),
+        }
+        self.pub_stats.publish(self._String(data=json.dumps(stats)))
+
+    def close(self) -> None:
+        self.inner.close()
+        self.world.close()
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console script ``pmnav-sim-create3``: ``pmnav-sim-create3 --ros-args -p
+    building:=fig2_hospital -p start_pose:=22,0,0``."""
+    from pmnav_bt.hardware.runtime import RosRuntime
+
+    args = list(sys.argv if argv is None else argv)
+    try:
+        runtime = RosRuntime(args=args)
+    except PmNavError as err:  # rclpy missing, or bad --ros-args
+        print(f"pmnav-sim-create3: {err}", file=sys.stderr)
+        sys.exit(2)
+    from rclpy.node import Node
+
+    node = Node("sim_create3", context=runtime.context)
+    sim = None
+    code = 0
+    try:
+        sim = SimCreate3(node)
+        runtime.add(node)
+        runtime.install_signals()
+        runtime.start()
+        while not runtime.stop_requested.wait(0.2):
+            pass
+    except PmNavError as err:
+        print(f"pmnav-sim-create3: {err}", file=sys.stderr)
+        code = 1
+    except KeyboardInterrupt:
+        pass
+    finally:
+        runtime.shutdown()
+        if sim is not None:
+            sim.close()
+    sys.exit(code)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()
