@@ -25,7 +25,8 @@ KEYS = (
     "recent_sightings",  # list[Sighting]: the last verified sightings (pose re-fits)
     "last_action",  # Action: the last plan action carried out
     "avoid_landmarks",  # frozenset[str]: landmarks that failed and are not used again
-    "blocked_segments",  # frozenset[int]: segments found blocked
+    "blocked_segments",  # frozenset[int]: segments found blocked (twice)
+    "blocked_suspects",  # frozenset[int]: segments found blocked once
     "replans",  # int
     "failure",  # Failure: why the last thing failed
 )

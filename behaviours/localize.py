@@ -48,14 +48,14 @@ class FixPosition(PmNavBehaviour):
     WRITES = ("map_T_odom", "fix_attempts")
 
     def initialise(self) -> None:
-        b, views = self.ctx.pm.building, self.get("views") or []
+        pm, views = self.ctx.pm, self.get("views") or []
 
         def locate(cancelled):
             sightings = [
                 s
                 for v in views
                 for d in v.detections
-                if (s := sighting(b, v.observation, d)) is not None
+                if (s := sighting(pm, v.observation, d)) is not None
             ]
             return sightings, fix_pose(sightings)
 

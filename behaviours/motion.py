@@ -138,17 +138,18 @@ def _free_ahead(obs, est, goal) -> float | None:
 
 
 class Approach(DriveTo):
-    """Approach the seen target: stop ``offset`` metres from its door, towards the corridor.
+    """Approach the seen target: the goal room to ``goal_offset`` metres from its door;
+    any other landmark to its node on the corridor centre line, abeam of it (desks and
+    lift lobbies stand out from the wall; the centre line is always clear).
 
-    Reads ``target`` (PlanStep), ``map_T_odom``. The goal room uses the tree's goal
-    offset, other landmarks the approach offset.
+    Reads ``target`` (PlanStep), ``map_T_odom``.
     """
 
     def goal(self) -> tuple[float, float]:
         t = self.get("target")
-        cfg = self.ctx.config.tree
-        offset = cfg.goal_offset if t.action == Action.ARRIVE else cfg.approach_offset
-        return approach_point(t.target, t.position, offset)
+        if t.action == Action.ARRIVE:
+            return approach_point(t.target, t.position, self.ctx.config.tree.goal_offset)
+        return float(t.position[0]), float(t.position[1])
 
 
 class MoveToward(DriveTo):

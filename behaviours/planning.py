@@ -17,14 +17,16 @@ class MakePlan(PmNavBehaviour):
     """Plan from the estimated map pose to the goal (in the worker).
 
     Reads ``goal``, ``map_T_odom``, ``avoid_landmarks``, ``blocked_segments``;
-    writes ``plan``, ``step_index`` (0), ``last_action`` (None). FAILURE:
-    INVALID_GOAL for an unknown room, PLANNING_FAILED when no route exists.
+    writes ``plan``, ``step_index`` (0), ``last_action`` (None), ``target`` (None).
+    FAILURE: INVALID_GOAL for an unknown room, PLANNING_FAILED when no route exists,
+    BLOCKED when only corridors found blocked would serve.
     """
 
     READS = ("goal", "map_T_odom", "avoid_landmarks", "blocked_segments")
-    WRITES = ("plan", "step_index", "last_action")
+    WRITES = ("plan", "step_index", "last_action", "target")
 
     def initialise(self) -> None:
+        self.bb.set("target", None)  # a planning failure belongs to no step
         est = map_pose(self.get("map_T_odom"), self.ctx.base.pose())
         start = f"{est.x:.3f},{est.y:.3f},{math.degrees(est.yaw):.1f}"
         goal = self.get("goal")
@@ -147,13 +149,23 @@ class NoteFailure(PmNavBehaviour):
     """Before a replan: remember what failed so the next plan avoids it.
 
     Reads ``failure``, ``target``, ``map_T_odom``, ``replans``, ``avoid_landmarks``,
-    ``blocked_segments``; writes ``replans``, ``avoid_landmarks``, ``blocked_segments``.
-    A target not found is avoided (unless it is the goal); a blocked corridor is not
-    routed through again.
+    ``blocked_segments``, ``blocked_suspects``; writes ``replans``, ``avoid_landmarks``,
+    ``blocked_segments``, ``blocked_suspects``. A target not found is avoided (unless
+    it is the goal). A corridor found blocked once is suspected (a poor pose estimate
+    can make a wall look like an obstacle; the replan re-localizes first); found
+    blocked again, it is not routed through any more.
     """
 
-    READS = ("failure", "target", "map_T_odom", "replans", "avoid_landmarks", "blocked_segments")
-    WRITES = ("replans", "avoid_landmarks", "blocked_segments")
+    READS = (
+        "failure",
+        "target",
+        "map_T_odom",
+        "replans",
+        "avoid_landmarks",
+        "blocked_segments",
+        "blocked_suspects",
+    )
+    WRITES = ("replans", "avoid_landmarks", "blocked_segments", "blocked_suspects")
 
     def update(self) -> Status:
         self.bb.set("replans", (self.get("replans") or 0) + 1)
@@ -164,11 +176,16 @@ class NoteFailure(PmNavBehaviour):
             self.bb.set(
                 "avoid_landmarks", frozenset(self.get("avoid_landmarks") or ()) | {t.look_for}
             )
-        if failure is not None and failure.code == FailureCode.BLOCKED:
+        if failure is not None and failure.code == FailureCode.BLOCKED and t is not None:
             est = map_pose(self.get("map_T_odom"), self.ctx.base.pose())
             ahead = (est.x + 0.6 * math.cos(est.yaw), est.y + 0.6 * math.sin(est.yaw))
             seg = self.ctx.pm.locate(*ahead).segment.index
-            self.bb.set("blocked_segments", frozenset(self.get("blocked_segments") or ()) | {seg})
+            suspects = frozenset(self.get("blocked_suspects") or ())
+            if seg in suspects:
+                blocked = frozenset(self.get("blocked_segments") or ()) | {seg}
+                self.bb.set("blocked_segments", blocked)
+            else:
+                self.bb.set("blocked_suspects", suspects | {seg})
         self.ctx.log("replan", str(failure) if failure else "")
         self.feedback_message = f"replan after {failure}"
         return Status.SUCCESS

@@ -151,7 +151,7 @@ class FineDirection(PmNavBehaviour):
         t = self.get("target")
         entity = target_entity(self.ctx, t.look_for)
         bearing = float(self.ctx.refiner.refine(obs, det))
-        m = entity_position(self.ctx.pm.building, entity)
+        m = entity_position(self.ctx.pm, entity)
         body = target_point(obs, det)
         if self.ctx.refiner.name != "geometric" or body is None:
             # No grounded range: assume the target lies along the bearing, as far as the map says.

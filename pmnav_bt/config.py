@@ -67,7 +67,6 @@ class TreeConfig(_Section):
         2.0, gt=0.0, description="move this far towards a target not found before searching again"
     )
     replans: int = Field(2, ge=0, description="re-localize-and-replan recoveries")
-    approach_offset: float = Field(1.0, ge=0.0, description="stop this far from a landmark door")
     goal_offset: float = Field(0.6, ge=0.0, description="stop this far from the goal door")
     step_timeout_s: float = Field(180.0, gt=0.0, description="clock seconds per plan step")
     max_linear: float = Field(0.306, gt=0.0, description="m/s (Create 3)")

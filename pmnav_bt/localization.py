@@ -15,6 +15,7 @@ import numpy as np
 
 from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose
 from pmnav_bt.perception.geometry import target_point
+from pmnav_bt.priori_map import PrioriMap
 from pmnav_bt.resolve import entity_index, entity_position, normalise
 from pmnav_bt.seams import Detection, Observation, Pose2D
 
@@ -44,18 +45,18 @@ class Fix:
 
 
 def sighting(
-    building, obs: Observation, det: Detection, entity: str | None = None
+    pm: PrioriMap, obs: Observation, det: Detection, entity: str | None = None
 ) -> Sighting | None:
     """A sighting from a detection, if its label names a map entity and depth gives its range."""
     if entity is None:
-        entity = entity_index(building).get(normalise(det.label))
+        entity = entity_index(pm.building).get(normalise(det.label))
     if entity is None or truncated(obs, det):
         return None
     p = target_point(obs, det)
     if p is None:
         return None
     odom = se2_apply((obs.pose.x, obs.pose.y, obs.pose.yaw), p)
-    m = entity_position(building, entity)
+    m = entity_position(pm, entity)
     return Sighting(entity, (float(m[0]), float(m[1])), (float(odom[0]), float(odom[1])))
 
 

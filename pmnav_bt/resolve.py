@@ -12,6 +12,8 @@ import math
 import re
 from dataclasses import dataclass
 
+import numpy as np
+
 from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.priori_map import PrioriMap, Segment
 
@@ -141,7 +143,21 @@ def entity_index(building) -> dict[str, str]:
     return index
 
 
-def entity_position(building, entity: str) -> tuple[float, float]:
-    """Map position of 'room:<id>' (its door) or 'landmark:<id>'."""
+def entity_position(pm: PrioriMap, entity: str) -> tuple[float, float]:
+    """Where 'room:<id>' or 'landmark:<id>' is seen: a room's door; a landmark's face on
+    the corridor wall nearest to it (landmarks are mounted on the wall; the file may
+    place them behind it)."""
     kind, ident = entity.split(":", 1)
-    return building.room(ident).door if kind == "room" else building.landmark(ident).pos
+    b = pm.building
+    if kind == "room":
+        return b.room(ident).door
+    pos = np.asarray(b.landmark(ident).pos, dtype=float)
+    place = pm.places[ident]
+    node = pm.node_xy(place.node)
+    d = pos - node
+    dist = float(np.linalg.norm(d))
+    half = pm.segments[place.segment - 1].width / 2.0
+    if dist <= half:
+        return float(pos[0]), float(pos[1])
+    face = node + d * (half / dist)
+    return float(face[0]), float(face[1])

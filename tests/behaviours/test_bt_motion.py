@@ -52,15 +52,15 @@ def test_approach_point_and_out_heading(make_rig):
     assert out_heading(plan, plan.steps[-1]) == pytest.approx(plan.steps[-1].heading)
 
 
-def test_approach_reaches_the_approach_point(make_rig):
+def test_approach_to_a_landmark_stops_on_the_centre_line_abeam_it(make_rig):
     rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
     step = room4_step(rig)
     rig.set(target=step)
     approach = Approach("Approach", rig.ctx)
     seen = rig.run(approach, max_ticks=400)
     rig.expect(seen, Status.SUCCESS)
-    goal = approach_point(step.target, step.position, rig.ctx.config.tree.approach_offset)
-    assert goal == pytest.approx((0.2, 22.0))
+    goal = step.position  # its node on the centre line, abeam the door
+    assert goal == pytest.approx((0.0, 22.0))
     p = rig.true_pose()
     assert math.dist((p.x, p.y), goal) < 0.2
     assert len(seen) * 0.1 > 4.3 / rig.body.max_linear  # it drove there, at most at top speed
@@ -84,7 +84,7 @@ def test_approach_drives_on_the_estimated_pose(make_rig):
     rig.set(target=room4_step(rig), map_T_odom=(0.0, 0.5, 0.0))  # believes it is 0.5 m north
     rig.expect(rig.run(Approach("Approach", rig.ctx), max_ticks=400), Status.SUCCESS)
     est, p = rig.estimate(), rig.true_pose()
-    assert math.dist((est.x, est.y), (0.2, 22.0)) < 0.2
+    assert math.dist((est.x, est.y), (0.0, 22.0)) < 0.2
     assert p.y == pytest.approx(est.y - 0.5)
 
 
@@ -95,8 +95,8 @@ def test_approach_with_an_obstacle_in_the_way_fails_blocked(make_rig):
     seen = rig.run(Approach("Approach", rig.ctx), max_ticks=400)
     rig.expect(seen, Status.FAILURE)
     # A 1 m box leaves the camera's view (1.6 m up, 47 deg vertical field) 1.4 m before
-    # it, and the depth watch only judges what is nearer than 0.9 m: this one is found by
-    # bumping into it (MAX_BUMPS ticks of BLOCKED), not by depth. See the tall box below.
+    # it; the depth watch (once a second) or the bumper (MAX_BUMPS ticks of BLOCKED)
+    # finds it. See the tall box below for depth alone.
     assert rig.failure.code == FailureCode.BLOCKED
     assert rig.stopped()
     p = rig.true_pose()

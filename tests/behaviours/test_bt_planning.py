@@ -207,16 +207,34 @@ def test_note_failure_avoids_a_landmark_not_found(make_rig):
     assert rig.get("replans") == 4
 
 
-def test_note_failure_blocks_the_segment_ahead_of_the_estimated_pose(make_rig):
+def test_note_failure_blocks_the_segment_ahead_once_found_blocked_twice(make_rig):
     rig = make_rig(SOUTH_AT_20)
     rig.set(
         map_T_odom=EAST_AT_12,  # at (12, 0) facing east: 0.6 m ahead is seg11(room12-room13)
         failure=Failure(FailureCode.BLOCKED, "obstacle 0.4 m ahead"),
         blocked_segments=frozenset({3}),
+        target=rig.plan("12,0,0", "room17").steps[0],
     )
     note = NoteFailure("NoteFailure", rig.ctx)
+    assert rig.tick(note) == Status.SUCCESS
+    # Once: only suspected (a poor pose estimate can make a wall look like an obstacle).
+    assert rig.get("blocked_segments") == frozenset({3})
+    assert rig.get("blocked_suspects") == frozenset({11})
     assert rig.tick(note) == Status.SUCCESS
     assert rig.get("blocked_segments") == frozenset({3, 11})
     assert rig.pm.segment(11).name == "seg11(room12-room13)"
     assert rig.get("avoid_landmarks") is None
-    assert rig.get("replans") == 1
+    assert rig.get("replans") == 2
+
+
+def test_note_failure_after_a_planning_failure_blocks_nothing_new(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    rig.set(
+        map_T_odom=EAST_AT_12,
+        failure=Failure(FailureCode.BLOCKED, "no route around the blocked seg3"),
+        blocked_segments=frozenset({3}),
+        target=None,  # MakePlan clears the target: the failure belongs to no step
+    )
+    assert rig.tick(NoteFailure("NoteFailure", rig.ctx)) == Status.SUCCESS
+    assert rig.get("blocked_segments") == frozenset({3})
+    assert rig.get("blocked_suspects") is None
