@@ -37,8 +37,9 @@ def run(ep, deferred: bool) -> tuple[list[float], float, bool, int]:
     with SimWorld(b) as world:
         inner = SimBase(world, pose=ep.start_pose, width=cfg.sim.width, height=cfg.sim.height)
         base = NoisyOdometry(inner, cfg.sim.odometry_noise, seed=ep.seed)
-        ctx = make_context(base, pm, cfg, seed=ep.seed, budget=ep.step_budget * 2,
-                           deferred_work=deferred)
+        ctx = make_context(
+            base, pm, cfg, seed=ep.seed, budget=ep.step_budget * 2, deferred_work=deferred
+        )
         out = run_tree(ctx, ep.goal, tick_durations=durations)
     return durations, time.perf_counter() - t0, out.success, out.ticks
 
@@ -52,19 +53,26 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--episodes", type=int, default=3)
     args = ap.parse_args()
-    cases = [("fig2_hospital", "room17", "22,0,0"), ("fig2_hospital", "room17", None),
-             ("loop_school", "room10", None)][: args.episodes]
-    print(f"{'episode':<34} {'mode':<9} {'ticks':>6} {'median ms':>9} {'p99 ms':>7} "
-          f"{'max ms':>7} {'wall s':>7} {'sim s/wall s':>12} ok")
+    cases = [
+        ("fig2_hospital", "room17", "22,0,0"),
+        ("fig2_hospital", "room17", None),
+        ("loop_school", "room10", None),
+    ][: args.episodes]
+    print(
+        f"{'episode':<34} {'mode':<9} {'ticks':>6} {'median ms':>9} {'p99 ms':>7} "
+        f"{'max ms':>7} {'wall s':>7} {'sim s/wall s':>12} ok"
+    )
     for building, goal, start in cases:
         ep = custom_episode(building, goal, start)
         for deferred in (True, False):
             d, wall, ok, ticks = run(ep, deferred)
             ms = [1e3 * x for x in d]
             name = f"{building}:{goal} from {start or 'start'}"
-            print(f"{name:<34} {'deferred' if deferred else 'immediate':<9} {ticks:>6} "
-                  f"{statistics.median(ms):>9.3f} {pct(ms, 0.99):>7.2f} {max(ms):>7.1f} "
-                  f"{wall:>7.1f} {ticks * 0.1 / wall:>12.1f} {ok}")
+            print(
+                f"{name:<34} {'deferred' if deferred else 'immediate':<9} {ticks:>6} "
+                f"{statistics.median(ms):>9.3f} {pct(ms, 0.99):>7.2f} {max(ms):>7.1f} "
+                f"{wall:>7.1f} {ticks * 0.1 / wall:>12.1f} {ok}"
+            )
     print("target: p99 tick < 5 ms")
 
 
