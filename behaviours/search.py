@@ -14,7 +14,6 @@ from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply
 from pmnav_bt.localization import Sighting, fix_pose
-from pmnav_bt.perception.coarse import best_detection
 from pmnav_bt.perception.geometry import target_point
 from pmnav_bt.resolve import entity_position
 
@@ -49,22 +48,23 @@ def target_entity(ctx: Context, look_for: str) -> str:
 
 
 class CoarseDirection(PmNavBehaviour):
-    """Pick the view that shows the target: best grounding score across the views.
+    """Pick the view that shows the target, with the context's coarse-direction back end
+    (``detector``: best grounding score across the views).
 
     Reads ``views``, ``target``; writes ``choice`` (view, detection). FAILURE
-    (TARGET_NOT_FOUND) when no view shows it.
+    (TARGET_NOT_FOUND) when no view shows it. ``min_score`` overrides the back end's.
     """
 
     READS = ("views", "target")
     WRITES = ("choice",)
 
-    def __init__(self, name: str, ctx: Context, min_score: float = 0.3):
+    def __init__(self, name: str, ctx: Context, min_score: float | None = None):
         super().__init__(name, ctx)
         self.min_score = min_score
 
     def update(self) -> Status:
         views = self.get("views") or []
-        best = best_detection(((v, v.detections) for v in views), self.min_score)
+        best = self.ctx.coarse.choose_view(views, target_query(self) or "", self.min_score)
         if best is None:
             t = self.get("target")
             return self.fail(

@@ -100,7 +100,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
                 target_query,
                 enough=lambda views: any(d.score >= 0.5 for d in views[-1].detections),
             ),
-            CoarseDirection("CoarseDirection", ctx, ctx.config.coarse.min_score),
+            CoarseDirection("CoarseDirection", ctx),
             # coarse-only (Table 4): no grounding and no refinement of the view direction
             *([] if cfg.variant == "coarse_only" else [Ground("Grounding", ctx)]),
             FineDirection("FineDirection", ctx),

@@ -29,12 +29,26 @@ def best_detection(
 
 @dataclass
 class DetectorCoarseDirection:
-    """The ``CoarseDirection`` seam by grounding: best score across the views."""
+    """The ``CoarseDirection`` seam by grounding: best score across the views.
+
+    Views that carry ``detections`` (grounded while they were captured, even if that
+    found nothing) are not grounded again; plain seam ``View``s are.
+    """
 
     grounder: Grounder
     min_score: float = 0.3
 
+    def choose_view(self, views: list, target: str, min_score: float | None = None):
+        """The (view, detection) that shows ``target`` best, or None."""
+        floor = self.min_score if min_score is None else min_score
+        pairs = (
+            (v, v.detections)
+            if getattr(v, "detections", None) is not None
+            else (v, self.grounder.detect(v.observation, target))
+            for v in views
+        )
+        return best_detection(pairs, floor)
+
     def choose(self, views: list[View], target: str) -> float | None:
-        pairs = ((v, self.grounder.detect(v.observation, target)) for v in views)
-        best = best_detection(pairs, self.min_score)
+        best = self.choose_view(views, target)
         return None if best is None else best[0].relative_yaw

@@ -240,3 +240,15 @@ def test_coarse_only_places_the_target_straight_ahead_at_the_map_distance(make_r
     assert math.dist(s.odom_xy, (p.x, p.y)) == pytest.approx(math.dist(ROOM4_DOOR, (p.x, p.y)))
     seen_dir = math.atan2(s.odom_xy[1] - p.y, s.odom_xy[0] - p.x)
     assert rig.yaw_error(seen_dir, p.yaw) < 1e-6
+
+
+def test_detector_coarse_direction_seam_grounds_plain_views(make_rig):
+    from pmnav_bt.seams import View
+
+    rig = make_rig(NORTH_OF_ROOM4, width=320, height=240)
+    captured = search(rig, targets(rig)["room4"])
+    plain = [View(v.relative_yaw, v.observation) for v in captured]  # no detections
+    yaw = rig.ctx.coarse.choose(plain, "104 Laboratory")
+    best = max(((v, d) for v in captured for d in v.detections), key=lambda vd: vd[1].score)
+    assert yaw == pytest.approx(best[0].relative_yaw)
+    assert rig.ctx.coarse.choose(plain, "103 Radiology") is None  # 16 m away: unreadable
