@@ -6,7 +6,6 @@ the Context holds the things a behaviour *uses* (injected once, not looked up).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -14,7 +13,7 @@ import numpy as np
 
 from pmnav_bt.config import Config
 from pmnav_bt.control import Limits, Odometer
-from pmnav_bt.geometry import se2_compose
+from pmnav_bt.geometry import se2_compose, wrap_angle
 from pmnav_bt.perception.coarse import DetectorCoarseDirection
 from pmnav_bt.priori_map import PrioriMap
 from pmnav_bt.seams import Base, Grounder, Planner, Pose2D, Refiner
@@ -82,4 +81,4 @@ def thumbnail(rgb: np.ndarray, width: int = 96) -> np.ndarray:
 
 
 def heading_error(a: float, b: float) -> float:
-    return abs(math.atan2(math.sin(a - b), math.cos(a - b)))
+    return abs(wrap_angle(a - b))

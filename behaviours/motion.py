@@ -16,7 +16,7 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
 from pmnav_bt.control import goto_command, rotate_command
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import Action, heading
+from pmnav_bt.geometry import Action, heading, wrap_angle
 from pmnav_bt.perception.corner import is_corner, is_opening, mask_ratios
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.seams import MotionStatus
@@ -131,7 +131,7 @@ def _free_ahead(obs, est, goal) -> float | None:
     """The free distance towards ``goal`` when something stands closer than the goal."""
     to_goal = math.hypot(goal[0] - est.x, goal[1] - est.y)
     bearing = heading((est.x, est.y), goal) - est.yaw
-    if abs(math.atan2(math.sin(bearing), math.cos(bearing))) > math.radians(25):
+    if abs(wrap_angle(bearing)) > math.radians(25):
         return None  # still turning towards the goal: nothing to judge yet
     free = free_distance(obs, bearing)
     return free if free < min(to_goal, OBSTACLE_RANGE) - 0.3 else None

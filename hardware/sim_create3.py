@@ -30,7 +30,7 @@ import threading
 import time
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.geometry import se2_compose, se2_inverse
+from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.seams import Pose2D
 
 PARAMETERS = {
@@ -187,7 +187,7 @@ class SimCreate3:
             if t > t0:
                 dx, dy = pose.x - q0.x, pose.y - q0.y
                 v = (math.cos(q0.yaw) * dx + math.sin(q0.yaw) * dy) / (t - t0)
-                w = math.atan2(math.sin(pose.yaw - q0.yaw), math.cos(pose.yaw - q0.yaw)) / (t - t0)
+                w = wrap_angle(pose.yaw - q0.yaw) / (t - t0)
         self._last_odom = (t, pose)
         msg = self._Odometry()
         msg.header.stamp = stamp

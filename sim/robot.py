@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.seams import (
     FORWARD_STEP_M,
     TURN_STEP_RAD,
@@ -36,10 +37,6 @@ CAMERA_HEIGHT = 1.6  # m (paper)
 HFOV = math.radians(60.0)  # horizontal field of view (paper)
 CONTACT_CLEAR = 0.01  # a collision event ends once the body is this far from everything
 _BISECT_TOL = 1e-4
-
-
-def _wrap(a: float) -> float:
-    return math.atan2(math.sin(a), math.cos(a))
 
 
 @dataclass
@@ -157,7 +154,7 @@ class SimBase:
     def set_pose(self, pose: Pose2D) -> None:
         """Teleport the body (drops any motion; does not count as driving)."""
         with self.world.lock:
-            self._pose = Pose2D(float(pose.x), float(pose.y), _wrap(float(pose.yaw)))
+            self._pose = Pose2D(float(pose.x), float(pose.y), wrap_angle(float(pose.yaw)))
             self._step = None
             self._cmd = (0.0, 0.0)
             self._status = MotionStatus.IDLE
@@ -262,7 +259,7 @@ class SimBase:
     def _rotate(self, da: float) -> None:
         if da:
             q = self._pose
-            self._pose = Pose2D(q.x, q.y, _wrap(q.yaw + da))
+            self._pose = Pose2D(q.x, q.y, wrap_angle(q.yaw + da))
             self.stats.rotation += abs(da)
 
     def _clearance(self, x: float, y: float) -> float:
