@@ -28,3 +28,21 @@ def test_builtin_buildings_are_package_data():
     cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
     assert "buildings/*.yaml" in cfg["package-data"]["pmnav_bt.data"]
     assert list((ROOT / "pmnav_bt" / "data" / "buildings").glob("*.yaml"))
+
+
+def test_the_core_imports_no_tree_simulator_or_ros_at_import_time():
+    import subprocess
+    import sys
+
+    core = sorted(
+        "pmnav_bt." + ".".join(p.relative_to(ROOT / "pmnav_bt").with_suffix("").parts)
+        for p in (ROOT / "pmnav_bt").rglob("*.py")
+        if p.name != "__init__.py"
+    )
+    code = (
+        "import importlib, sys\n"
+        f"for m in {core!r}: importlib.import_module(m)\n"
+        "print(' '.join(sorted({'py_trees', 'pybullet', 'rclpy'} & set(sys.modules))))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "", f"the core imported {out.stdout.strip()}"
