@@ -16,7 +16,7 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
 from pmnav_bt.control import goto_command, rotate_command
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import Action, heading, wrap_angle
+from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
 from pmnav_bt.perception.corner import is_corner, is_opening, mask_ratios
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.seams import MotionStatus
@@ -148,7 +148,7 @@ class Approach(DriveTo):
     def goal(self) -> tuple[float, float]:
         t = self.get("target")
         if t.action == Action.ARRIVE:
-            return approach_point(t.target, t.position, self.ctx.config.tree.goal_offset)
+            return point_towards(t.target, t.position, self.ctx.config.tree.goal_offset)
         return float(t.position[0]), float(t.position[1])
 
 
@@ -171,16 +171,6 @@ class MoveToward(DriveTo):
         if step == 0.0:
             return est.x, est.y
         return float(est.x + d[0] * step / n), float(est.y + d[1] * step / n)
-
-
-def approach_point(target, node, offset: float) -> tuple[float, float]:
-    """The point ``offset`` m from ``target`` (a door) towards its node on the centre line."""
-    m, n = np.asarray(target, float), np.asarray(node, float)
-    d = float(np.linalg.norm(n - m))
-    if d < 1e-6:
-        return float(n[0]), float(n[1])
-    p = m + (n - m) * min(offset, d) / d
-    return float(p[0]), float(p[1])
 
 
 class DriveToWaypoint(DriveTo):

@@ -65,6 +65,16 @@ def side_of(heading_travel: float, origin, point) -> str:
     return "left" if cross >= 0.0 else "right"
 
 
+def point_towards(a, b, distance: float) -> tuple[float, float]:
+    """The point ``distance`` metres from ``a`` towards ``b``, never beyond ``b``."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    d = float(np.linalg.norm(b - a))
+    if d < 1e-6:
+        return float(b[0]), float(b[1])
+    p = a + (b - a) * min(distance, d) / d
+    return float(p[0]), float(p[1])
+
+
 def project_points_to_segments(
     points: np.ndarray, seg_a: np.ndarray, seg_b: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

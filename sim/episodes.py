@@ -26,7 +26,7 @@ import numpy as np
 
 from pmnav_bt.building import Building, load_building
 from pmnav_bt.errors import PmNavError, Problem
-from pmnav_bt.geometry import Action, heading, relative_action, wrap_angle
+from pmnav_bt.geometry import Action, heading, point_towards, relative_action, wrap_angle
 from pmnav_bt.metrics import SUCCESS_RADIUS_M, EpisodeResult, spl, success
 from pmnav_bt.priori_map import PrioriMap, parse_building
 from pmnav_bt.resolve import resolve_room
@@ -377,14 +377,8 @@ def goal_door(pm: PrioriMap, room: str) -> tuple[float, float]:
 
 def goal_stop_point(pm: PrioriMap, room: str) -> tuple[float, float]:
     """``STOP_OFFSET_M`` from the room's door point towards the corridor centre line."""
-    door = np.asarray(goal_door(pm, room))
-    foot = pm.locate(*door).point(pm)
-    d = foot - door
-    n = float(np.linalg.norm(d))
-    if n < 1e-9:
-        return float(door[0]), float(door[1])
-    p = door + d * (min(STOP_OFFSET_M, n) / n)
-    return float(p[0]), float(p[1])
+    door = goal_door(pm, room)
+    return point_towards(door, pm.locate(*door).point(pm), STOP_OFFSET_M)
 
 
 @dataclass(frozen=True)

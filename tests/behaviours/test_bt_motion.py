@@ -17,11 +17,10 @@ from pmnav_bt.behaviours.motion import (
     DriveToWaypoint,
     MoveToward,
     TurnOnto,
-    approach_point,
     out_heading,
 )
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import Action
+from pmnav_bt.geometry import Action, point_towards
 from pmnav_bt.seams import Pose2D
 
 SOUTH, EAST = math.radians(-90), 0.0
@@ -42,10 +41,10 @@ def turn1(rig):
     return plan, step
 
 
-def test_approach_point_and_out_heading(make_rig):
-    assert approach_point((1.2, 22.0), (0.0, 22.0), 1.0) == pytest.approx((0.2, 22.0))
-    assert approach_point((1.2, 22.0), (0.0, 22.0), 5.0) == pytest.approx((0.0, 22.0))  # capped
-    assert approach_point((0.0, 22.0), (0.0, 22.0), 1.0) == (0.0, 22.0)
+def test_point_towards_and_out_heading(make_rig):
+    assert point_towards((1.2, 22.0), (0.0, 22.0), 1.0) == pytest.approx((0.2, 22.0))
+    assert point_towards((1.2, 22.0), (0.0, 22.0), 5.0) == pytest.approx((0.0, 22.0))  # capped
+    assert point_towards((0.0, 22.0), (0.0, 22.0), 1.0) == (0.0, 22.0)
     rig = make_rig(Pose2D(0.0, 5.0, SOUTH))
     plan, step = turn1(rig)
     assert out_heading(plan, step) == pytest.approx(EAST)  # leaves turn1 eastward
