@@ -59,6 +59,8 @@ from pmnav_bt.hardware.messages import (
     stamp_to_sec,
 )
 from pmnav_bt.seams import (
+    CREATE3_MAX_ANGULAR,
+    CREATE3_MAX_LINEAR,
     FORWARD_STEP_M,
     TURN_STEP_RAD,
     CameraIntrinsics,
@@ -68,8 +70,8 @@ from pmnav_bt.seams import (
     Pose2D,
 )
 
-MAX_LINEAR = 0.306  # m/s, Create 3 with safety_override none
-MAX_ANGULAR = 1.9  # rad/s
+MAX_LINEAR = CREATE3_MAX_LINEAR  # m/s, Create 3 with safety_override none
+MAX_ANGULAR = CREATE3_MAX_ANGULAR  # rad/s
 ZERO_BURST = 3  # zero commands sent on a stop
 STEP_TOL_M = 0.005
 STEP_TOL_RAD = math.radians(0.5)

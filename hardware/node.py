@@ -37,7 +37,7 @@ from typing import Any
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.hardware.create3 import Create3Options
-from pmnav_bt.seams import Pose2D
+from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR, Pose2D
 
 # name -> (default, description). Types follow the defaults.
 PARAMETERS: dict[str, tuple[Any, str]] = {
@@ -61,8 +61,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "odom_fault_s": (1.0, "fail the mission (SENSOR_TIMEOUT) after this long without odometry"),
     "camera_timeout": (2.0, "stop and fail when the camera is silent this long (s)"),
     "sync_slop": (0.05, "depth/segmentation match the colour frame within this (s)"),
-    "max_linear": (0.306, "m/s"),
-    "max_angular": (1.9, "rad/s"),
+    "max_linear": (CREATE3_MAX_LINEAR, "m/s"),
+    "max_angular": (CREATE3_MAX_ANGULAR, "rad/s"),
     "camera_height": (1.6, "m above the floor"),
     "hfov_deg": (60.0, "horizontal field of view until a CameraInfo arrives"),
     "stall_s": (2.0, "a motion without progress for this long is BLOCKED"),

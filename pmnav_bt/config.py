@@ -14,6 +14,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from pmnav_bt.errors import ConfigError
+from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR
 
 
 class _Section(BaseModel):
@@ -69,8 +70,8 @@ class TreeConfig(_Section):
     replans: int = Field(2, ge=0, description="re-localize-and-replan recoveries")
     goal_offset: float = Field(0.6, ge=0.0, description="stop this far from the goal door")
     step_timeout_s: float = Field(180.0, gt=0.0, description="clock seconds per plan step")
-    max_linear: float = Field(0.306, gt=0.0, description="m/s (Create 3)")
-    max_angular: float = Field(1.9, gt=0.0, description="rad/s (Create 3)")
+    max_linear: float = Field(CREATE3_MAX_LINEAR, gt=0.0, description="m/s (Create 3)")
+    max_angular: float = Field(CREATE3_MAX_ANGULAR, gt=0.0, description="rad/s (Create 3)")
 
 
 class SimConfig(_Section):

@@ -10,15 +10,21 @@ import math
 from dataclasses import dataclass
 
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.seams import FORWARD_STEP_M, TURN_STEP_RAD, Pose2D
+from pmnav_bt.seams import (
+    CREATE3_MAX_ANGULAR,
+    CREATE3_MAX_LINEAR,
+    FORWARD_STEP_M,
+    TURN_STEP_RAD,
+    Pose2D,
+)
 
 ROTATE_FIRST = math.radians(25.0)  # turn in place when the heading error is larger
 
 
 @dataclass(frozen=True)
 class Limits:
-    linear: float = 0.306
-    angular: float = 1.9
+    linear: float = CREATE3_MAX_LINEAR
+    angular: float = CREATE3_MAX_ANGULAR
 
 
 def clip(v: float, limit: float) -> float:

@@ -25,6 +25,10 @@ if TYPE_CHECKING:  # pragma: no cover
 FORWARD_STEP_M = 0.25
 TURN_STEP_RAD = math.radians(30.0)
 
+# The iRobot Create 3's speed limits (safety_override none), used by every body and the tree.
+CREATE3_MAX_LINEAR = 0.306  # m/s
+CREATE3_MAX_ANGULAR = 1.9  # rad/s
+
 
 @dataclass(frozen=True)
 class Pose2D:

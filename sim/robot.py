@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.seams import (
+    CREATE3_MAX_ANGULAR,
+    CREATE3_MAX_LINEAR,
     FORWARD_STEP_M,
     TURN_STEP_RAD,
     CameraIntrinsics,
@@ -29,8 +31,8 @@ from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.render import render_camera
 from pmnav_bt.sim.world import ROBOT, SimWorld
 
-MAX_LINEAR = 0.306  # m/s, iRobot Create 3
-MAX_ANGULAR = 1.9  # rad/s
+MAX_LINEAR = CREATE3_MAX_LINEAR  # m/s
+MAX_ANGULAR = CREATE3_MAX_ANGULAR  # rad/s
 RADIUS = 0.17  # m
 COLLISION_HEIGHT = 1.7  # the body with its camera mast, for collisions
 CAMERA_HEIGHT = 1.6  # m (paper)
