@@ -14,8 +14,8 @@ import numpy as np
 from pmnav_bt.config import Config
 from pmnav_bt.control import Limits, Odometer
 from pmnav_bt.geometry import se2_compose, wrap_angle
+from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.perception.coarse import DetectorCoarseDirection
-from pmnav_bt.priori_map import PrioriMap
 from pmnav_bt.seams import Base, Grounder, Planner, Pose2D, Refiner
 from pmnav_bt.worker import Worker
 

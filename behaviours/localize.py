@@ -13,7 +13,7 @@ from pmnav_bt.control import goto_command, rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.localization import fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance
-from pmnav_bt.resolve import entity_index, normalise
+from pmnav_bt.planning.resolve import entity_index, normalise
 from pmnav_bt.seams import MotionStatus
 
 ALL_SIGNS = "sign"

@@ -10,7 +10,7 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.errors import PlanningError, UnknownNameError
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.resolve import resolve_room
+from pmnav_bt.planning.resolve import resolve_room
 
 
 class MakePlan(PmNavBehaviour):

@@ -15,7 +15,7 @@ from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply
 from pmnav_bt.localization import Sighting, fix_pose
 from pmnav_bt.perception.geometry import target_point
-from pmnav_bt.resolve import entity_position
+from pmnav_bt.planning.resolve import entity_position
 
 # How far (m) a sighting may be from where the map puts the target and still be it.
 VERIFY_TOLERANCE = 3.0

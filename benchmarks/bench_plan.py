@@ -16,10 +16,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from pmnav_bt.building import load_building, save_building
-from pmnav_bt.generate import generate_building
-from pmnav_bt.planner import GraphPlanner
-from pmnav_bt.priori_map import parse_building
+from pmnav_bt.map.building import load_building, save_building
+from pmnav_bt.map.generate import generate_building
+from pmnav_bt.map.priori_map import parse_building
+from pmnav_bt.planning.graph_planner import GraphPlanner
 
 
 def _best_of(fn, repeat: int) -> tuple[float, object]:

@@ -18,12 +18,12 @@ import statistics
 import time
 
 from pmnav_bt.config import load_config
-from pmnav_bt.evaluation import custom_episode
+from pmnav_bt.experiments.evaluation import custom_episode
 
 
 def run(ep, deferred: bool) -> tuple[list[float], float, bool, int]:
-    from pmnav_bt.building import load_building
-    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.odometry import NoisyOdometry
     from pmnav_bt.sim.robot import SimBase
     from pmnav_bt.sim.world import SimWorld

@@ -25,15 +25,15 @@ FILE_HELP = "A building file (YAML) or the name of a built-in building (see 'pmn
 
 
 def _priori_map(file: str):
-    from pmnav_bt.building import load_building
-    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.priori_map import parse_building
 
     return parse_building(load_building(file))
 
 
 def _folder(file: str) -> Path:
     """The folder a building file's relative paths (floor plan) are resolved against."""
-    from pmnav_bt.building import resolve_building_path
+    from pmnav_bt.map.building import resolve_building_path
 
     return resolve_building_path(file).parent
 
@@ -41,7 +41,7 @@ def _folder(file: str) -> Path:
 @app.command()
 def buildings() -> None:
     """List the built-in buildings."""
-    from pmnav_bt.building import builtin_buildings, load_building
+    from pmnav_bt.map.building import builtin_buildings, load_building
 
     for name in builtin_buildings():
         b = load_building(name)
@@ -51,8 +51,8 @@ def buildings() -> None:
 @app.command()
 def validate(file: str = typer.Argument(..., help=FILE_HELP)) -> None:
     """Check a building file and list every problem (exit 1 if there are any)."""
-    from pmnav_bt.building import load_building
-    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.priori_map import parse_building
 
     try:
         b = load_building(file)
@@ -78,7 +78,7 @@ def map_(
     pm = _priori_map(file)
     typer.echo(json.dumps(pm.to_dict(), indent=2) if as_json else pm.to_text(), nl=not as_json)
     if image is not None:
-        from pmnav_bt.annotate import render_annotated_map
+        from pmnav_bt.render.annotate import render_annotated_map
 
         render_annotated_map(pm, path=image, base_dir=_folder(file))
         typer.echo(f"wrote {image}", err=True)
@@ -98,13 +98,13 @@ def plan(
     max_gap: float = typer.Option(10.0, help="Most metres between consecutive plan steps."),
 ) -> None:
     """Plan from a start to a goal room: ordered {landmark: action} steps."""
-    from pmnav_bt.planner import GraphPlanner
+    from pmnav_bt.planning.graph_planner import GraphPlanner
 
     pm = _priori_map(file)
     p = GraphPlanner(max_gap=max_gap).plan(pm, start, goal)
     typer.echo(p.to_json() if as_json else p.text())
     if image is not None:
-        from pmnav_bt.annotate import render_annotated_map
+        from pmnav_bt.render.annotate import render_annotated_map
 
         render_annotated_map(pm, path=image, path_xy=list(p.path), base_dir=_folder(file))
         typer.echo(f"wrote {image}", err=True)

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose
+from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.perception.geometry import target_point
-from pmnav_bt.priori_map import PrioriMap
-from pmnav_bt.resolve import entity_index, entity_position, normalise
+from pmnav_bt.planning.resolve import entity_index, entity_position, normalise
 from pmnav_bt.seams import Detection, Observation, Pose2D
 
 MAX_RESIDUAL = 0.8  # metres (RMS) for a set of sightings to count as consistent

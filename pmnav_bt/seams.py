@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, Protocol, runtime_checkable
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.plan import Plan
-    from pmnav_bt.priori_map import PrioriMap
+    from pmnav_bt.map.priori_map import PrioriMap
+    from pmnav_bt.planning.plan import Plan
 
 # Discrete motion, the Habitat/PixelNav convention.
 FORWARD_STEP_M = 0.25

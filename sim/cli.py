@@ -115,7 +115,7 @@ def _tiers(tier: str) -> list[str]:
 
 
 def _buildings(building: str) -> list[str]:
-    from pmnav_bt.building import builtin_buildings
+    from pmnav_bt.map.building import builtin_buildings
 
     if building != "all":
         return [b.strip() for b in building.split(",") if b.strip()]
@@ -172,7 +172,7 @@ def run(
     overrides: list[str] | None = SET_OPT,
 ) -> None:
     """Run one PM-Nav episode and print its result; write the tree log and trajectory plot."""
-    from pmnav_bt.evaluation import VARIANT_NAMES, custom_episode, run_episode
+    from pmnav_bt.experiments.evaluation import VARIANT_NAMES, custom_episode, run_episode
 
     cfg = _config(config, overrides)
     if episode_file is not None:
@@ -227,7 +227,7 @@ def eval_(
     """Run many episodes and print SR/SPL per tier for each tree variant (paper Table 1)."""
     from rich.progress import Progress
 
-    from pmnav_bt.evaluation import (
+    from pmnav_bt.experiments.evaluation import (
         comparison_markdown,
         episodes_for,
         evaluate,

@@ -4,7 +4,7 @@ An episode is a start pose on a corridor centre line (yaw along the corridor) an
 room. Its geodesic is the corridor-graph path from the start to the goal room's node on
 the centre line, then straight to the goal *stop point*, ``STOP_OFFSET_M`` from the door
 point towards the corridor centre. Success is stopping within ``SUCCESS_RADIUS_M`` of the
-door point (:mod:`pmnav_bt.metrics`).
+door point (:mod:`pmnav_bt.eval.metrics`).
 
 The tiers (paper RQ1) are defined once, in ``TIERS``, by structure (goal visible from the
 start, turns and forks on the path) and path length in paper "steps" of ``STEP_M``;
@@ -24,12 +24,12 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from pmnav_bt.building import Building, load_building
 from pmnav_bt.errors import PmNavError, Problem
+from pmnav_bt.eval.metrics import SUCCESS_RADIUS_M, EpisodeResult, spl, success
 from pmnav_bt.geometry import Action, heading, point_towards, relative_action, wrap_angle
-from pmnav_bt.metrics import SUCCESS_RADIUS_M, EpisodeResult, spl, success
-from pmnav_bt.priori_map import PrioriMap, parse_building
-from pmnav_bt.resolve import resolve_room
+from pmnav_bt.map.building import Building, load_building
+from pmnav_bt.map.priori_map import PrioriMap, parse_building
+from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.seams import FORWARD_STEP_M, Pose2D
 
 __all__ = [

@@ -17,10 +17,10 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from pmnav_bt.building import Building, builtin_buildings, load_building
+from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
 from pmnav_bt.geometry import heading, wrap_angle
-from pmnav_bt.metrics import EpisodeResult, aggregate_by_tier
-from pmnav_bt.priori_map import PrioriMap, parse_building
+from pmnav_bt.map.building import Building, builtin_buildings, load_building
+from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.seams import FORWARD_STEP_M, DiscreteAction, MotionStatus
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.episodes import (

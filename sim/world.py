@@ -26,8 +26,8 @@ import shapely
 from shapely.geometry import LineString, MultiPolygon, Polygon
 from shapely.geometry.polygon import orient
 
-from pmnav_bt.building import Building, Landmark, WaypointKind, load_building
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.map.building import Building, Landmark, WaypointKind, load_building
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.textures import make_sign, write_png

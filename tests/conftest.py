@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from pmnav_bt.building import load_building
-from pmnav_bt.priori_map import parse_building
+from pmnav_bt.map.building import load_building
+from pmnav_bt.map.priori_map import parse_building
 
 
 @pytest.fixture(scope="session")

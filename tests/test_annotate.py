@@ -8,7 +8,11 @@ import cv2
 import numpy as np
 import pytest
 
-from pmnav_bt.annotate import (
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.map.building import building_from_data, load_building
+from pmnav_bt.map.floorplan import FloorPlanImage, rasterize_building
+from pmnav_bt.map.priori_map import parse_building
+from pmnav_bt.render.annotate import (
     MAP_PAD,
     PATH_COLOUR,
     layout_labels,
@@ -16,10 +20,6 @@ from pmnav_bt.annotate import (
     nice_length,
     render_annotated_map,
 )
-from pmnav_bt.building import building_from_data, load_building
-from pmnav_bt.errors import PmNavError
-from pmnav_bt.floorplan import FloorPlanImage, rasterize_building
-from pmnav_bt.priori_map import parse_building
 
 
 @pytest.fixture(scope="module", params=["fig2_hospital", "loop_school"])

@@ -8,7 +8,8 @@ import math
 import pytest
 import yaml
 
-from pmnav_bt.building import (
+from pmnav_bt.errors import BuildingFileError
+from pmnav_bt.map.building import (
     Building,
     building_from_data,
     builtin_buildings,
@@ -16,7 +17,6 @@ from pmnav_bt.building import (
     load_building,
     save_building,
 )
-from pmnav_bt.errors import BuildingFileError
 
 GOOD = {
     "schema_version": 1,

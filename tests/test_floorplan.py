@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 import yaml
 
-from pmnav_bt.building import building_from_data, load_building
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.floorplan import (
+from pmnav_bt.map.building import building_from_data, load_building
+from pmnav_bt.map.floorplan import (
     FREE,
     OCCUPIED,
     UNKNOWN,

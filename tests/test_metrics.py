@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from pmnav_bt.metrics import (
+from pmnav_bt.eval.metrics import (
     SUCCESS_RADIUS_M,
     EpisodeResult,
     aggregate_by_tier,

@@ -10,9 +10,9 @@ import pytest
 
 from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.geometry import Action
-from pmnav_bt.planner import GraphPlanner
-from pmnav_bt.priori_map import parse_building
-from pmnav_bt.resolve import resolve_start
+from pmnav_bt.map.priori_map import parse_building
+from pmnav_bt.planning.graph_planner import GraphPlanner
+from pmnav_bt.planning.resolve import resolve_start
 
 planner = GraphPlanner()
 
@@ -82,7 +82,7 @@ def test_landmark_goal_is_a_clear_error(fig2_map):
 def test_ambiguous_goal_lists_both(fig2):
     data = fig2.to_dict()
     data["rooms"][0]["name"] = "Pharmacy"  # room1 and room2 both called Pharmacy now
-    from pmnav_bt.building import building_from_data
+    from pmnav_bt.map.building import building_from_data
 
     pm = parse_building(building_from_data(data))
     with pytest.raises(UnknownNameError, match="ambiguous") as info:
@@ -99,7 +99,7 @@ def test_pose_start_with_heading_gives_initial_turn(fig2_map):
 
 
 def test_on_a_tie_the_plan_goes_the_way_the_robot_faces():
-    from pmnav_bt.building import building_from_data
+    from pmnav_bt.map.building import building_from_data
 
     data = {
         "schema_version": 1,

@@ -7,9 +7,9 @@ import math
 
 import pytest
 
-from pmnav_bt.building import building_from_data
 from pmnav_bt.errors import UnknownNameError
-from pmnav_bt.priori_map import MERGE_TOLERANCE, parse_building
+from pmnav_bt.map.building import building_from_data
+from pmnav_bt.map.priori_map import MERGE_TOLERANCE, parse_building
 
 
 def test_fig2_has_the_papers_segment(fig2_map):

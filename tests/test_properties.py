@@ -11,10 +11,10 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pmnav_bt.building import Building, building_from_data
-from pmnav_bt.generate import generate_building
-from pmnav_bt.planner import GraphPlanner
-from pmnav_bt.priori_map import parse_building
+from pmnav_bt.map.building import Building, building_from_data
+from pmnav_bt.map.generate import generate_building
+from pmnav_bt.map.priori_map import parse_building
+from pmnav_bt.planning.graph_planner import GraphPlanner
 
 EPS = 1e-6
 

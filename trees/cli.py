@@ -42,9 +42,9 @@ def _build_tree(variant: str):
     Returns (tree, close) where close() releases the worker and the physics client."""
     import py_trees
 
-    from pmnav_bt.building import load_building
     from pmnav_bt.config import load_config
-    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.robot import SimBase
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.pmnav import build_pmnav_tree

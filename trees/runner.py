@@ -20,10 +20,10 @@ from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.config import Config
 from pmnav_bt.failures import Failure, FailureCode
+from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.perception.ground_truth import GroundTruthGrounder
 from pmnav_bt.perception.refine import CoarseOnly, GeometricRefiner
-from pmnav_bt.planner import GraphPlanner
-from pmnav_bt.priori_map import PrioriMap
+from pmnav_bt.planning.graph_planner import GraphPlanner
 from pmnav_bt.seams import FORWARD_STEP_M, Base
 from pmnav_bt.trees.pmnav import build_pmnav_tree
 from pmnav_bt.trees.snapshots import SnapshotLogger

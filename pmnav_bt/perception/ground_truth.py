@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from pmnav_bt.building import Building
-from pmnav_bt.resolve import entity_index, normalise
+from pmnav_bt.map.building import Building
+from pmnav_bt.planning.resolve import entity_index, normalise
 from pmnav_bt.seams import Detection, Observation
 
 CLASS_QUERIES = ("wall", "floor")

@@ -21,7 +21,7 @@ from pmnav_bt.behaviours.common import KEYS, NAMESPACE
 from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.config import load_config
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.priori_map import PrioriMap, parse_building
+from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.seams import MotionStatus, Pose2D
 from pmnav_bt.sim.odometry import NoisyOdometry
 from pmnav_bt.sim.robot import SimBase

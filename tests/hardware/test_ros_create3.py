@@ -18,9 +18,9 @@ from pathlib import Path
 
 import pytest
 
-from pmnav_bt.building import load_building
+from pmnav_bt.eval.metrics import SUCCESS_RADIUS_M, success
 from pmnav_bt.hardware.testing import Proc
-from pmnav_bt.metrics import SUCCESS_RADIUS_M, success
+from pmnav_bt.map.building import load_building
 from pmnav_bt.sim.episodes import generate_episodes
 
 BUILDING = "fig2_hospital"

@@ -9,9 +9,9 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from pmnav_bt.building import WaypointKind, builtin_buildings, load_building
 from pmnav_bt.geometry import project_points_to_segments
-from pmnav_bt.priori_map import parse_building
+from pmnav_bt.map.building import WaypointKind, builtin_buildings, load_building
+from pmnav_bt.map.priori_map import parse_building
 
 # name -> (turn waypoints, branch waypoints, corridor loop?) as each file claims.
 STRUCTURE = {

@@ -7,10 +7,10 @@ import math
 
 import pytest
 
-from pmnav_bt.building import builtin_buildings, load_building
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.priori_map import parse_building
+from pmnav_bt.map.building import builtin_buildings, load_building
+from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.sim.episodes import (
     START_CLEARANCE_M,
     STOP_OFFSET_M,

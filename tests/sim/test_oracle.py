@@ -8,9 +8,9 @@ import math
 
 import pytest
 
-from pmnav_bt.building import builtin_buildings, load_building
-from pmnav_bt.metrics import aggregate_by_tier
-from pmnav_bt.priori_map import parse_building
+from pmnav_bt.eval.metrics import aggregate_by_tier
+from pmnav_bt.map.building import builtin_buildings, load_building
+from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.episodes import (
     TIERS,

@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 
 from pmnav_bt.config import load_config
-from pmnav_bt.evaluation import custom_episode, run_episode
+from pmnav_bt.experiments.evaluation import custom_episode, run_episode
 from pmnav_bt.sim.episodes import generate_episodes
 from pmnav_bt.trees.snapshots import Replay
 
@@ -67,9 +67,9 @@ def test_hidden_goal_sign_re_search_then_replan_then_target_not_found(tmp_path):
 
 def test_hidden_intermediate_landmark_is_avoided_after_a_replan():
     ep = shortest("hard")
-    from pmnav_bt.building import load_building
-    from pmnav_bt.planner import GraphPlanner
-    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.priori_map import parse_building
+    from pmnav_bt.planning.graph_planner import GraphPlanner
 
     pm = parse_building(load_building("fig2_hospital"))
     start = f"{ep.start_x},{ep.start_y},{ep.start_yaw * 57.29578}"

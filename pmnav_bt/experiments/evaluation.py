@@ -1,7 +1,7 @@
 """Run PM-Nav episodes in the simulator and score them (SR, SPL as in the paper's Table 1).
 
 This module joins the simulator and the tree, so it imports both lazily, inside the
-functions: importing ``pmnav_bt.evaluation`` loads neither pybullet nor py_trees.
+functions: importing ``pmnav_bt.experiments.evaluation`` loads neither pybullet nor py_trees.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 from pmnav_bt.config import Config
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.metrics import EpisodeResult, aggregate_by_tier
+from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.sim.episodes import Episode
@@ -36,9 +36,9 @@ class EpisodeRun:
 def custom_episode(building: str, goal: str, start: str | None = None, seed: int = 0) -> Episode:
     """An episode for ``pmnav sim run``: a goal by name, from a start pose or the building's
     start waypoint (facing along its corridor)."""
-    from pmnav_bt.building import load_building
-    from pmnav_bt.priori_map import parse_building
-    from pmnav_bt.resolve import resolve_room, resolve_start
+    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.priori_map import parse_building
+    from pmnav_bt.planning.resolve import resolve_room, resolve_start
     from pmnav_bt.seams import Pose2D
     from pmnav_bt.sim.episodes import Episode, classify, path_facts, step_budget
 
@@ -89,8 +89,8 @@ def run_episode(
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     """
-    from pmnav_bt.building import load_building
-    from pmnav_bt.priori_map import parse_building
+    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.episodes import score_episode
     from pmnav_bt.sim.odometry import NoisyOdometry
     from pmnav_bt.sim.robot import SimBase
@@ -158,7 +158,7 @@ def _plot(pm, trace, truth, path: Path, result: EpisodeResult, config: Config, o
     """The Fig. 4-style plot: planned path, driven path, key nodes with thumbnails."""
     import numpy as np
 
-    from pmnav_bt.trajectory import KeyNode, render_trajectory
+    from pmnav_bt.render.trajectory import KeyNode, render_trajectory
 
     times = np.array([t for t, _, _ in truth]) if truth else np.zeros(1)
 

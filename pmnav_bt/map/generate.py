@@ -14,7 +14,7 @@ import random
 
 import networkx as nx
 
-from pmnav_bt.building import SCHEMA_VERSION, Building, building_from_data
+from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
 
 ROOM_PITCH = 3.0  # metres between door centres along a corridor (alternating walls)
 JUNCTION_CLEARANCE = 2.5  # no door closer than this to a junction

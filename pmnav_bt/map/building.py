@@ -397,7 +397,7 @@ def dump_building(b: Building) -> str:
 
 # -- built-in buildings ---------------------------------------------------------------
 
-BUILTIN_DIR = Path(__file__).parent / "data" / "buildings"
+BUILTIN_DIR = Path(__file__).parent.parent / "data" / "buildings"
 
 
 def builtin_buildings() -> list[str]:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pmnav_bt.errors import UnknownNameError
-from pmnav_bt.priori_map import PrioriMap, Segment
+from pmnav_bt.map.priori_map import PrioriMap, Segment
 
 
 def normalise(name: str) -> str:

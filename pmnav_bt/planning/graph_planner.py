@@ -18,9 +18,9 @@ import numpy as np
 
 from pmnav_bt.errors import PlanningError
 from pmnav_bt.geometry import Action, heading, relative_action, wrap_angle
-from pmnav_bt.plan import ForkChoice, Plan, PlanStart, PlanStep
-from pmnav_bt.priori_map import PrioriMap
-from pmnav_bt.resolve import StartPoint, resolve_room, resolve_start
+from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.planning.plan import ForkChoice, Plan, PlanStart, PlanStep
+from pmnav_bt.planning.resolve import StartPoint, resolve_room, resolve_start
 
 
 @dataclass(frozen=True)

@@ -20,9 +20,9 @@ from itertools import pairwise
 import networkx as nx
 import numpy as np
 
-from pmnav_bt.building import Building
 from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.geometry import compass, heading, project_points_to_segments, side_of
+from pmnav_bt.map.building import Building
 
 # Room waypoints closer than this (metres, along one corridor) share one map node,
 # as doors facing each other across a corridor do.

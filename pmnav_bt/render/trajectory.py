@@ -14,9 +14,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pmnav_bt.annotate import make_canvas, put_text, render_annotated_map
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.priori_map import PrioriMap
+from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.render.annotate import make_canvas, put_text, render_annotated_map
 
 ACTUAL_COLOUR = (40, 40, 220)  # BGR red
 EVENT_COLOUR = {

@@ -24,7 +24,7 @@ import cv2
 import numpy as np
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.floorplan import (
+from pmnav_bt.map.floorplan import (
     DOOR_WIDTH_M,
     DoorFrame,
     FloorPlanImage,
@@ -33,7 +33,7 @@ from pmnav_bt.floorplan import (
     door_frames,
     load_floor_plan,
 )
-from pmnav_bt.priori_map import PrioriMap, natural_key
+from pmnav_bt.map.priori_map import PrioriMap, natural_key
 
 log = logging.getLogger(__name__)
 

@@ -23,9 +23,9 @@ import cv2
 import numpy as np
 import yaml
 
-from pmnav_bt.building import Building
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import project_points_to_segments
+from pmnav_bt.map.building import Building
 
 # map_saver's grey levels and thresholds (trinary mode).
 FREE, UNKNOWN, OCCUPIED = 254, 205, 0

@@ -1,0 +1,1 @@
+"""Evaluation: metrics (SR, SPL, soft SPL, SDF), tiers, episodes as data. No pybullet."""

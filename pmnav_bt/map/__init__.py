@@ -1,0 +1,1 @@
+"""The building model: building files, floor plans, the priori-map, generated buildings."""

@@ -1,0 +1,1 @@
+"""Pictures: the annotated priori-map and trajectory plots."""
