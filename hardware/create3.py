@@ -45,7 +45,7 @@ import weakref
 from collections import deque
 from dataclasses import dataclass
 
-from pmnav_bt.errors import PmNavError
+from pmnav_bt.errors import PmNavError, SensorError
 from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.hardware import qos
@@ -78,7 +78,7 @@ STEP_TOL_RAD = math.radians(0.5)
 HISTORY = 200  # odometry messages kept (10 s at 20 Hz)
 
 
-class SensorTimeoutError(PmNavError):
+class SensorTimeoutError(SensorError):
     """No fresh camera frame (or depth/segmentation to go with it) within the timeout."""
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from pmnav_bt.errors import ConfigError
 from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR
@@ -21,8 +21,24 @@ class _Section(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
+def _registered(seam: str):
+    """A validator: ``backend`` must name a back end registered for ``seam``."""
+
+    def check(cls, name: str) -> str:
+        from pmnav_bt.registry import REGISTRIES
+
+        try:
+            REGISTRIES[seam].spec(name)
+        except ConfigError as err:
+            raise ValueError(str(err).split(": ", 1)[1]) from None
+        return name
+
+    return field_validator("backend")(check)
+
+
 class GrounderConfig(_Section):
-    backend: Literal["sim_gt"] = Field("sim_gt", description="text query -> box + mask")
+    backend: str = Field("sim_gt", description="grounder back end (pmnav backends lists them)")
+    _check_backend = _registered("grounder")
     miss_rate: float = Field(0.0, ge=0.0, le=1.0, description="chance a readable sign is missed")
     false_positive_rate: float = Field(
         0.0, ge=0.0, le=1.0, description="chance another visible sign is read as the target"
@@ -36,16 +52,19 @@ class GrounderConfig(_Section):
 
 
 class CoarseConfig(_Section):
-    backend: Literal["detector"] = Field("detector", description="panorama views -> view")
+    backend: str = Field("detector", description="panorama views -> the view of the target")
+    _check_backend = _registered("coarse")
     min_score: float = Field(0.3, ge=0.0, le=1.0, description="weaker detections are ignored")
 
 
 class RefinerConfig(_Section):
-    backend: Literal["geometric"] = Field("geometric", description="goal pixel -> bearing")
+    backend: str = Field("geometric", description="goal pixel -> bearing (and range)")
+    _check_backend = _registered("refiner")
 
 
 class PlannerConfig(_Section):
-    backend: Literal["graph"] = Field("graph", description="priori-map + start + goal -> plan")
+    backend: str = Field("graph", description="priori-map + start + goal -> plan")
+    _check_backend = _registered("planner")
     max_gap: float = Field(8.0, gt=0.0, description="most metres between plan steps")
 
 
@@ -125,4 +144,5 @@ def load_config(path: str | Path | None = None, overrides: list[str] | tuple = (
         e = err.errors()[0]
         where = ".".join(str(p) for p in e["loc"])
         more = f" (and {len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
-        raise ConfigError(f"{source}: {where}: {e['msg']}{more}") from None
+        msg = e["msg"].removeprefix("Value error, ")
+        raise ConfigError(f"{source}: {where}: {msg}{more}") from None

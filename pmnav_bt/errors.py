@@ -55,3 +55,16 @@ class PlanningError(PmNavError):
 
 class ConfigError(PmNavError):
     """A configuration file or value is invalid."""
+
+
+class SensorError(PmNavError):
+    """A sensor gave no data in time (no camera frame, no odometry)."""
+
+
+class VlmError(PmNavError):
+    """A VLM server could not be reached, failed, timed out or answered unusably."""
+
+
+class BackendError(PmNavError):
+    """A perception or planning back end cannot be built or run (missing weights, a
+    simulator-only back end on a robot)."""

@@ -16,13 +16,21 @@ class FailureCode(str, Enum):
     TIMEOUT = "TIMEOUT"  # a step took longer than its clock budget
     SENSOR_TIMEOUT = "SENSOR_TIMEOUT"  # no camera frames or odometry
     BASE_FAULT = "BASE_FAULT"  # the body reports it cannot move
-    CANCELLED = "CANCELLED"
+    STOPPED_AWAY = "STOPPED_AWAY"  # the tree arrived, but the robot stopped too far from the door
+    CANCELLED = "CANCELLED"  # the user cancelled the goal
+    VLM_ERROR = "VLM_ERROR"  # the VLM server failed, timed out or gave no usable answer
+    INTERNAL_ERROR = "INTERNAL_ERROR"  # a bug: an unexpected exception, with its message
 
 
 @dataclass(frozen=True)
 class Failure:
+    """Why something failed. ``cause``: the first, root-cause failure when a recovery that
+    followed it failed too (the run reports both)."""
+
     code: FailureCode
     message: str
+    cause: Failure | None = None
 
     def __str__(self) -> str:
-        return f"{self.code.value}: {self.message}"
+        text = f"{self.code.value}: {self.message}"
+        return f"{text} (after {self.cause})" if self.cause is not None else text

@@ -11,9 +11,10 @@ counter-clockwise from +x in the map frame.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
-from typing import TYPE_CHECKING, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, Union, runtime_checkable
 
 import numpy as np
 
@@ -66,6 +67,30 @@ class CameraIntrinsics:
     def pixel_bearing(self, u: float) -> float:
         """Bearing (rad, left positive) of image column u from the optical axis."""
         return math.atan2(self.cx - u, self.fx)
+
+
+# Segmentation labels of a simulated Observation (the only place they are spelled).
+FLOOR_LABEL = "floor"
+WALL_LABEL = "wall"
+OBSTACLE_LABEL = "obstacle"
+
+
+def door_label(room_id: str) -> str:
+    return f"door:{room_id}"
+
+
+def sign_label(room_id: str) -> str:
+    return f"sign:{room_id}"
+
+
+def landmark_label(landmark_id: str) -> str:
+    return f"landmark:{landmark_id}"
+
+
+def parse_label(label: str) -> tuple[str, str]:
+    """``"door:room17"`` -> ``("door", "room17")``; ``"floor"`` -> ``("floor", "")``."""
+    kind, _, ident = label.partition(":")
+    return kind, ident
 
 
 @dataclass
@@ -146,14 +171,48 @@ class Base(Protocol):
         ...
 
 
+class EntityKind(str, Enum):
+    """What a plan step, a sign or a detection refers to."""
+
+    ROOM = "room"  # seen as its door, marked by its door sign
+    LANDMARK = "landmark"  # elevator, stairs, reception, ...: seen as itself or its sign
+
+
+@dataclass(frozen=True)
+class Entity:
+    """A typed reference to a room or landmark of the building (never a prefixed string)."""
+
+    kind: EntityKind
+    id: str
+
+    @classmethod
+    def room(cls, ident: str) -> Entity:
+        return cls(EntityKind.ROOM, ident)
+
+    @classmethod
+    def landmark(cls, ident: str) -> Entity:
+        return cls(EntityKind.LANDMARK, ident)
+
+    def __str__(self) -> str:  # for logs and people: "room 17", "landmark elevator1"
+        return f"{self.kind.value} {self.id}"
+
+
 @dataclass
 class Detection:
-    """A grounded object: label, pixel box (x0, y0, x1, y1), optional mask, score in [0, 1]."""
+    """A grounded object: pixel box (x0, y0, x1, y1), score in [0, 1], optional mask.
+
+    ``entity``: what the grounder recognised it as (None for class masks and unmatched
+    text); ``label``: the text a person would read there (the sign), for logs.
+    ``point``: the object's 3D position in the camera body frame (x forward, y left,
+    z up, metres) when the grounder had depth, else None.
+    """
 
     label: str
     box: tuple[float, float, float, float]
     score: float
     mask: np.ndarray | None = None  # (H, W) bool
+    entity: Entity | None = None
+    point: tuple[float, float, float] | None = None
 
     @property
     def centre(self) -> tuple[float, float]:
@@ -164,33 +223,106 @@ class Detection:
         return (x0 + x1) / 2.0, (y0 + y1) / 2.0
 
 
-class Grounder(Protocol):
-    """Text query -> detections in one image."""
+@dataclass(frozen=True)
+class SurfaceMasks:
+    """Where the floor and the walls are in one frame: (H, W) bool masks."""
 
-    def detect(self, obs: Observation, query: str) -> list[Detection]: ...
+    floor: np.ndarray
+    wall: np.ndarray
+
+
+@runtime_checkable
+class Grounder(Protocol):
+    """Finds things in one frame: a room's door or a landmark, every readable sign, and
+    the floor/wall surfaces (corner, opening and obstacle checks).
+
+    ``needs_sim_labels``: True for back ends that read the simulator's segmentation;
+    the factory refuses them on a robot.
+    """
+
+    needs_sim_labels: bool
+
+    def detect(self, obs: Observation, target: Entity) -> list[Detection]:
+        """Detections of ``target`` (a room is grounded as its door), best first."""
+        ...
+
+    def read_signs(self, obs: Observation) -> list[Detection]:
+        """Every sign readable in the frame, each with the ``entity`` it names."""
+        ...
+
+    def surfaces(self, obs: Observation) -> SurfaceMasks:
+        """Floor and wall masks of the frame."""
+        ...
 
 
 @dataclass(frozen=True)
 class View:
-    """One view of a panorama: its yaw relative to the body heading when taken, and the frame."""
+    """One view of a panorama: its yaw relative to the heading when the sweep began, the
+    frame, and the target's detections when it was grounded during the capture (None: not
+    grounded yet; an empty tuple: grounded, nothing found)."""
 
     relative_yaw: float
     observation: Observation
+    detections: tuple[Detection, ...] | None = None
 
 
+@dataclass(frozen=True)
+class CoarseChoice:
+    """The view that shows the target, and the detection that says so."""
+
+    view: View
+    detection: Detection
+
+
+@runtime_checkable
 class CoarseDirection(Protocol):
-    """Panorama views -> the relative yaw of the view that shows the target, or None."""
+    """Panorama views -> the view that shows the target (and its detection), or None."""
 
-    def choose(self, views: list[View], target: str) -> float | None: ...
+    def choose(self, views: Sequence[View], target: Entity) -> CoarseChoice | None: ...
 
 
+@dataclass(frozen=True)
+class Refinement:
+    """A refined direction to a grounded goal: bearing (rad, left positive, relative to the
+    observation's heading) and range (m) when the back end measures it."""
+
+    bearing: float
+    range: float | None = None
+
+
+@runtime_checkable
 class Refiner(Protocol):
-    """Observation + goal pixel/mask -> precise relative heading (rad) to the goal."""
+    """Observation + grounded goal (pixel/mask) -> a precise bearing, and range if known.
 
-    def refine(self, obs: Observation, goal: Detection) -> float: ...
+    ``gives_range``: whether ``refine`` measures the range (else callers take it from the map).
+    """
+
+    gives_range: bool
+
+    def refine(self, obs: Observation, goal: Detection) -> Refinement: ...
 
 
+@dataclass(frozen=True)
+class PlanConstraints:
+    """What a replan must avoid: landmarks that failed, corridor segments found blocked."""
+
+    avoid_landmarks: frozenset[str] = frozenset()
+    blocked_segments: frozenset[int] = frozenset()
+
+
+# A plan start: an estimated map pose (inside the loop), or a map node / segment / room
+# name as a person types it (the CLI).
+PlanStart = Union[Pose2D, str]  # noqa: UP007 - a runtime alias on Python 3.10
+
+
+@runtime_checkable
 class Planner(Protocol):
-    """Priori-map + start + goal -> Plan."""
+    """Priori-map + start + goal room (+ constraints) -> Plan."""
 
-    def plan(self, pm: PrioriMap, start: str, goal: str) -> Plan: ...
+    def plan(
+        self,
+        pm: PrioriMap,
+        start: PlanStart,
+        goal: str,
+        constraints: PlanConstraints = PlanConstraints(),
+    ) -> Plan: ...

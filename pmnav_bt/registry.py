@@ -1,0 +1,166 @@
+"""Back ends by name: one registry per seam, one factory for the simulator and the robot.
+
+Each seam (grounder, coarse direction, refiner, planner) has a registry of named back
+ends. An entry points at its factory as ``"module:function"`` and is imported only when
+chosen, so heavy back ends (OCR models, torch networks, an HTTP client) cost nothing
+unless configured. A factory takes the ``BackendDeps`` and returns the back end.
+
+    >>> GROUNDERS.names()
+    ['sim_gt', ...]
+
+New back ends: ``GROUNDERS.register(BackendSpec("mine", "my_pkg.grounder:build", ...))``
+and ``--set grounder.backend=mine``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from pmnav_bt.errors import BackendError, ConfigError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from pmnav_bt.config import Config
+    from pmnav_bt.map.priori_map import PrioriMap
+    from pmnav_bt.seams import CoarseDirection, Grounder, Planner, Refiner
+
+
+@dataclass(frozen=True)
+class BackendSpec:
+    """A named back end: where its factory is, whether it needs simulator labels, a summary."""
+
+    name: str
+    factory: str  # "package.module:function", imported when the back end is built
+    summary: str
+    needs_sim_labels: bool = False
+
+
+@dataclass
+class BackendDeps:
+    """What a factory may use to build its back end."""
+
+    config: Config
+    pm: PrioriMap
+    seed: int = 0
+    on_robot: bool = False
+    grounder: Grounder | None = None  # built first; for back ends that ground (coarse)
+
+
+class Registry:
+    """The named back ends of one seam."""
+
+    def __init__(self, seam: str, specs: list[BackendSpec]):
+        self.seam = seam
+        self._specs: dict[str, BackendSpec] = {}
+        for spec in specs:
+            self.register(spec)
+
+    def register(self, spec: BackendSpec) -> None:
+        if spec.name in self._specs and self._specs[spec.name] != spec:
+            raise ValueError(f"{self.seam} back end {spec.name!r} is registered already")
+        self._specs[spec.name] = spec
+
+    def names(self) -> list[str]:
+        return list(self._specs)
+
+    def spec(self, name: str) -> BackendSpec:
+        """The entry for ``name``; an unknown name lists the registered ones."""
+        try:
+            return self._specs[name]
+        except KeyError:
+            close = difflib.get_close_matches(name, self._specs, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ConfigError(
+                f"{self.seam}.backend: unknown back end {name!r}{hint}; "
+                f"registered: {', '.join(self._specs)}"
+            ) from None
+
+    def build(self, name: str, deps: BackendDeps) -> Any:
+        """Build the back end ``name`` (refusing simulator-only back ends on a robot)."""
+        spec = self.spec(name)
+        if spec.needs_sim_labels and deps.on_robot:
+            others = [s.name for s in self._specs.values() if not s.needs_sim_labels]
+            raise BackendError(
+                f"{self.seam}.backend {name!r} reads the simulator's segmentation labels and "
+                f"cannot run on a robot; choose one of: {', '.join(others) or '(none)'}"
+            )
+        return _load(spec.factory)(deps)
+
+
+def _load(target: str) -> Callable[[BackendDeps], Any]:
+    module, _, attr = target.partition(":")
+    return getattr(importlib.import_module(module), attr)
+
+
+GROUNDERS = Registry(
+    "grounder",
+    [
+        BackendSpec(
+            "sim_gt",
+            "pmnav_bt.perception.grounders.ground_truth:build",
+            "the simulator's segmentation (oracle; misses/noise configurable)",
+            needs_sim_labels=True,
+        ),
+    ],
+)
+COARSE = Registry(
+    "coarse",
+    [
+        BackendSpec(
+            "detector",
+            "pmnav_bt.perception.coarse:build_detector",
+            "ground the target in every view, take the best score",
+        ),
+    ],
+)
+REFINERS = Registry(
+    "refiner",
+    [
+        BackendSpec(
+            "geometric",
+            "pmnav_bt.perception.refiners.geometric:build",
+            "goal pixel -> bearing from the intrinsics, range from depth",
+        ),
+        BackendSpec(
+            "coarse_only",
+            "pmnav_bt.perception.refiners.geometric:build_coarse_only",
+            "no refinement: straight ahead of the view (paper Table 4 ablation)",
+        ),
+    ],
+)
+PLANNERS = Registry(
+    "planner",
+    [
+        BackendSpec(
+            "graph",
+            "pmnav_bt.planning.graph_planner:build",
+            "shortest path on the priori-map graph",
+        ),
+    ],
+)
+REGISTRIES = {r.seam: r for r in (GROUNDERS, COARSE, REFINERS, PLANNERS)}
+
+
+@dataclass
+class Backends:
+    """The back ends of one run, built from the config."""
+
+    grounder: Grounder
+    coarse: CoarseDirection
+    refiner: Refiner
+    planner: Planner
+
+
+def build_backends(config: Config, pm: PrioriMap, *, on_robot: bool, seed: int = 0) -> Backends:
+    """Every seam's back end, as ``config`` names them (the simulator and the robot alike)."""
+    deps = BackendDeps(config=config, pm=pm, seed=seed, on_robot=on_robot)
+    deps.grounder = GROUNDERS.build(config.grounder.backend, deps)
+    return Backends(
+        grounder=deps.grounder,
+        coarse=COARSE.build(config.coarse.backend, deps),
+        refiner=REFINERS.build(config.refiner.backend, deps),
+        planner=PLANNERS.build(config.planner.backend, deps),
+    )
