@@ -7,18 +7,20 @@ through call chains.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from pmnav_bt.errors import ConfigError
+from pmnav_bt.errors import ConfigError, PmNavError
+from pmnav_bt.loading import InputFileError, load_yaml, parse_yaml_value
 from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR
 
 
 class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    # strict: "1" or true is not a number; ranges keep a run finite in time and memory.
+    model_config = ConfigDict(extra="forbid", strict=True)
 
 
 def _registered(seam: str):
@@ -43,9 +45,15 @@ class GrounderConfig(_Section):
     false_positive_rate: float = Field(
         0.0, ge=0.0, le=1.0, description="chance another visible sign is read as the target"
     )
-    mask_noise_px: int = Field(0, ge=0, description="random erosion/dilation and shift of masks")
-    min_sign_pixels: int = Field(40, ge=1, description="a sign smaller than this is unreadable")
-    max_range: float = Field(9.0, gt=0.0, description="a sign farther than this (m) is unreadable")
+    mask_noise_px: int = Field(
+        0, ge=0, le=100, description="random erosion/dilation and shift of masks"
+    )
+    min_sign_pixels: int = Field(
+        40, ge=1, le=1_000_000, description="a sign smaller than this is unreadable"
+    )
+    max_range: float = Field(
+        9.0, gt=0.0, le=1000.0, description="a sign farther than this (m) is unreadable"
+    )
     hidden: list[str] = Field(
         default_factory=list, description="room/landmark IDs whose signs are never read"
     )
@@ -65,39 +73,54 @@ class RefinerConfig(_Section):
 class PlannerConfig(_Section):
     backend: str = Field("graph", description="priori-map + start + goal -> plan")
     _check_backend = _registered("planner")
-    max_gap: float = Field(8.0, gt=0.0, description="most metres between plan steps")
+    max_gap: float = Field(8.0, gt=0.0, le=1000.0, description="most metres between plan steps")
 
 
 class TreeConfig(_Section):
     variant: Literal["pmnav", "coarse_only"] = Field(
         "pmnav", description="coarse_only: no grounding or refinement (paper Table 4)"
     )
-    tick_hz: float = Field(10.0, gt=0.0, description="tree ticks per second of the clock")
-    budget_actions: int = Field(500, ge=1, description="action budget (Habitat ObjectNav)")
+    tick_hz: float = Field(
+        10.0, ge=0.5, le=1000.0, description="tree ticks per second of the clock"
+    )
+    budget_actions: int = Field(
+        500, ge=1, le=100_000, description="action budget (Habitat ObjectNav)"
+    )
     budget_path_factor: float = Field(
-        3.0, gt=0.0, description="budget = max(budget_actions, factor * shortest path in actions)"
+        3.0,
+        gt=0.0,
+        le=100.0,
+        description="budget = max(budget_actions, factor * shortest path in actions)",
     )
-    localization_attempts: int = Field(4, ge=1, description="localization tries")
-    explore_distance: float = Field(2.0, gt=0.0, description="m explored between tries")
+    localization_attempts: int = Field(4, ge=1, le=100, description="localization tries")
+    explore_distance: float = Field(2.0, gt=0.0, le=100.0, description="m explored between tries")
     search_range: float = Field(
-        4.5, gt=0.0, description="drive until a target is this close (by the map) before searching"
+        4.5,
+        gt=0.0,
+        le=100.0,
+        description="drive until a target is this close (by the map) before searching",
     )
-    search_attempts: int = Field(3, ge=1, description="searches for one landmark")
+    search_attempts: int = Field(3, ge=1, le=100, description="searches for one landmark")
     research_distance: float = Field(
-        2.0, gt=0.0, description="move this far towards a target not found before searching again"
+        2.0,
+        gt=0.0,
+        le=100.0,
+        description="move this far towards a target not found before searching again",
     )
-    replans: int = Field(2, ge=0, description="re-localize-and-replan recoveries")
-    goal_offset: float = Field(0.6, ge=0.0, description="stop this far from the goal door")
-    step_timeout_s: float = Field(180.0, gt=0.0, description="clock seconds per plan step")
-    max_linear: float = Field(CREATE3_MAX_LINEAR, gt=0.0, description="m/s (Create 3)")
-    max_angular: float = Field(CREATE3_MAX_ANGULAR, gt=0.0, description="rad/s (Create 3)")
+    replans: int = Field(2, ge=0, le=100, description="re-localize-and-replan recoveries")
+    goal_offset: float = Field(0.6, ge=0.0, le=10.0, description="stop this far from the goal door")
+    step_timeout_s: float = Field(
+        180.0, gt=0.0, le=86_400.0, description="clock seconds per plan step"
+    )
+    max_linear: float = Field(CREATE3_MAX_LINEAR, gt=0.0, le=5.0, description="m/s (Create 3)")
+    max_angular: float = Field(CREATE3_MAX_ANGULAR, gt=0.0, le=10.0, description="rad/s (Create 3)")
 
 
 class SimConfig(_Section):
-    width: int = Field(320, ge=16, description="camera pixels (60 deg horizontal field)")
-    height: int = Field(240, ge=16, description="camera pixels")
+    width: int = Field(320, ge=16, le=1920, description="camera pixels (60 deg horizontal field)")
+    height: int = Field(240, ge=16, le=1080, description="camera pixels")
     odometry_noise: float = Field(
-        0.02, ge=0.0, description="std of the relative error of each odometry increment"
+        0.02, ge=0.0, le=1.0, description="std of the relative error of each odometry increment"
     )
 
 
@@ -116,33 +139,52 @@ def _set_dotted(data: dict, key: str, value: Any) -> None:
     for p in parts[:-1]:
         d = d.setdefault(p, {})
         if not isinstance(d, dict):
-            raise ConfigError(f"override {key!r}: {p!r} is not a section")
+            raise ConfigError(f"--set {_short(key)}: {_short(p)!r} is not a section")
     d[parts[-1]] = value
 
 
 def load_config(path: str | Path | None = None, overrides: list[str] | tuple = ()) -> Config:
     """The configuration from ``path`` (optional) with ``key=value`` overrides applied."""
-    data: dict = {}
+    data: Any = {}
     source = str(path) if path else "<defaults>"
     if path:
         try:
-            data = yaml.safe_load(Path(path).read_text(encoding="utf-8")) or {}
-        except OSError as err:
-            raise ConfigError(f"{path}: cannot read config: {err.strerror}") from None
-        except yaml.YAMLError as err:
-            raise ConfigError(f"{path}: not valid YAML: {err}") from None
+            data = load_yaml(path, "config")
+        except InputFileError as err:
+            raise ConfigError(str(err)) from None
+        if data is None:
+            data = {}
         if not isinstance(data, dict):
             raise ConfigError(f"{path}: expected a mapping of sections")
+    set_keys: set[str] = set()
     for item in overrides:
-        key, sep, raw = item.partition("=")
+        key, sep, raw = str(item).partition("=")
         if not sep or not key.strip():
-            raise ConfigError(f"override {item!r}: expected section.key=value")
-        _set_dotted(data, key.strip(), yaml.safe_load(raw))
+            raise ConfigError(f"--set {_short(item)}: expected section.key=value")
+        try:
+            value = parse_yaml_value(raw, f"--set {_short(item)}")
+        except PmNavError as err:
+            raise ConfigError(str(err)) from None
+        if isinstance(value, str) and _NUMBER.fullmatch(value.strip()):
+            value = float(value)  # YAML 1.1 reads 1e3 as text; on the command line it is a number
+        _set_dotted(data, key.strip(), value)
+        set_keys.add(key.strip())
     try:
         return Config.model_validate(data)
     except ValidationError as err:
         e = err.errors()[0]
         where = ".".join(str(p) for p in e["loc"])
+        if where in set_keys:
+            source = "--set"
         more = f" (and {len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
         msg = e["msg"].removeprefix("Value error, ")
-        raise ConfigError(f"{source}: {where}: {msg}{more}") from None
+        got = e.get("input")
+        shown = "" if isinstance(got, (dict, list)) else f" (got {_short(repr(got))})"
+        raise ConfigError(f"{source}: {where}: {msg}{shown}{more}") from None
+
+
+_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
+
+
+def _short(text: str, n: int = 60) -> str:
+    return text if len(text) <= n else text[: n - 3] + "..."

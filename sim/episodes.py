@@ -27,6 +27,7 @@ import numpy as np
 from pmnav_bt.errors import PmNavError, Problem
 from pmnav_bt.eval.metrics import SUCCESS_RADIUS_M, EpisodeResult, spl, success
 from pmnav_bt.geometry import Action, heading, point_towards, relative_action, wrap_angle
+from pmnav_bt.loading import InputFileError, atomic_write_text, load_json
 from pmnav_bt.map.building import Building, load_building
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.planning.resolve import resolve_room
@@ -255,6 +256,28 @@ _FIELD_TYPES: dict[str, tuple[type, ...]] = {
     "step_budget": (int,),
 }
 _OPTIONAL = {"route", "step_budget"}
+# Plausible magnitudes: a building fits in 1 km; text is short; budgets stay finite.
+_LIMITS: dict[str, tuple[float, float]] = {
+    "id": (1, 200),
+    "building": (1, 4096),
+    "goal": (1, 64),
+    "start_x": (-1000.0, 1000.0),
+    "start_y": (-1000.0, 1000.0),
+    "start_yaw": (-100.0, 100.0),
+    "geodesic_length": (0.0, 100_000.0),
+    "seed": (0, 2**63 - 1),
+    "turns": (0, 10_000),
+    "forks": (0, 10_000),
+    "route": (0, 10_000),
+    "step_budget": (1, 1_000_000),
+}
+_LENGTHS = {"id", "building", "goal", "route"}
+MAX_EPISODES = 100_000
+
+
+def _in_limits(key: str, v: Any) -> bool:
+    lo, hi = _LIMITS[key]
+    return lo <= (len(v) if key in _LENGTHS else v) <= hi
 
 
 def _episode_from_dict(d: Any, where: str) -> tuple[Episode | None, list[Problem]]:
@@ -278,7 +301,14 @@ def _episode_from_dict(d: Any, where: str) -> tuple[Episode | None, list[Problem
             ok = all(isinstance(x, str) for x in v)
         if not ok:
             want = " or ".join(t.__name__ for t in types)
-            problems.append(Problem(f"{where}.{k}", f"expected {want}, got {v!r}"))
+            shown = repr(v) if len(repr(v)) <= 60 else repr(v)[:57] + "..."
+            problems.append(Problem(f"{where}.{k}", f"expected {want}, got {shown}"))
+        elif (
+            k in _LIMITS and not _LIMITS[k][0] <= (len(v) if k in _LENGTHS else v) <= _LIMITS[k][1]
+        ):
+            lo, hi = _LIMITS[k]
+            what = "length" if k in _LENGTHS else "value"
+            problems.append(Problem(f"{where}.{k}", f"{what} must be from {lo} to {hi}"))
     if not problems and d["tier"] not in TIERS:
         problems.append(
             Problem(f"{where}.tier", f"unknown tier {d['tier']!r}; known: {', '.join(TIERS)}")
@@ -303,26 +333,16 @@ def save_episodes(episodes: Sequence[Episode], path: str | Path) -> Path:
         "tier_definition": tier_definition(),
         "episodes": [e.to_dict() for e in episodes],
     }
-    path.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
-    return path
+    return atomic_write_text(path, json.dumps(data, indent=1) + "\n")
 
 
 def load_episodes(path: str | Path) -> list[Episode]:
     """Read an episode file written by ``save_episodes``; raise EpisodeFileError if invalid."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise EpisodeFileError(
-            str(path), [Problem("", f"cannot read file: {err.strerror}")]
-        ) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise EpisodeFileError(
-            str(path),
-            [Problem(f"line {err.lineno}, column {err.colno}", f"not valid JSON: {err.msg}")],
-        ) from None
+        data = load_json(path, "episodes")
+    except InputFileError as err:
+        raise EpisodeFileError(str(path), [Problem(err.field, err.message)]) from None
     if isinstance(data, list):  # a bare list of episodes is accepted too
         data = {"schema_version": EPISODES_SCHEMA_VERSION, "episodes": data}
     if not isinstance(data, dict) or "episodes" not in data:
@@ -350,6 +370,10 @@ def load_episodes(path: str | Path) -> list[Episode]:
     items = data["episodes"]
     if not isinstance(items, list):
         raise EpisodeFileError(str(path), [Problem("episodes", "expected a list")])
+    if len(items) > MAX_EPISODES:
+        raise EpisodeFileError(
+            str(path), [Problem("episodes", f"{len(items)} episodes; at most {MAX_EPISODES}")]
+        )
     episodes, problems = [], []
     for i, d in enumerate(items):
         ep, probs = _episode_from_dict(d, f"episodes[{i}]")

@@ -5,6 +5,8 @@ from __future__ import annotations
 import copy
 import math
 
+import cv2
+import numpy as np
 import pytest
 import yaml
 
@@ -145,7 +147,7 @@ def test_top_level_not_a_mapping():
 
 def test_file_errors_name_the_file(tmp_path):
     missing = tmp_path / "missing.yaml"
-    with pytest.raises(BuildingFileError, match="missing.yaml: cannot read file"):
+    with pytest.raises(BuildingFileError, match="missing.yaml: cannot read building file"):
         load_building(missing)
     broken = tmp_path / "broken.yaml"
     broken.write_text("name: [unclosed\n")
@@ -163,7 +165,10 @@ def test_floor_plan_file_must_exist(tmp_path):
     path.write_text(yaml.safe_dump(data))
     with pytest.raises(BuildingFileError, match="floor_plan.image: file not found"):
         load_building(path)
-    (tmp_path / "plan.png").write_bytes(b"not checked here")
+    (tmp_path / "plan.png").write_bytes(b"not an image")
+    with pytest.raises(BuildingFileError, match="floor_plan.image: .*not a PNG"):
+        load_building(path)
+    cv2.imwrite(str(tmp_path / "plan.png"), np.zeros((4, 4), np.uint8))
     assert load_building(path).floor_plan.metres_per_pixel == 0.05
 
 

@@ -12,6 +12,7 @@ Coordinates are metres in the map frame (x east, y north).
 from __future__ import annotations
 
 import math
+import os
 from enum import Enum
 from functools import cached_property
 from pathlib import Path
@@ -24,11 +25,37 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from pmnav_bt.errors import BuildingFileError, Problem
 from pmnav_bt.geometry import project_points_to_segments
+from pmnav_bt.loading import (
+    InputFileError,
+    atomic_write_text,
+    image_size,
+    is_regular_file,
+    load_yaml,
+)
 
 SCHEMA_VERSION = 1
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Point = tuple[Finite, Finite]
+# What a building can plausibly be (docs/building-format.md, "Limits"): beyond these a
+# file is a mistake or an attack, and rendering or simulating it would exhaust memory.
+MAX_COORD_M = 1000.0  # |x|, |y| of any point
+MAX_WIDTH_M = 50.0  # corridor width
+MAX_WALL_HEIGHT_M = 20.0
+MAX_WAYPOINTS = 2000
+MAX_EDGES = 4000
+MAX_ROOMS = 5000
+MAX_LANDMARKS = 5000
+MAX_ALIASES = 32
+MAX_ID_CHARS = 64
+MAX_TEXT_CHARS = 200  # names, signs, aliases, kinds, file names
+MAX_DESCRIPTION_CHARS = 2000
+
+# Numbers are strict: "1" or true is not a number.
+Finite = Annotated[float, Field(allow_inf_nan=False, strict=True)]
+Coord = Annotated[float, Field(allow_inf_nan=False, strict=True, ge=-MAX_COORD_M, le=MAX_COORD_M)]
+Point = tuple[Coord, Coord]
+Ident = Annotated[str, Field(min_length=1, max_length=MAX_ID_CHARS, strict=True)]
+Text = Annotated[str, Field(max_length=MAX_TEXT_CHARS, strict=True)]
+Width = Annotated[float, Field(allow_inf_nan=False, strict=True, gt=0, le=MAX_WIDTH_M)]
 
 # A door may be this far beyond the corridor wall and still count as reached.
 DOOR_REACH_SLACK = 1.0
@@ -50,7 +77,7 @@ class _Strict(BaseModel):
 class Waypoint(_Strict):
     """A key waypoint on the corridor centre line."""
 
-    id: str = Field(min_length=1)
+    id: Ident
     kind: WaypointKind
     pos: Point
 
@@ -60,9 +87,9 @@ class Edge(_Strict):
 
     model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
 
-    a: str = Field(alias="from", min_length=1)
-    b: str = Field(alias="to", min_length=1)
-    width: Finite | None = Field(default=None, gt=0)
+    a: Ident = Field(alias="from")
+    b: Ident = Field(alias="to")
+    width: Width | None = None
 
     @model_validator(mode="before")
     @classmethod
@@ -78,11 +105,11 @@ class Edge(_Strict):
 class Room(_Strict):
     """A room behind a door on a corridor. ``door`` is the door centre, in the corridor wall."""
 
-    id: str = Field(min_length=1)
-    name: str = ""
-    aliases: tuple[str, ...] = ()
+    id: Ident
+    name: Text = ""
+    aliases: tuple[Text, ...] = Field(default=(), max_length=MAX_ALIASES)
     door: Point
-    sign: str = ""
+    sign: Text = ""
 
     @property
     def display_name(self) -> str:
@@ -97,12 +124,12 @@ class Room(_Strict):
 class Landmark(_Strict):
     """A non-room landmark (elevator, stairs, reception desk, a named sign ...)."""
 
-    id: str = Field(min_length=1)
-    kind: str = Field(min_length=1)
-    name: str = ""
-    aliases: tuple[str, ...] = ()
+    id: Ident
+    kind: Annotated[Text, Field(min_length=1)]
+    name: Text = ""
+    aliases: tuple[Text, ...] = Field(default=(), max_length=MAX_ALIASES)
     pos: Point
-    sign: str = ""
+    sign: Text = ""
 
     @property
     def display_name(self) -> str:
@@ -116,10 +143,10 @@ class FloorPlan(_Strict):
     map_server convention). Paths are relative to the building file.
     """
 
-    image: str | None = None
-    metres_per_pixel: Finite | None = Field(default=None, gt=0)
+    image: Annotated[Text, Field(min_length=1)] | None = None
+    metres_per_pixel: Annotated[Finite, Field(ge=0.001, le=10.0)] | None = None
     origin: Point = (0.0, 0.0)
-    ros_map: str | None = None
+    ros_map: Annotated[Text, Field(min_length=1)] | None = None
 
     @model_validator(mode="after")
     def _one_source(self) -> FloorPlan:
@@ -133,17 +160,17 @@ class FloorPlan(_Strict):
 class Building(_Strict):
     """A functional building: the content of one building file."""
 
-    schema_version: int
-    name: str = Field(min_length=1)
-    kind: str = "building"
-    description: str = ""
-    corridor_width: Finite = Field(default=2.4, gt=0)
-    wall_height: Finite = Field(default=3.0, gt=0)
+    schema_version: Annotated[int, Field(strict=True)]
+    name: Annotated[Text, Field(min_length=1)]
+    kind: Text = "building"
+    description: Annotated[str, Field(max_length=MAX_DESCRIPTION_CHARS, strict=True)] = ""
+    corridor_width: Width = 2.4
+    wall_height: Annotated[Finite, Field(gt=0, le=MAX_WALL_HEIGHT_M)] = 3.0
     floor_plan: FloorPlan | None = None
-    waypoints: tuple[Waypoint, ...]
-    edges: tuple[Edge, ...]
-    rooms: tuple[Room, ...] = ()
-    landmarks: tuple[Landmark, ...] = ()
+    waypoints: tuple[Waypoint, ...] = Field(max_length=MAX_WAYPOINTS)
+    edges: tuple[Edge, ...] = Field(max_length=MAX_EDGES)
+    rooms: tuple[Room, ...] = Field(default=(), max_length=MAX_ROOMS)
+    landmarks: tuple[Landmark, ...] = Field(default=(), max_length=MAX_LANDMARKS)
 
     @field_validator("schema_version")
     @classmethod
@@ -231,7 +258,8 @@ def _pydantic_problems(err: ValidationError) -> list[Problem]:
             msg = msg[len("Value error, ") :]
         got = e.get("input")
         if e["type"] not in ("missing", "extra_forbidden") and not isinstance(got, (dict, list)):
-            msg += f" (got {got!r})"
+            shown = repr(got)
+            msg += f" (got {shown if len(shown) <= 60 else shown[:57] + '...'})"
         problems.append(Problem(_loc(e["loc"]), msg))
     return problems
 
@@ -338,8 +366,16 @@ def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem
     if b.floor_plan is not None and base_dir is not None:
         for field in ("image", "ros_map"):
             rel = getattr(b.floor_plan, field)
-            if rel is not None and not (base_dir / rel).is_file():
-                problems.append(Problem(f"floor_plan.{field}", f"file not found: {base_dir / rel}"))
+            if rel is None:
+                continue
+            f = base_dir / rel
+            if not is_regular_file(f):
+                problems.append(Problem(f"floor_plan.{field}", f"file not found: {f}"))
+            elif field == "image":
+                try:
+                    image_size(f, f"floor_plan.{field}")
+                except InputFileError as err:
+                    problems.append(Problem(f"floor_plan.{field}", f"{f}: {err.message}"))
     return problems
 
 
@@ -359,34 +395,19 @@ def building_from_data(data: Any, source: str = "<data>", base_dir: Path | None 
     return b
 
 
-def _yaml_loader():
-    return getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-
-
 def load_building(path: str | Path) -> Building:
     """Read and validate a building file (or a built-in building's name)."""
     path = resolve_building_path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise BuildingFileError(
-            str(path), [Problem("", f"cannot read file: {err.strerror}")]
-        ) from None
-    try:
-        data = yaml.load(text, Loader=_yaml_loader())  # noqa: S506 - a safe loader
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(err, "problem", None) or str(err)
-        raise BuildingFileError(str(path), [Problem(where, f"not valid YAML: {problem}")]) from None
+        data = load_yaml(path, "building")
+    except InputFileError as err:
+        raise BuildingFileError(str(path), [Problem(err.field, err.message)]) from None
     return building_from_data(data, str(path), path.parent)
 
 
 def save_building(b: Building, path: str | Path) -> Path:
     """Write a building file that loads back to an equal Building."""
-    path = Path(path)
-    path.write_text(dump_building(b), encoding="utf-8")
-    return path
+    return atomic_write_text(path, dump_building(b))
 
 
 def dump_building(b: Building) -> str:
@@ -408,7 +429,10 @@ def builtin_buildings() -> list[str]:
 def resolve_building_path(name_or_path: str | Path) -> Path:
     """A path as given, or the file of a built-in building of that name."""
     p = Path(name_or_path)
-    if p.exists() or p.suffix in (".yaml", ".yml") or len(p.parts) > 1:
+    text = str(name_or_path)
+    if len(text) > 255 or "\0" in text or p.suffix in (".yaml", ".yml") or len(p.parts) > 1:
+        return p
+    if os.path.lexists(p):
         return p
     builtin = BUILTIN_DIR / f"{name_or_path}.yaml"
     if builtin.is_file():

@@ -174,7 +174,7 @@ def test_bad_episode_files_name_file_and_field(tmp_path, maps, mutate, needle):
 
 
 def test_unreadable_and_non_json_files(tmp_path):
-    with pytest.raises(EpisodeFileError, match="cannot read file"):
+    with pytest.raises(EpisodeFileError, match="cannot read episodes file"):
         load_episodes(tmp_path / "missing.json")
     with pytest.raises(EpisodeFileError, match="line 1, column"):
         load_episodes(_write(tmp_path, "{not json"))
