@@ -236,7 +236,7 @@ def test_bad_yaml_names_file_and_field(tmp_path, text, field):
 def test_unreadable_image_names_the_image(tmp_path):
     (tmp_path / "m.pgm").write_bytes(b"not an image at all")
     path = _write(tmp_path, "image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
-    with pytest.raises(FloorPlanError, match=r"m\.pgm.*cannot decode"):
+    with pytest.raises(FloorPlanError, match=r"m\.pgm.*not a PNG, PGM or JPEG"):
         load_ros_map(path)
 
 

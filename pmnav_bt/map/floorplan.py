@@ -25,6 +25,14 @@ import yaml
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import project_points_to_segments
+from pmnav_bt.loading import (
+    MAX_IMAGE_PIXELS,
+    InputFileError,
+    atomic_write_text,
+    image_size,
+    is_regular_file,
+    load_yaml,
+)
 from pmnav_bt.map.building import Building
 
 # map_saver's grey levels and thresholds (trinary mode).
@@ -153,8 +161,12 @@ def _as_points(xy) -> np.ndarray:
 def read_image(path: str | Path, field: str = "image") -> np.ndarray:
     """Read an 8-bit image file (PGM, PNG, JPG) as grey or BGR(A), or raise FloorPlanError."""
     path = Path(path)
-    if not path.is_file():
+    if not is_regular_file(path):
         raise FloorPlanError(path, field, "image file not found; check the path")
+    try:
+        image_size(path, field)  # from the header: no decoding of a 30000 x 30000 image
+    except InputFileError as err:
+        raise FloorPlanError(path, field, err.message) from None
     img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise FloorPlanError(path, field, "cannot decode the image; use a PGM, PNG or JPG file")
@@ -192,12 +204,17 @@ def load_ros_map(yaml_path: str | Path) -> FloorPlanImage:
     if not isinstance(data["image"], str) or not data["image"]:
         raise FloorPlanError(yaml_path, "image", f"must be a file name (got {data['image']!r})")
     res = data["resolution"]
-    if not _is_number(res) or res <= 0:
+    if not _is_number(res) or not 0.001 <= res <= 10.0:
         raise FloorPlanError(
-            yaml_path, "resolution", f"must be a positive number of metres per pixel (got {res!r})"
+            yaml_path, "resolution", f"must be 0.001 to 10 metres per pixel (got {res!r})"
         )
     origin = data["origin"]
-    if not (isinstance(origin, list) and len(origin) == 3 and all(map(_is_number, origin))):
+    if not (
+        isinstance(origin, list)
+        and len(origin) == 3
+        and all(map(_is_number, origin))
+        and all(abs(v) <= 100_000 for v in origin)
+    ):
         raise FloorPlanError(
             yaml_path, "origin", f"must be [x, y, yaw] in metres and radians (got {origin!r})"
         )
@@ -219,7 +236,7 @@ def load_ros_map(yaml_path: str | Path) -> FloorPlanImage:
     image_path = Path(data["image"])
     if not image_path.is_absolute():
         image_path = yaml_path.parent / image_path
-    if not image_path.is_file():
+    if not is_regular_file(image_path):
         raise FloorPlanError(
             yaml_path,
             "image",
@@ -250,17 +267,9 @@ def load_floor_plan(building: Building, base_dir: str | Path = ".") -> FloorPlan
 
 def _read_yaml(path: Path) -> dict[str, Any]:
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise FloorPlanError(
-            path, "", f"cannot read the map YAML ({err.strerror}); check the path"
-        ) from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark else ""
-        raise FloorPlanError(path, "", f"not valid YAML{where}; fix the file") from None
+        data = load_yaml(path, "ros_map")
+    except InputFileError as err:
+        raise FloorPlanError(path, err.field, err.message) from None
     if not isinstance(data, dict):
         raise FloorPlanError(
             path, "", "expected a mapping with image, resolution and origin (a map_server YAML)"
@@ -291,7 +300,7 @@ def save_ros_map(plan: FloorPlanImage, yaml_path: str | Path) -> Path:
         "occupied_thresh": float(plan.occupied_thresh),
         "free_thresh": float(plan.free_thresh),
     }
-    yaml_path.write_text(yaml.safe_dump(meta, sort_keys=False), encoding="utf-8")
+    atomic_write_text(yaml_path, yaml.safe_dump(meta, sort_keys=False))
     return yaml_path
 
 
@@ -382,6 +391,12 @@ def rasterize_building(
     xmin, ymin, xmax, ymax = building_bounds(building, margin)
     w = math.ceil((xmax - xmin) / resolution)
     h = math.ceil((ymax - ymin) / resolution)
+    if w * h > MAX_IMAGE_PIXELS:
+        raise FloorPlanError(
+            f"<rasterized {building.name}>",
+            "resolution",
+            f"{w}x{h} pixels at {resolution} m per pixel; use a coarser resolution",
+        )
     plan = FloorPlanImage(
         np.full((h, w), UNKNOWN, dtype=np.uint8),
         float(resolution),
