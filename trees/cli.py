@@ -144,7 +144,10 @@ def load_replay(path: Path):
     """A tree log read back and checked (PmNavError names the file and what is wrong)."""
     from pmnav_bt.trees.snapshots import Replay
 
-    return Replay.load(path)
+    rp = Replay.load(path)
+    if rp.warning:
+        typer.echo(f"pmnav: warning: {rp.warning}", err=True)
+    return rp
 
 
 def _span(replay) -> str:

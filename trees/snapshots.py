@@ -17,10 +17,6 @@ from typing import Any, TextIO
 import numpy as np
 import py_trees
 
-from pmnav_bt.errors import PmNavError
-
-TICK_FIELDS = frozenset({"tick", "time", "status", "feedback", "blackboard"})
-NODE_FIELDS = frozenset({"id", "name", "class", "parent"})
 STATUS_MARK = {"SUCCESS": "✔", "FAILURE": "✘", "RUNNING": "*", "INVALID": "-"}
 
 
@@ -112,42 +108,15 @@ class Replay:
     nodes: list[dict]
     ticks: list[dict]
 
+    warning: str = ""  # set when the last line was cut short and dropped
+
     @classmethod
     def load(cls, path: str | Path) -> Replay:
         """Read and check a log; PmNavError names the file and what is wrong."""
-        path = Path(path)
-        try:
-            lines = path.read_text(encoding="utf-8").splitlines()
-        except OSError as err:
-            raise PmNavError(f"{path}: cannot read tree log: {err.strerror}") from None
-        except UnicodeDecodeError:
-            raise PmNavError(f"{path}: not a tree log (not UTF-8 text)") from None
-        nodes, ticks = None, []
-        for i, line in enumerate(lines, 1):
-            if not line.strip():
-                continue
-            try:
-                rec = json.loads(line)
-            except json.JSONDecodeError as err:
-                raise PmNavError(f"{path}: line {i}: not JSON ({err.msg})") from None
-            if not isinstance(rec, dict):
-                raise PmNavError(f"{path}: line {i}: not a tree log record (not a JSON object)")
-            if rec.get("type") == "tree":
-                nodes = rec.get("nodes")
-            elif rec.get("type") == "tick":
-                missing = TICK_FIELDS - rec.keys()
-                if missing:
-                    raise PmNavError(
-                        f"{path}: line {i}: a tick record lacks {', '.join(sorted(missing))}"
-                    )
-                ticks.append(rec)
-        if nodes is None:
-            raise PmNavError(f"{path}: not a tree log (no tree record); write one with --tree-log")
-        if not isinstance(nodes, list) or not all(
-            isinstance(n, dict) and n.keys() >= NODE_FIELDS for n in nodes
-        ):
-            raise PmNavError(f"{path}: the tree record's nodes lack id/name/class/parent")
-        return cls(nodes, ticks)
+        from pmnav_bt.treelog import read_tree_log
+
+        log = read_tree_log(path)
+        return cls(log.nodes, log.ticks, log.warning)
 
     def render(self, tick: dict, visited_only: bool = False) -> str:
         """The tree at one tick, as unicode, with statuses and feedback."""

@@ -133,7 +133,7 @@ def test_step_without_a_terminal_prints_everything(log):
     "content, expected",
     [
         (None, "cannot read tree log"),
-        ('{"type": "tree", "nodes": [\n', "line 1: not JSON"),
+        ('{"type": "tree", "nodes": [\n', "line 1: not valid JSON"),
         (
             '{"type": "tick", "tick": 0, "time": 0, "status": {}, "feedback": {}, '
             '"blackboard": {}}\n',
