@@ -7,12 +7,15 @@ with status 2; ``pmnav validate`` exits 1 when the file has problems.
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import typer
 
+from pmnav_bt.cli_values import finite, run_cli
 from pmnav_bt.errors import BuildingFileError, PmNavError
+from pmnav_bt.loading import check_output_file
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 app = typer.Typer(
     add_completion=False,
@@ -75,6 +78,8 @@ def map_(
     image: Path | None = typer.Option(None, "--image", help="Write the annotated map PNG here."),
 ) -> None:
     """Print the semantic priori-map (structured text or JSON); optionally draw it."""
+    if image is not None:
+        check_output_file(image, "--image", IMAGE_SUFFIXES)
     pm = _priori_map(file)
     typer.echo(json.dumps(pm.to_dict(), indent=2) if as_json else pm.to_text(), nl=not as_json)
     if image is not None:
@@ -100,6 +105,9 @@ def plan(
     """Plan from a start to a goal room: ordered {landmark: action} steps."""
     from pmnav_bt.planning.graph_planner import GraphPlanner
 
+    finite(max_gap, "--max-gap", 0.1, 1000.0)
+    if image is not None:
+        check_output_file(image, "--image", IMAGE_SUFFIXES)
     pm = _priori_map(file)
     p = GraphPlanner(max_gap=max_gap).plan(pm, start, goal)
     typer.echo(p.to_json() if as_json else p.text())
@@ -122,14 +130,13 @@ def _mount_subcommands() -> None:
 _mount_subcommands()
 
 
+def _error_line(err: PmNavError) -> str:
+    return err.summary() if isinstance(err, BuildingFileError) else str(err)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the app; user errors become one line on stderr and exit status 2."""
-    try:
-        app(args=argv, prog_name="pmnav")
-    except PmNavError as err:
-        msg = err.summary() if isinstance(err, BuildingFileError) else str(err)
-        print(f"pmnav: error: {msg}", file=sys.stderr)
-        sys.exit(2)
+    run_cli(app, argv, "pmnav", _error_line)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -57,7 +57,7 @@ def test_plan_text_and_json(capsys):
         (["plan", "fig2_hospital", "--from", "seg13", "--to", "room71"], "no room called 'room71'"),
         (["plan", "fig2_hospital", "--from", "seg99", "--to", "room7"], "unknown segment"),
         (["plan", "nosuch", "--from", "seg1", "--to", "room7"], "no built-in building"),
-        (["map", "/nonexistent/b.yaml"], "cannot read file"),
+        (["map", "/nonexistent/b.yaml"], "cannot read building file"),
     ],
 )
 def test_user_errors_are_one_line_exit_2(capsys, argv, words):
