@@ -9,7 +9,9 @@ from pathlib import Path
 
 import typer
 
+from pmnav_bt import cli_values
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.loading import check_output_dir, check_output_file, safe_filename
 from pmnav_bt.seams import Pose2D
 
 app = typer.Typer(
@@ -30,14 +32,13 @@ class PoseError(PmNavError):
 
 
 def parse_pose(text: str) -> Pose2D:
-    """'x,y,yaw_deg' (metres, degrees) -> Pose2D (radians)."""
-    parts = text.replace(" ", "").split(",")
+    """'x,y,yaw_deg' (metres, degrees) -> Pose2D (radians); finite and in range."""
+    from pmnav_bt.cli_values import CliValueError, parse_pose_text
+
     try:
-        x, y, yaw_deg = (float(v) for v in parts)
-    except ValueError:
-        raise PoseError(
-            f"--pose {text!r}: expected three numbers 'x,y,yaw_deg', e.g. --pose 0,30,-90"
-        ) from None
+        x, y, yaw_deg = parse_pose_text(text, "--pose")
+    except CliValueError as err:
+        raise PoseError(str(err)) from None
     return Pose2D(x, y, math.radians(yaw_deg))
 
 
@@ -48,8 +49,8 @@ def show(
     pose: str | None = typer.Option(
         None, "--pose", help="Camera pose x,y,yaw_deg (default: the start, along its corridor)."
     ),
-    width: int = typer.Option(640, "--width", min=16, help="Image width, pixels."),
-    height: int = typer.Option(480, "--height", min=16, help="Image height, pixels."),
+    width: int = typer.Option(640, "--width", min=16, max=4096, help="Image width, pixels."),
+    height: int = typer.Option(480, "--height", min=16, max=4096, help="Image height, pixels."),
     gui: bool = typer.Option(False, "--gui", help="Also open the pybullet GUI (needs a display)."),
 ) -> None:
     """Write a top-down plan and the first-person RGB, depth and segmentation views."""
@@ -64,12 +65,12 @@ def show(
     from pmnav_bt.sim.world import SimWorld
 
     start = parse_pose(pose) if pose is not None else None
+    check_output_dir(out)
     with SimWorld(building, gui=gui) as world:
         base = SimBase(world, pose=start, width=width, height=height)
         q = base.pose()
         obs = base.observe()
-        name = world.building.name
-        out.mkdir(parents=True, exist_ok=True)
+        name = safe_filename(world.building.name)
         files = {
             f"{name}_top_down.png": draw_top_down(world, q),
             f"{name}_view_rgb.png": obs.rgb,
@@ -144,11 +145,14 @@ def episodes(
     """Generate seeded episodes of a tier and save them as JSON."""
     from pmnav_bt.sim.episodes import generate_episodes, save_episodes, tier_definition
 
+    cli_values.count(n, "-n")
+    cli_values.seed(seed)
+    if out is None:
+        out = Path(f"{safe_filename(Path(building).stem)}_{safe_filename(tier)}_episodes.json")
+    check_output_file(out, "--out", (".json",))
     eps = []
     for t in _tiers(tier):
         eps += generate_episodes(building, t, n, seed=seed)
-    if out is None:
-        out = Path(f"{Path(building).stem}_{tier}_episodes.json")
     save_episodes(eps, out)
     typer.echo(tier_definition())
     typer.echo(f"wrote {len(eps)} episodes to {out}")
@@ -174,7 +178,10 @@ def run(
     """Run one PM-Nav episode and print its result; write the tree log and trajectory plot."""
     from pmnav_bt.experiments.evaluation import VARIANT_NAMES, custom_episode, run_episode
 
+    cli_values.seed(seed)
+    cli_values.index(index)
     cfg = _config(config, overrides)
+    check_output_dir(out)
     if episode_file is not None:
         from pmnav_bt.sim.episodes import load_episodes
 
@@ -219,7 +226,9 @@ def eval_(
     n: int = typer.Option(20, "-n", min=1, help="Episodes per tier per building."),
     seed: int = typer.Option(0, "--seed"),
     variants: str = typer.Option("pmnav,coarse_only", "--variants", help="Tree variants."),
-    jobs: int = typer.Option(2, "--jobs", min=1, help="Episodes run in parallel."),
+    jobs: int | None = typer.Option(
+        None, "--jobs", help="Episodes run in parallel [default: 2, at most the CPUs]."
+    ),
     out: Path = typer.Option(Path("out/eval"), "--out", help="Folder for results.json/.md."),
     config: Path | None = CONFIG_OPT,
     overrides: list[str] | None = SET_OPT,
@@ -234,9 +243,14 @@ def eval_(
         save_evaluation,
         variant_configs,
     )
+    from pmnav_bt.interrupts import Interrupted, JsonlAppender, stop_signals
     from pmnav_bt.sim.episodes import tier_definition
 
+    cli_values.count(n, "-n")
+    cli_values.seed(seed)
+    jobs = cli_values.jobs(jobs) if jobs is not None else min(2, cli_values.cpu_count())
     cfg = _config(config, overrides)
+    check_output_dir(out)
     names = [v.strip() for v in variants.split(",") if v.strip()]
     configs = variant_configs(cfg, names)
     eps, notes = episodes_for(_buildings(building), _tiers(tier), n, seed)
@@ -245,23 +259,41 @@ def eval_(
     if not eps:
         raise PmNavError("no episodes to run")
     total = len(eps) * len(configs)
-    if sys.stderr.isatty():
-        with Progress(transient=False) as bar:
-            task = bar.add_task("episodes", total=total)
-            results = evaluate(
-                eps,
-                configs,
-                jobs=jobs,
-                progress=lambda name, done, _: bar.update(task, completed=done),
+    finished: dict = {}
+    with JsonlAppender(out / "results.jsonl") as log, stop_signals():
+        save = lambda name, r: log.write({"variant": name, **r.to_dict()})  # noqa: E731
+        try:
+            if sys.stderr.isatty():
+                with Progress(transient=False) as bar:
+                    task = bar.add_task("episodes", total=total)
+                    results = evaluate(
+                        eps,
+                        configs,
+                        jobs=jobs,
+                        progress=lambda name, done, _: bar.update(task, completed=done),
+                        on_result=save,
+                        finished=finished,
+                    )
+            else:  # a log: a line every tenth of the way
+                step = max(1, total // 10)
+
+                def report(name: str, done: int, _total: int) -> None:
+                    if done % step == 0 or done == total:
+                        typer.echo(f"{done}/{total} episodes ({name})", err=True)
+
+                results = evaluate(
+                    eps, configs, jobs=jobs, progress=report, on_result=save, finished=finished
+                )
+        except Interrupted as stop:
+            kept = {k: v for k, v in finished.items() if v}
+            if kept:
+                save_evaluation(kept, out, f"# PM-Nav evaluation (stopped by {stop.signame})")
+            typer.echo(
+                f"pmnav: stopped by {stop.signame} after {log.count} of {total} episodes; "
+                f"finished ones are in {out / 'results.jsonl'}",
+                err=True,
             )
-    else:  # a log: a line every tenth of the way
-        step = max(1, total // 10)
-
-        def report(name: str, done: int, _total: int) -> None:
-            if done % step == 0 or done == total:
-                typer.echo(f"{done}/{total} episodes ({name})", err=True)
-
-        results = evaluate(eps, configs, jobs=jobs, progress=report)
+            raise typer.Exit(stop.exit_code) from None
     g = cfg.grounder
     header = (
         f"# PM-Nav evaluation\n\nbuildings: {building}; tiers: {tier}; {n} per tier per "

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from pmnav_bt.config import Config
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
+from pmnav_bt.loading import atomic_write_text, safe_filename
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.sim.episodes import Episode
@@ -123,7 +124,7 @@ def run_episode(
         log_path = None
         if out_dir is not None:
             out_dir.mkdir(parents=True, exist_ok=True)
-            log_path = out_dir / f"{episode.id}.tree.jsonl"
+            log_path = out_dir / f"{safe_filename(episode.id)}.tree.jsonl"
         with open(log_path, "w", encoding="utf-8") if log_path else _null() as log:
             outcome = run_tree(ctx, episode.goal, log=log, on_tick=record)
         final = inner.pose()
@@ -141,7 +142,7 @@ def run_episode(
     )
     plot_path = None
     if out_dir is not None and plot:
-        plot_path = out_dir / f"{episode.id}.trajectory.png"
+        plot_path = out_dir / f"{safe_filename(episode.id)}.trajectory.png"
         _plot(pm, ctx.trace, truth, plot_path, result, config, outcome)
     return EpisodeRun(result, plot_path, log_path)
 
@@ -228,32 +229,50 @@ def evaluate(
     configs: dict[str, Config],
     jobs: int = 1,
     progress: Callable[[str, int, int], None] | None = None,
+    on_result: Callable[[str, EpisodeResult], None] | None = None,
+    finished: dict[str, list[EpisodeResult]] | None = None,
 ) -> dict[str, list[EpisodeResult]]:
-    """Run every episode under each named config; results per config name."""
-    results: dict[str, list[EpisodeResult]] = {}
+    """Run every episode under each named config; results per config name.
+
+    ``on_result(name, result)`` is called as each episode ends (to save it at once).
+    ``finished``, when given, is filled as results arrive: after an interruption it
+    holds what finished. Pool workers ignore Ctrl-C; on any exception the pool is
+    terminated before the exception goes on.
+    """
+    results: dict[str, list[EpisodeResult]] = {} if finished is None else finished
     total = len(episodes) * len(configs)
     done = 0
     for name, cfg in configs.items():
         tasks = [(e, cfg.model_dump_json()) for e in episodes]
+        got: list[EpisodeResult] = results.setdefault(name, [])
+
+        def take(row: dict, name: str = name, got: list = got) -> None:
+            nonlocal done
+            r = EpisodeResult(**row)
+            got.append(r)
+            if on_result:
+                on_result(name, r)
+            done += 1
+            if progress:
+                progress(name, done, total)
+
         if jobs > 1:
             import multiprocessing as mp
-            from concurrent.futures import ProcessPoolExecutor
 
-            with ProcessPoolExecutor(jobs, mp_context=mp.get_context("spawn")) as pool:
-                rows = []
-                for row in pool.map(_run_one, tasks):
-                    rows.append(row)
-                    done += 1
-                    if progress:
-                        progress(name, done, total)
+            from pmnav_bt.interrupts import quiet_worker
+
+            pool = mp.get_context("spawn").Pool(jobs, initializer=quiet_worker)
+            try:
+                for row in pool.imap_unordered(_run_one, tasks):
+                    take(row)
+            finally:
+                pool.terminate()
+                pool.join()
+            order = {e.id: i for i, e in enumerate(episodes)}
+            got.sort(key=lambda r: order.get(r.episode_id, 0))
         else:
-            rows = []
             for t in tasks:
-                rows.append(_run_one(t))
-                done += 1
-                if progress:
-                    progress(name, done, total)
-        results[name] = [EpisodeResult(**r) for r in rows]
+                take(_run_one(t))
     return results
 
 
@@ -291,9 +310,9 @@ def save_evaluation(results: dict[str, list[EpisodeResult]], out_dir: Path, head
     """Write results.json (every episode) and results.md (the table); return the .md path."""
     out_dir.mkdir(parents=True, exist_ok=True)
     data = {name: [r.to_dict() for r in rs] for name, rs in results.items()}
-    (out_dir / "results.json").write_text(json.dumps(data, indent=1), encoding="utf-8")
+    atomic_write_text(out_dir / "results.json", json.dumps(data, indent=1))
     md = out_dir / "results.md"
-    md.write_text(header + "\n\n" + comparison_markdown(results) + "\n", encoding="utf-8")
+    atomic_write_text(md, header + "\n\n" + comparison_markdown(results) + "\n")
     return md
 
 

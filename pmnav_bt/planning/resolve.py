@@ -88,6 +88,8 @@ def resolve_start(pm: PrioriMap, spec: str) -> StartPoint:
             yaw = math.radians(float(m.group(3))) if m.group(3) is not None else None
         except ValueError:
             raise UnknownNameError(f"bad pose {spec!r}: expected 'x,y' or 'x,y,yaw_deg'") from None
+        if not all(map(math.isfinite, (x, y, yaw if yaw is not None else 0.0))):
+            raise UnknownNameError(f"bad pose {spec[:60]!r}: the numbers must be finite")
         loc = pm.locate(x, y)
         limit = loc.segment.width / 2.0 + 1.0
         if loc.offset > limit:

@@ -1,0 +1,87 @@
+"""Stopping a long run cleanly: SIGTERM like Ctrl-C, quiet pool workers, results kept.
+
+``stop_signals()`` turns SIGINT and SIGTERM in the main process into ``Interrupted``;
+``quiet_worker()`` (a pool initializer) makes workers ignore both, so only the parent
+decides, terminates the pool and keeps what finished. ``JsonlAppender`` writes one line
+per finished result, flushed and synced, so a kill loses at most the running episodes.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
+
+
+class Interrupted(BaseException):
+    """The run was stopped by SIGINT (Ctrl-C) or SIGTERM.
+
+    A BaseException, like KeyboardInterrupt, so no ``except Exception`` on the way up
+    (an episode's crash guard, for one) turns it into a result."""
+
+    def __init__(self, signame: str):
+        self.signame = signame
+        super().__init__(f"stopped by {signame}")
+
+    @property
+    def exit_code(self) -> int:
+        return EXIT_CODES.get(self.signame, 1)
+
+
+@contextmanager
+def stop_signals() -> Iterator[None]:
+    """Within the block, SIGINT and SIGTERM raise Interrupted in the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum, _frame):
+        # Once is enough: a second signal while cleaning up must not break the cleanup.
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        raise Interrupted(signal.Signals(signum).name)
+
+    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+def quiet_worker() -> None:
+    """Pool initializer: a worker ignores SIGINT/SIGTERM from the terminal's process group;
+    the parent stops it with terminate()."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+class JsonlAppender:
+    """Append one JSON object per line to a file, each line flushed and synced."""
+
+    def __init__(self, path: str | Path, mode: str = "w"):
+        self.path = Path(path)
+        self._f = open(self.path, mode, encoding="utf-8")  # noqa: SIM115 - closed in close()
+        self.count = 0
+
+    def write(self, record: dict[str, Any]) -> None:
+        self._f.write(json.dumps(record) + "\n")
+        self._f.flush()
+        os.fsync(self._f.fileno())
+        self.count += 1
+
+    def close(self) -> None:
+        self._f.close()
+
+    def __enter__(self) -> JsonlAppender:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
