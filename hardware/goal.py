@@ -19,15 +19,34 @@ import time
 from pmnav_bt.errors import PmNavError
 
 
-def main(argv: list[str] | None = None) -> None:
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    """The command line; the goal stripped as the node strips it (its result names it so)."""
     ap = argparse.ArgumentParser(prog="pmnav-ros-goal", description=__doc__.splitlines()[0])
     ap.add_argument("goal", nargs="?", help="a room name, id or alias")
     ap.add_argument("--timeout", type=float, default=900.0, help="seconds to wait for the result")
     ap.add_argument("--namespace", default="/", help="the controller's namespace")
     ap.add_argument("--cancel", action="store_true", help="cancel the running goal instead")
     args = ap.parse_args(argv)
+    # The node strips the name it receives and reports the stripped name in its result.
+    args.goal = (args.goal or "").strip()
     if not args.goal and not args.cancel:
         ap.error("give a goal, or --cancel")
+    if not (args.timeout > 0 and args.timeout < 1e7):
+        ap.error(f"--timeout {args.timeout}: expected seconds above 0")
+    return args
+
+
+def result_for(data: str, goal: str) -> dict | None:
+    """The result record in a ``result`` message if it is for ``goal``, else None."""
+    try:
+        r = json.loads(data)
+    except ValueError:
+        return None  # not a pmnav-ros result
+    return r if isinstance(r, dict) and r.get("goal") == goal else None
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = parse_args(argv)
 
     from pmnav_bt.hardware.runtime import RosRuntime
 
@@ -46,8 +65,8 @@ def main(argv: list[str] | None = None) -> None:
     result: dict = {}
 
     def on_result(msg) -> None:
-        r = json.loads(msg.data)
-        if r.get("goal") == args.goal:
+        r = result_for(msg.data, args.goal)
+        if r is not None:
             result.update(r)
             done.set()
 

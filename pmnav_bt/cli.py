@@ -64,11 +64,27 @@ def validate(file: str = typer.Argument(..., help=FILE_HELP)) -> None:
             typer.echo(line, err=True)
         typer.echo(f"{len(err.problems)} problem(s)", err=True)
         raise typer.Exit(1) from None
+    _check_floor_plan(file, b)
     pm = parse_building(b)
     typer.echo(
         f"{file}: OK: {b.name}: {len(b.rooms)} rooms, {len(b.landmarks)} landmarks, "
         f"{len(b.waypoints)} key waypoints, {len(b.edges)} corridors, {len(pm.segments)} segments"
     )
+
+
+def _check_floor_plan(file: str, b) -> None:
+    """Open and decode the floor plan (image or ROS map) so a bad file fails here, not later."""
+    if b.floor_plan is None:
+        return
+    from pmnav_bt.map.floorplan import FloorPlanError, load_floor_plan
+
+    try:
+        load_floor_plan(b, _folder(file))
+    except FloorPlanError as err:
+        field = "floor_plan.ros_map" if b.floor_plan.ros_map else "floor_plan.image"
+        typer.echo(f"{file}: {field}: {err}", err=True)
+        typer.echo("1 problem(s)", err=True)
+        raise typer.Exit(1) from None
 
 
 @app.command("map")

@@ -167,7 +167,7 @@ def read_image(path: str | Path, field: str = "image") -> np.ndarray:
         image_size(path, field)  # from the header: no decoding of a 30000 x 30000 image
     except InputFileError as err:
         raise FloorPlanError(path, field, err.message) from None
-    img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    img = _imread_quiet(path)
     if img is None:
         raise FloorPlanError(path, field, "cannot decode the image; use a PGM, PNG or JPG file")
     if img.dtype != np.uint8:
@@ -175,6 +175,21 @@ def read_image(path: str | Path, field: str = "image") -> np.ndarray:
     if img.ndim == 3 and img.shape[2] == 1:
         img = img[:, :, 0]
     return img
+
+
+def _imread_quiet(path: Path) -> np.ndarray | None:
+    """cv2.imread without OpenCV's own error lines on stderr (our message says it once)."""
+    log = getattr(getattr(cv2, "utils", None), "logging", None)
+    old = log.getLogLevel() if log is not None else None
+    if log is not None:
+        log.setLogLevel(log.LOG_LEVEL_SILENT)
+    try:
+        return cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    except cv2.error:
+        return None
+    finally:
+        if log is not None:
+            log.setLogLevel(old)
 
 
 def load_image_plan(

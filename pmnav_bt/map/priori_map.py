@@ -294,15 +294,15 @@ def parse_building(b: Building) -> PrioriMap:
         w.id: MapNode(w.id, w.kind.value, (float(w.pos[0]), float(w.pos[1]))) for w in b.waypoints
     }
     at_key: dict[str, list[tuple[str, str]]] = {}  # waypoint id -> items attached there
-    per_edge: dict[int, list[tuple[float, str, str]]] = {}
-    for (kind, ident, _), e, t in zip(items, ei, tt, strict=True):
+    per_edge: dict[int, list[tuple[float, str, str, int]]] = {}
+    for (kind, ident, p), e, t in zip(items, ei, tt, strict=True):
         s = float(t) * float(edge_len[e])
         if s < MERGE_TOLERANCE:
             at_key.setdefault(edges[e].a, []).append((kind, ident))
         elif edge_len[e] - s < MERGE_TOLERANCE:
             at_key.setdefault(edges[e].b, []).append((kind, ident))
         else:
-            per_edge.setdefault(int(e), []).append((s, kind, ident))
+            per_edge.setdefault(int(e), []).append((s, kind, ident, _side(seg_a[e], seg_b[e], p)))
     for wid, attached in at_key.items():
         n = nodes[wid]
         nodes[wid] = MapNode(
@@ -322,9 +322,9 @@ def parse_building(b: Building) -> PrioriMap:
         length = float(edge_len[e_idx])
         chain = [e.a]
         for cluster in _clusters(sorted(per_edge.get(e_idx, []))):
-            s_mid = sum(s for s, _, _ in cluster) / len(cluster)
-            rooms = tuple(sorted((i for _, k, i in cluster if k == "room"), key=natural_key))
-            lms = tuple(sorted((i for _, k, i in cluster if k == "landmark"), key=natural_key))
+            s_mid = sum(a[0] for a in cluster) / len(cluster)
+            rooms = tuple(sorted((a[2] for a in cluster if a[1] == "room"), key=natural_key))
+            lms = tuple(sorted((a[2] for a in cluster if a[1] == "landmark"), key=natural_key))
             node_id = rooms[0] if rooms else lms[0]
             xy = a_xy + (s_mid / length) * (b_xy - a_xy)
             nodes[node_id] = MapNode(
@@ -355,12 +355,31 @@ def parse_building(b: Building) -> PrioriMap:
     return PrioriMap(b, nodes, segments, directions, places, graph)
 
 
-def _clusters(anchors: list[tuple[float, str, str]]) -> list[list[tuple[float, str, str]]]:
-    """Group anchors sorted by distance along an edge into runs closer than MERGE_TOLERANCE."""
-    out: list[list[tuple[float, str, str]]] = []
+def _side(a, b, p) -> int:
+    """+1 left of the centre line a->b, -1 right, 0 on it (within 5 cm)."""
+    u = (b - a) / float(np.linalg.norm(b - a))
+    off = u[0] * (p[1] - a[1]) - u[1] * (p[0] - a[0])
+    return 0 if abs(off) < 0.05 else (1 if off > 0 else -1)
+
+
+def _clusters(
+    anchors: list[tuple[float, str, str, int]],
+) -> list[list[tuple[float, str, str, int]]]:
+    """Group anchors sorted by distance along an edge: facing doors share a node.
+
+    An anchor joins the open group when it lies within MERGE_TOLERANCE of the group's
+    first anchor and on a side of the corridor the group does not have yet, so doors
+    along one wall never chain into one node however close they are.
+    """
+    out: list[list[tuple[float, str, str, int]]] = []
     for a in anchors:
-        if out and a[0] - out[-1][-1][0] < MERGE_TOLERANCE:
-            out[-1].append(a)
+        group = out[-1] if out else None
+        if (
+            group is not None
+            and a[0] - group[0][0] < MERGE_TOLERANCE
+            and all(g[3] != a[3] for g in group)
+        ):
+            group.append(a)
         else:
             out.append([a])
     return out
