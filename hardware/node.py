@@ -82,8 +82,11 @@ class Cancelled(Exception):  # noqa: N818 - raised out of run_tree to end a run
 
 
 def read_parameters(node) -> dict[str, Any]:
-    """Declare every parameter of ``PARAMETERS`` on ``node`` and return their values."""
-    return declare_parameters(node, PARAMETERS)
+    """Declare every parameter of ``PARAMETERS`` on ``node`` and return their values,
+    checked against their ranges (hardware/param_limits.py)."""
+    from pmnav_bt.hardware.param_limits import check_parameters
+
+    return check_parameters(declare_parameters(node, PARAMETERS))
 
 
 def declare_parameters(node, spec: dict[str, tuple[Any, str]]) -> dict[str, Any]:
