@@ -31,7 +31,7 @@ MAX_BYTES = {
     "config": 1 << 20,
     "episodes": 64 << 20,
     "ros_map": 1 << 20,
-    "tree log": 1 << 30,
+    "tree log": 256 << 20,
     "image": 256 << 20,
     "weights": 4 << 30,
 }
@@ -228,7 +228,7 @@ def parse_yaml_value(raw: str, what: str) -> Any:
 # -- JSON ------------------------------------------------------------------------------
 
 
-def check_json_depth(text: str, path: str | Path, limit: int = MAX_DEPTH) -> None:
+def check_json_depth(text: str, path: str | Path, limit: int = MAX_DEPTH, where: str = "") -> None:
     """Refuse JSON nested deeper than ``limit`` (counted on brackets outside strings)."""
     # Strip strings first (escapes included), then count brackets.
     stripped = _JSON_STRING.sub('""', text)
@@ -237,7 +237,7 @@ def check_json_depth(text: str, path: str | Path, limit: int = MAX_DEPTH) -> Non
         if m.group() in "[{":
             depth += 1
             if depth > limit:
-                raise InputFileError(path, f"nested deeper than {limit} levels")
+                raise InputFileError(path, f"nested deeper than {limit} levels", where)
         else:
             depth -= 1
 
@@ -261,7 +261,7 @@ def _no_constants(name: str) -> Any:
 
 def parse_json(text: str, path: str | Path, where: str = "", allow_nan: bool = False) -> Any:
     """JSON text to plain data: bounded depth, no duplicate keys, no NaN/Infinity."""
-    check_json_depth(text, path)
+    check_json_depth(text, path, where=where)
     extra = {} if allow_nan else {"parse_constant": _no_constants}
     try:
         return json.loads(text, object_pairs_hook=_no_duplicates, **extra)
