@@ -170,7 +170,7 @@ class PmNavController:
         overrides = [s.strip() for s in str(p["overrides"]).split(";") if s.strip()]
         if p["tick_hz"] > 0:
             overrides.append(f"tree.tick_hz={float(p['tick_hz'])}")
-        self.config = load_config(p["config"] or None, overrides)
+        self.config = load_config(p["config"] or None, overrides, label="parameter 'overrides'")
         if self.config.grounder.backend == "sim_gt" and not p["segmentation_topic"]:
             raise PmNavError(
                 "grounder.backend 'sim_gt' reads the simulator's segmentation, but the "

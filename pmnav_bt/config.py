@@ -133,18 +133,24 @@ class Config(_Section):
     sim: SimConfig = SimConfig()
 
 
-def _set_dotted(data: dict, key: str, value: Any) -> None:
+def _set_dotted(data: dict, key: str, value: Any, label: str = "--set") -> None:
     parts = key.split(".")
+    if len(parts) > 4 or len(key) > 200 or not all(parts):
+        raise ConfigError(f"{label} {_short(key)}: expected section.key")
     d = data
     for p in parts[:-1]:
         d = d.setdefault(p, {})
         if not isinstance(d, dict):
-            raise ConfigError(f"--set {_short(key)}: {_short(p)!r} is not a section")
+            raise ConfigError(f"{label} {_short(key)}: {_short(p)!r} is not a section")
     d[parts[-1]] = value
 
 
-def load_config(path: str | Path | None = None, overrides: list[str] | tuple = ()) -> Config:
-    """The configuration from ``path`` (optional) with ``key=value`` overrides applied."""
+def load_config(
+    path: str | Path | None = None, overrides: list[str] | tuple = (), label: str = "--set"
+) -> Config:
+    """The configuration from ``path`` (optional) with ``key=value`` overrides applied.
+
+    ``label`` names where overrides come from in errors (``--set``, a ROS parameter)."""
     data: Any = {}
     source = str(path) if path else "<defaults>"
     if path:
@@ -160,14 +166,14 @@ def load_config(path: str | Path | None = None, overrides: list[str] | tuple = (
     for item in overrides:
         key, sep, raw = str(item).partition("=")
         if not sep or not key.strip():
-            raise ConfigError(f"--set {_short(item)}: expected section.key=value")
+            raise ConfigError(f"{label} {_short(item)}: expected section.key=value")
         try:
-            value = parse_yaml_value(raw, f"--set {_short(item)}")
+            value = parse_yaml_value(raw, f"{label} {_short(item)}")
         except PmNavError as err:
             raise ConfigError(str(err)) from None
         if isinstance(value, str) and _NUMBER.fullmatch(value.strip()):
             value = float(value)  # YAML 1.1 reads 1e3 as text; on the command line it is a number
-        _set_dotted(data, key.strip(), value)
+        _set_dotted(data, key.strip(), value, label)
         set_keys.add(key.strip())
     try:
         return Config.model_validate(data)
@@ -175,7 +181,7 @@ def load_config(path: str | Path | None = None, overrides: list[str] | tuple = (
         e = err.errors()[0]
         where = ".".join(str(p) for p in e["loc"])
         if where in set_keys:
-            source = "--set"
+            source = label
         more = f" (and {len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
         msg = e["msg"].removeprefix("Value error, ")
         got = e.get("input")
