@@ -145,5 +145,7 @@ def run_cli(app: Callable, argv: list[str] | None, prog: str, format_error: Call
 
 def _die(prog: str, message: str, code: int) -> None:
     line = " ".join(str(message).split())  # one line, whatever the message held
+    if len(line) > 1000:  # a message quoting a 100,000-character value
+        line = line[:997] + "..."
     print(f"{prog}: error: {line}", file=sys.stderr)
     sys.exit(code)
