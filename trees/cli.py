@@ -90,9 +90,13 @@ def render(
     ),
 ) -> None:
     """Draw the PM-Nav tree as .dot, .svg and .png (the real tree, or one from a tree log)."""
+    from pmnav_bt.loading import check_output_dir, safe_filename
     from pmnav_bt.trees.render import render_log_tick, render_tree
 
     fmts = _formats(formats)
+    check_output_dir(out)
+    if name is not None:
+        name = safe_filename(name)
     rankdir = rankdir.upper()
     if rankdir not in ("TB", "LR", "BT", "RL"):
         raise PmNavError(f"--rankdir {rankdir!r}: choose TB or LR")
@@ -108,7 +112,7 @@ def render(
         written = render_log_tick(
             replay.nodes,
             out,
-            name or log.stem + (f"_tick{tick}" if tick is not None else ""),
+            name or safe_filename(log.stem) + (f"_tick{tick}" if tick is not None else ""),
             record,
             formats=fmts,
             rankdir=rankdir,
