@@ -9,6 +9,10 @@ from dataclasses import dataclass
 class PmNavError(Exception):
     """Base class of errors a user can cause; the CLI prints them in one line."""
 
+    def __str__(self) -> str:
+        # One line whatever user text (a file name with a newline, say) the message quotes.
+        return " ".join(super().__str__().split())
+
 
 @dataclass(frozen=True)
 class Problem:

@@ -225,6 +225,14 @@ def parse_yaml_value(raw: str, what: str) -> Any:
         ) from None
 
 
+def weights_file(path: str | Path) -> Path:
+    """A model weights file (for safetensors or ``torch.load(weights_only=True)``), checked
+    to be a regular file within the size limit before any loader opens it."""
+    path = Path(path)
+    _stat_regular(path, "weights")
+    return path
+
+
 # -- JSON ------------------------------------------------------------------------------
 
 

@@ -14,6 +14,8 @@ import time
 import pytest
 from fuzzkit import TRIED, one_line
 
+pytestmark = pytest.mark.timeout(180)  # bounded time, whatever regresses
+
 
 def _session(sid: int) -> list[int]:
     """Live (non-zombie) processes of session ``sid``."""

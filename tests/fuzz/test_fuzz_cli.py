@@ -6,9 +6,12 @@ range, not finite, not numbers), so no command gets as far as running episodes.
 
 from __future__ import annotations
 
+import pytest
 from fuzzkit import TRIED, one_line, pmnav_cli
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+
+pytestmark = pytest.mark.timeout(120)  # bounded time, whatever regresses
 
 FUZZ = settings(
     max_examples=100,

@@ -26,6 +26,8 @@ from pmnav_bt.map.floorplan import FloorPlanError, load_ros_map, read_image
 from pmnav_bt.sim.episodes import EpisodeFileError, load_episodes
 from pmnav_bt.treelog import read_tree_log
 
+pytestmark = pytest.mark.timeout(120)  # bounded time, whatever regresses
+
 FUZZ = settings(
     max_examples=150,
     deadline=None,

@@ -19,6 +19,8 @@ from fuzzkit import TRIED, assert_clean_failure, one_line, pmnav_cli, pmnav_subp
 
 from pmnav_bt.map.building import BUILTIN_DIR
 
+pytestmark = pytest.mark.timeout(120)  # bounded time, whatever regresses
+
 OFFICE = yaml.safe_load((BUILTIN_DIR / "straight_office.yaml").read_text())
 
 

@@ -15,7 +15,10 @@ from fuzzkit import TRIED, assert_clean_failure
 
 from pmnav_bt.hardware.env import domain_id_for, rclpy_available, ros_env
 
-pytestmark = pytest.mark.skipif(not rclpy_available()[0], reason="ROS 2 (rclpy) not installed")
+pytestmark = [
+    pytest.mark.skipif(not rclpy_available()[0], reason="ROS 2 (rclpy) not installed"),
+    pytest.mark.timeout(120),
+]
 
 
 @pytest.mark.parametrize(
