@@ -476,3 +476,20 @@ def test_doors_along_one_wall_never_chain():
     for i in range(10):
         x, _ = pm.nodes[node_of[f"room{i}"]].pos
         assert abs(x - (10 + 0.5 * i)) < 0.15  # no plan off by metres
+
+
+def test_run_files_stay_in_out_whatever_the_episode_id(tmp_path):
+    """The tree log and plot of `sim run` are named after the episode id (building name and
+    goal): `../../..` in it never reaches outside --out."""
+    from dataclasses import replace
+
+    from pmnav_bt.config import load_config
+    from pmnav_bt.experiments.evaluation import custom_episode, run_episode
+
+    TRIED["issue examples: in-process CLI"] += 1
+    ep = replace(custom_episode("straight_office", "room1"), id="../../../evil/x")
+    out = tmp_path / "a" / "out"
+    r = run_episode(ep, load_config(), out_dir=out)
+    assert r.tree_log.parent == out and r.plot.parent == out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a"]
+    assert sorted(p.name for p in (tmp_path / "a").iterdir()) == ["out"]
