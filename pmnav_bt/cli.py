@@ -7,6 +7,7 @@ with status 2; ``pmnav validate`` exits 1 when the file has problems.
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import typer
@@ -134,6 +135,29 @@ def plan(
         typer.echo(f"wrote {image}", err=True)
 
 
+@app.command("map-draft")
+def map_draft(
+    grid: Path = typer.Argument(..., help="A ROS map_server YAML (its PGM beside it)."),
+    out: Path = typer.Option(..., "-o", "--out", help="The building file to write."),
+    name: str | None = typer.Option(None, help="Building name (default: the grid's file name)."),
+    image: Path | None = typer.Option(None, "--image", help="Draw the extraction steps here."),
+) -> None:
+    """Draft a building file from an occupancy grid (also: 'pmnav map draft GRID -o FILE')."""
+    from pmnav_bt.map.draft import draft_building, draw_steps
+    from pmnav_bt.map.floorplan import load_ros_map
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    b, d, text = draft_building(grid, out, name=name)
+    out.write_text(text, encoding="utf-8")
+    if image is not None:
+        draw_steps(load_ros_map(grid), d, image)
+    typer.echo(
+        f"wrote {out}: {len(b.waypoints)} key waypoints, {len(b.edges)} corridors, "
+        f"{len(b.rooms)} door candidates, {len(d.open_areas)} open area(s); "
+        "fill in the todo notes, then 'pmnav validate'"
+    )
+
+
 def _mount_subcommands() -> None:
     # Both import only typer at module level: pybullet and py_trees load inside commands.
     from pmnav_bt.sim.cli import app as sim_app
@@ -152,7 +176,10 @@ def _error_line(err: PmNavError) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the app; user errors become one line on stderr and exit status 2."""
-    run_cli(app, argv, "pmnav", _error_line)
+    args = list(sys.argv[1:] if argv is None else argv)
+    if args[:2] == ["map", "draft"]:  # 'pmnav map FILE' is a command, so draft is map-draft
+        args = ["map-draft", *args[2:]]
+    run_cli(app, args, "pmnav", _error_line)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,687 @@
+"""Draft a building file from a ROS map_server occupancy grid.
+
+The steps (each a function, so a person can look at every stage; run
+``python -m pmnav_bt.map.draft GRID.yaml -o building.yaml --image steps.png``):
+
+1. **Free space**: map_server's free cells, the largest connected part.
+2. **Corridor space**: the free space opened by a disc a little wider than a door,
+   so door gaps and rooms fall away; the largest part left is the corridor network.
+3. **Skeleton** of the corridor space (scikit-image), traced into a graph of pixel
+   paths between junctions and ends; spurs shorter than the local half width plus
+   ``spur_m`` are pruned and straight-through nodes merged.
+4. **Open areas**: skeleton stretches wider than ``open_width_m`` (a lobby, a hall)
+   are flagged and left out of the corridors, for the person to decide.
+5. **Straight lines**: each path is split by Douglas-Peucker into straight pieces;
+   every piece is fitted by total least squares, and every key waypoint moved to the
+   least-squares crossing of its corridors' lines (so it sits on the centre lines).
+6. **Widths** from the distance transform along the middle of each corridor.
+7. **Door candidates**: runs along each annotated corridor wall where the wall is
+   open and free space lies behind it, as wide as a door; each is placed exactly on
+   the annotated wall (half the corridor width from the centre line).
+
+What a grid cannot tell (room names, sign texts, closed doors, which end is the
+entrance) is left for the person and marked ``todo`` in the file's comments.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import cv2
+import networkx as nx
+import numpy as np
+
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
+from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map
+
+
+class DraftError(PmNavError):
+    """The grid holds no corridor network the draft can use."""
+
+
+@dataclass(frozen=True)
+class DraftParams:
+    """Knobs of the extraction, in metres."""
+
+    door_max_m: float = 1.6  # a wall opening wider than this is not a door
+    door_min_m: float = 0.6  # narrower than this is noise, not a door
+    behind_m: float = 0.4  # free space needed this far behind the wall for a door
+    spur_m: float = 0.6  # prune spurs shorter than the local half width + this
+    line_tol_m: float = 0.35  # Douglas-Peucker tolerance for straight pieces
+    open_width_m: float = 6.0  # a stretch wider than this is an open area, not a corridor
+    min_edge_m: float = 0.8  # merge key waypoints closer than this
+    clean_m: float = 0.1  # close free-space holes smaller than this (laser speckle)
+    clutter_m: float = 1.25  # fill obstacles no longer than this in free space (bins, desks)
+
+
+@dataclass
+class OpenArea:
+    """A free area too wide to be a corridor: its bounding box in the map frame."""
+
+    xmin: float
+    ymin: float
+    xmax: float
+    ymax: float
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        return (self.xmin + self.xmax) / 2.0, (self.ymin + self.ymax) / 2.0
+
+
+@dataclass
+class Draft:
+    """The result: plain building data plus what the person must look at."""
+
+    waypoints: list[dict]
+    edges: list[dict]
+    rooms: list[dict]
+    open_areas: list[OpenArea] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    # Stages, for pictures (pixel masks and the skeleton graph).
+    free: np.ndarray | None = None
+    corridor: np.ndarray | None = None
+    skeleton: np.ndarray | None = None
+
+    def building_data(self, name: str, ros_map: str, kind: str = "building") -> dict:
+        widths = [e["width"] for e in self.edges]
+        return {
+            "schema_version": SCHEMA_VERSION,
+            "name": name,
+            "kind": kind,
+            "description": "Drafted from an occupancy grid by 'pmnav map draft'.",
+            "corridor_width": round(float(np.median(widths)), 2) if widths else 2.4,
+            "floor_plan": {"ros_map": ros_map},
+            "waypoints": self.waypoints,
+            "edges": self.edges,
+            "rooms": self.rooms,
+        }
+
+
+# -- masks ----------------------------------------------------------------------------
+
+
+def free_mask(plan: FloorPlanImage, params: DraftParams = DraftParams()) -> np.ndarray:
+    """map_server's free cells (bool, rows as in the image), specks closed, largest part only."""
+    free = (plan.occupancy() == 0).astype(np.uint8)
+    k = max(1, round(params.clean_m / plan.resolution))
+    if k > 1:
+        free = cv2.morphologyEx(free, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
+    free = _largest_component(free)
+    # Small islands of non-free cells enclosed by free space are clutter, not walls.
+    n, lab, stats, _ = cv2.connectedComponentsWithStats((~free).astype(np.uint8), connectivity=8)
+    h, w = free.shape
+    small = params.clutter_m / plan.resolution
+    for i in range(1, n):
+        x, y, bw, bh, _ = stats[i]
+        inside = x > 0 and y > 0 and x + bw < w and y + bh < h
+        if inside and max(bw, bh) <= small:
+            free[lab == i] = True
+    return free
+
+
+def corridor_mask(free: np.ndarray, resolution: float, params: DraftParams) -> np.ndarray:
+    """The free space without door gaps and the rooms behind them.
+
+    Eroding by a disc wider than a door cuts every door gap (even in a wall one pixel
+    thin); the largest eroded part, grown back by the same disc within the free
+    space, is the corridor network.
+    """
+    r = round(params.door_max_m / 2.0 / resolution) + 1
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1,) * 2)
+    core = _largest_component(cv2.erode(free.astype(np.uint8), disc))
+    return cv2.dilate(core.astype(np.uint8), disc).astype(bool) & free
+
+
+def _largest_component(mask: np.ndarray) -> np.ndarray:
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=4)
+    if n <= 1:
+        return np.zeros(mask.shape, bool)
+    best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    return lab == best
+
+
+# -- skeleton graph ---------------------------------------------------------------------
+
+
+def skeleton_graph(skel: np.ndarray) -> nx.MultiGraph:
+    """Junctions and ends of a one-pixel skeleton as nodes; edges carry their pixel ``path``.
+
+    Node positions (``rc``) are (row, col) floats; a node of several touching junction
+    pixels is their mean.
+    """
+    rows, cols = np.nonzero(skel)
+    pix = set(zip(rows.tolist(), cols.tolist(), strict=True))
+    nbrs: dict[tuple[int, int], list[tuple[int, int]]] = {}
+    for r, c in pix:
+        ortho = [(r + dr, c + dc) for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1))]
+        ortho = [q for q in ortho if q in pix]
+        out = list(ortho)
+        for dr, dc in ((-1, -1), (-1, 1), (1, -1), (1, 1)):
+            q = (r + dr, c + dc)
+            # A diagonal step is redundant when an orthogonal pixel already links the two.
+            if q in pix and (r + dr, c) not in pix and (r, c + dc) not in pix:
+                out.append(q)
+        nbrs[(r, c)] = out
+    is_node = {p for p, n in nbrs.items() if len(n) != 2}
+    # Cluster touching node pixels into one node.
+    node_of: dict[tuple[int, int], int] = {}
+    g = nx.MultiGraph()
+    for p in is_node:
+        if p in node_of:
+            continue
+        k = g.number_of_nodes()
+        stack, members = [p], []
+        node_of[p] = k
+        while stack:
+            q = stack.pop()
+            members.append(q)
+            for s in nbrs[q]:
+                if s in is_node and s not in node_of:
+                    node_of[s] = k
+                    stack.append(s)
+        g.add_node(k, rc=np.mean(members, axis=0))
+    seen: set[frozenset] = set()
+    for p in is_node:
+        for q in nbrs[p]:
+            if q in is_node or frozenset((p, q)) in seen:
+                continue
+            path, prev, cur = [p, q], p, q
+            seen.add(frozenset((p, q)))
+            while cur not in is_node:
+                nxt = [s for s in nbrs[cur] if s != prev]
+                if not nxt:
+                    break
+                prev, cur = cur, nxt[0]
+                seen.add(frozenset((prev, cur)))
+                path.append(cur)
+            if cur in is_node:
+                g.add_edge(node_of[p], node_of[cur], path=np.array(path, float))
+    # Direct node-to-node steps (adjacent clusters were merged, so none are left) and
+    # closed loops with no node at all: cut each loop at its first pixel.
+    left = {p for p in pix if p not in is_node} - {q for e in seen for q in e}
+    while left:
+        p = min(left)
+        k = g.number_of_nodes()
+        g.add_node(k, rc=np.array(p, float))
+        path, prev, cur = [p], None, p
+        while True:
+            nxt = [s for s in nbrs[cur] if s != prev and s in left | {p}]
+            if not nxt or (nxt[0] == p and len(path) > 2):
+                path.append(p)
+                break
+            prev, cur = cur, nxt[0]
+            path.append(cur)
+            if cur == p:
+                break
+        left -= set(path)
+        if len(path) > 3:
+            g.add_edge(k, k, path=np.array(path, float))
+    return g
+
+
+def _path_len(path: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+
+
+def prune_and_merge(g: nx.MultiGraph, dist: np.ndarray, spur_px: float) -> nx.MultiGraph:
+    """Remove short spurs (end to junction) and merge nodes that became pass-throughs."""
+    changed = True
+    while changed:
+        changed = False
+        for u, v, k, d in list(g.edges(keys=True, data=True)):
+            if u == v or not g.has_edge(u, v, k):
+                continue
+            du, dv = g.degree(u), g.degree(v)
+            if (du == 1) == (dv == 1):
+                continue
+            end, junction = (u, v) if du == 1 else (v, u)
+            rc = g.nodes[junction]["rc"].round().astype(int)
+            limit = dist[rc[0], rc[1]] + spur_px
+            if _path_len(d["path"]) < limit:
+                g.remove_edge(u, v, k)
+                g.remove_node(end)
+                changed = True
+        for n in list(g.nodes):
+            if g.degree(n) == 2 and g.number_of_edges(n, n) == 0:
+                (a, b, ka, da), (c, e, kc, dc) = list(g.edges(n, keys=True, data=True))
+                other1, other2 = (b if a == n else a), (e if c == n else c)
+                p1 = _oriented(da["path"], g.nodes[n]["rc"], to_node=True)
+                p2 = _oriented(dc["path"], g.nodes[n]["rc"], to_node=False)
+                g.remove_node(n)
+                g.add_edge(other1, other2, path=np.vstack([p1, p2[1:]]))
+                changed = True
+    g.remove_nodes_from([n for n in list(g.nodes) if g.degree(n) == 0])
+    return g
+
+
+def _oriented(path: np.ndarray, rc: np.ndarray, to_node: bool) -> np.ndarray:
+    """The path running towards (or away from) the node at ``rc``."""
+    ends_here = np.linalg.norm(path[-1] - rc) <= np.linalg.norm(path[0] - rc)
+    if ends_here != to_node:
+        path = path[::-1]
+    return path
+
+
+# -- open areas -------------------------------------------------------------------------
+
+
+def open_area_mask(corridor: np.ndarray, dist_px: np.ndarray, res: float, params: DraftParams):
+    """Corridor-space pixels belonging to areas wider than ``open_width_m``."""
+    core = (dist_px * 2.0 - 1.0) * res > params.open_width_m
+    if not core.any():
+        return np.zeros(corridor.shape, bool)
+    r = round(params.open_width_m / 2.0 / res)
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1,) * 2)
+    return cv2.dilate(core.astype(np.uint8), disc).astype(bool) & corridor
+
+
+def _boxes(mask: np.ndarray, plan: FloorPlanImage) -> list[OpenArea]:
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+    out = []
+    for i in range(1, n):
+        x, y, w, h = (int(v) for v in stats[i, :4])
+        corners = plan.pixel_to_world([[x - 0.5, y - 0.5], [x + w - 0.5, y + h - 0.5]])
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        out.append(OpenArea(*(round(float(v), 2) for v in (lo[0], lo[1], hi[0], hi[1]))))
+    out.sort(key=lambda a: -(a.xmax - a.xmin) * (a.ymax - a.ymin))
+    return out
+
+
+# -- straight corridors -----------------------------------------------------------------
+
+
+def _split_straight(g: nx.MultiGraph, tol_px: float) -> nx.Graph:
+    """Each skeleton path cut into straight pieces (Douglas-Peucker); a simple graph."""
+    from skimage.measure import approximate_polygon
+
+    h = nx.Graph()
+    for n, d in g.nodes(data=True):
+        h.add_node(n, rc=d["rc"])
+    nxt = max(g.nodes, default=-1) + 1
+    for u, v, d in g.edges(data=True):
+        path = _oriented(d["path"], g.nodes[u]["rc"], to_node=False)
+        verts = approximate_polygon(path, tol_px)
+        # Indices of the kept vertices along the path.
+        idx = [int(np.argmin(np.linalg.norm(path - q, axis=1))) for q in verts]
+        idx = sorted(set([0, *idx, len(path) - 1]))
+        if u == v and len(idx) < 4:  # a loop needs at least three sides
+            idx = sorted(set([0, len(path) // 3, 2 * len(path) // 3, len(path) - 1]))
+        chain = [u]
+        for i in idx[1:-1]:
+            h.add_node(nxt, rc=path[i])
+            chain.append(nxt)
+            nxt += 1
+        chain.append(v)
+        for k, (a, b) in enumerate(zip(chain, chain[1:], strict=False)):
+            piece = path[idx[k] : idx[k + 1] + 1]
+            if a == b or h.has_edge(a, b):
+                continue
+            h.add_edge(a, b, path=piece)
+    return h
+
+
+def _merge_close(h: nx.Graph, dist: np.ndarray, min_px: float) -> nx.Graph:
+    """Contract corridor pieces shorter than ``min_px`` or than the corridor is wide.
+
+    A piece shorter than its width (a chamfer at a corner, a kink at a junction) is
+    no corridor a robot could follow; its two ends become one waypoint.
+    """
+
+    def width_px(n) -> float:
+        r, c = np.clip(h.nodes[n]["rc"].round().astype(int), 0, np.array(dist.shape) - 1)
+        return 2.0 * float(dist[r, c])
+
+    changed = True
+    while changed:
+        changed = False
+        for u, v in list(h.edges):
+            limit = max(min_px, 0.8 * min(width_px(u), width_px(v)))
+            if np.linalg.norm(h.nodes[u]["rc"] - h.nodes[v]["rc"]) >= limit:
+                continue
+            keep, drop = (u, v) if h.degree(u) >= h.degree(v) else (v, u)
+            for w in list(h.neighbors(drop)):
+                if w != keep and not h.has_edge(keep, w):
+                    h.add_edge(keep, w, path=h.edges[drop, w]["path"])
+            h.remove_node(drop)
+            changed = True
+            break
+    return h
+
+
+def _fit_lines(h: nx.Graph, world: dict, dist_m: dict) -> dict:
+    """Per edge, (centroid, unit direction) of a total-least-squares line through its middle."""
+    lines = {}
+    for u, v, d in h.edges(data=True):
+        pts = d["world"]
+        pu, pv = world[u], world[v]
+        trim_u = dist_m.get(u, 0.0) + 0.2
+        trim_v = dist_m.get(v, 0.0) + 0.2
+        far_u = np.linalg.norm(pts - pu, axis=1) > trim_u
+        keep = far_u & (np.linalg.norm(pts - pv, axis=1) > trim_v)
+        sel = pts[keep] if keep.sum() >= 5 else np.array([pu, pv])
+        c = sel.mean(axis=0)
+        if len(sel) >= 3:
+            _, _, vt = np.linalg.svd(sel - c)
+            direc = vt[0]
+        else:
+            direc = (pv - pu) / max(np.linalg.norm(pv - pu), 1e-9)
+        if np.dot(direc, pv - pu) < 0:
+            direc = -direc
+        lines[(u, v)] = lines[(v, u)] = (c, direc)
+    return lines
+
+
+def _place_nodes(h: nx.Graph, world: dict, lines: dict) -> dict:
+    """Each key waypoint at the least-squares crossing of its corridors' centre lines."""
+    out = {}
+    for n in h.nodes:
+        ls = [lines[(n, m)] for m in h.neighbors(n)]
+        dirs = [d for _, d in ls]
+        crossing = any(
+            abs(float(a[0] * b[1] - a[1] * b[0])) > math.sin(math.radians(20))
+            for i, a in enumerate(dirs)
+            for b in dirs[i + 1 :]
+        )
+        p0 = world[n]
+        if crossing:
+            a = np.zeros((2, 2))
+            b = np.zeros(2)
+            for c, d in ls:
+                m = np.eye(2) - np.outer(d, d)
+                a += m
+                b += m @ c
+            p = np.linalg.solve(a, b)
+            out[n] = p if np.linalg.norm(p - p0) < 3.0 else p0
+        else:  # an end, or nearly straight: project onto the lines
+            out[n] = np.mean([c + d * np.dot(p0 - c, d) for c, d in ls], axis=0)
+    return out
+
+
+# -- doors ----------------------------------------------------------------------------
+
+
+def _is_free(plan: FloorPlanImage, free: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    cell = plan.world_to_cell(pts)
+    ok = (cell >= 0).all(axis=1) & (cell[:, 0] < plan.width) & (cell[:, 1] < plan.height)
+    out = np.zeros(len(pts), bool)
+    out[ok] = free[cell[ok, 1], cell[ok, 0]]
+    return out
+
+
+def door_candidates(
+    plan: FloorPlanImage,
+    free: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    width: float,
+    margins: tuple[float, float],
+    params: DraftParams,
+) -> list[tuple[float, int]]:
+    """Door-wide openings in both walls of the corridor a-b, with free space behind them.
+
+    Returns (distance along from ``a``, side) pairs; side +1 is left of a->b.
+    """
+    length = float(np.linalg.norm(b - a))
+    u = (b - a) / length
+    n = np.array([-u[1], u[0]])
+    step = plan.resolution / 2.0
+    s = np.arange(margins[0], length - margins[1], step)
+    if len(s) == 0:
+        return []
+    res = plan.resolution
+    offs = np.arange(width / 2.0 + res, width / 2.0 + params.behind_m + 1e-9, res)
+    found = []
+    for side in (1, -1):
+        pts = a + s[:, None, None] * u + side * offs[None, :, None] * n
+        open_ = _is_free(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(offs)).all(axis=1)
+        for lo, hi in _runs(open_):
+            run = (hi - lo) * step
+            if params.door_min_m <= run <= params.door_max_m:
+                found.append((float((s[lo] + s[hi - 1]) / 2.0), side))
+    return found
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """[lo, hi) index ranges of the True runs."""
+    d = np.diff(np.concatenate([[0], flags.astype(int), [0]]))
+    return list(zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0], strict=True))
+
+
+# -- the whole draft --------------------------------------------------------------------
+
+
+def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -> Draft:
+    """Corridors, widths, key waypoints, open areas and door candidates from a grid."""
+    from skimage.morphology import skeletonize
+
+    res = plan.resolution
+    if abs(plan.origin[2]) > 1e-9:
+        raise DraftError(f"{plan.source}: origin yaw must be 0 for a draft (got {plan.origin[2]})")
+    free = free_mask(plan, params)
+    if not free.any():
+        raise DraftError(f"{plan.source}: the grid has no free cells")
+    corridor = corridor_mask(free, res, params)
+    if not corridor.any():
+        raise DraftError(
+            f"{plan.source}: no free area wider than a door ({params.door_max_m} m); "
+            "check resolution and the free/occupied thresholds"
+        )
+    dist = cv2.distanceTransform(free.astype(np.uint8), cv2.DIST_L2, 5)
+    open_mask = open_area_mask(corridor, dist, res, params)
+    skel = skeletonize(corridor) & ~open_mask
+    g = skeleton_graph(skel)
+    g = prune_and_merge(g, dist, params.spur_m / res)
+    if g.number_of_edges() == 0:
+        raise DraftError(f"{plan.source}: no corridor found in the free space")
+    h = _split_straight(g, params.line_tol_m / res)
+    h = _merge_close(h, dist, params.min_edge_m / res)
+    notes = []
+    parts = sorted(nx.connected_components(h), key=len, reverse=True)
+    if len(parts) > 1:
+        notes.append(f"{len(parts) - 1} small corridor part(s) apart from the rest were left out")
+        h = h.subgraph(parts[0]).copy()
+    h.remove_edges_from(nx.selfloop_edges(h))
+
+    def to_world(rc: np.ndarray) -> np.ndarray:
+        return plan.pixel_to_world(np.asarray(rc).reshape(-1, 2)[:, ::-1])
+
+    world = {n: to_world(d["rc"])[0] for n, d in h.nodes(data=True)}
+    half = {}
+    for n, d in h.nodes(data=True):
+        r, c = np.clip(d["rc"].round().astype(int), 0, np.array(free.shape) - 1)
+        half[n] = (float(dist[r, c]) - 0.5) * res
+    for _, _, d in h.edges(data=True):
+        d["world"] = to_world(d["path"])
+        rc = d["path"].round().astype(int)
+        d["half"] = (dist[rc[:, 0], rc[:, 1]] - 0.5) * res
+    lines = _fit_lines(h, world, half)
+    pos = _place_nodes(h, world, lines)
+
+    # Widths from the distance transform along the middle of each corridor.
+    widths = {}
+    for u, v, d in h.edges(data=True):
+        pts, hw = d["world"], d["half"]
+        keep = (np.linalg.norm(pts - pos[u], axis=1) > half[u] + 0.2) & (
+            np.linalg.norm(pts - pos[v], axis=1) > half[v] + 0.2
+        )
+        vals = hw[keep] if keep.sum() >= 3 else hw
+        widths[frozenset((u, v))] = round(float(2.0 * np.median(vals)), 2)
+
+    open_areas = _boxes(open_mask, plan)
+    names = _name_nodes(h, pos, open_areas)
+    waypoints = [
+        {"id": names[n], "kind": _kind(h, n, names), "pos": [round(float(v), 2) for v in pos[n]]}
+        for n in sorted(h.nodes, key=lambda n: _order(names[n]))
+    ]
+    edges, rooms = [], []
+    for u, v in sorted(h.edges, key=lambda e: sorted((_order(names[e[0]]), _order(names[e[1]])))):
+        if _order(names[u]) > _order(names[v]):
+            u, v = v, u
+        w = widths[frozenset((u, v))]
+        edges.append({"from": names[u], "to": names[v], "width": w})
+        a, b = pos[u], pos[v]
+        margins = tuple(
+            max((widths[frozenset((x, m))] for m in h.neighbors(x) if m != y), default=-w) / 2.0
+            + 0.1
+            for x, y in ((u, v), (v, u))
+        )
+        uu = (b - a) / np.linalg.norm(b - a)
+        nn = np.array([-uu[1], uu[0]])
+        for s, side in door_candidates(plan, free, a, b, w, margins, params):
+            door = a + uu * s + side * nn * (w / 2.0)
+            xy = [round(float(x), 2) for x in door]
+            rooms.append({"id": f"room{len(rooms) + 1}", "door": xy})
+    return Draft(waypoints, edges, rooms, open_areas, notes, free, corridor, skel)
+
+
+def _name_nodes(h: nx.Graph, pos: dict, open_areas: list[OpenArea]) -> dict:
+    """start, endN, turnN, branchN; numbered top to bottom, left to right."""
+    order = sorted(h.nodes, key=lambda n: (-round(pos[n][1], 1), round(pos[n][0], 1)))
+    ends = [n for n in order if h.degree(n) == 1]
+    start = None
+    if ends:
+        if open_areas:  # the entrance is most likely where a corridor meets the lobby
+            c = np.array(open_areas[0].centre)
+            start = min(ends, key=lambda n: np.linalg.norm(pos[n] - c))
+        else:
+            start = ends[0]
+    names, counts = {}, {"end": 0, "turn": 0, "branch": 0}
+    for n in order:
+        if n == start:
+            names[n] = "start"
+            continue
+        kind = "end" if h.degree(n) == 1 else "turn" if h.degree(n) == 2 else "branch"
+        counts[kind] += 1
+        names[n] = f"{kind}{counts[kind]}"
+    return names
+
+
+def _kind(h: nx.Graph, n, names: dict) -> str:
+    if names[n] == "start":
+        return "start"
+    return {1: "end", 2: "turn"}.get(h.degree(n), "branch")
+
+
+def _order(name: str) -> tuple[int, int]:
+    rank = {"start": 0, "branch": 1, "turn": 2, "end": 3}
+    kind = name.rstrip("0123456789")
+    num = name[len(kind) :]
+    return rank.get(kind, 9), int(num) if num else 0
+
+
+# -- writing --------------------------------------------------------------------------
+
+
+def draft_building(
+    grid_yaml: str | Path,
+    out_path: str | Path,
+    name: str | None = None,
+    params: DraftParams = DraftParams(),
+) -> tuple[Building, Draft, str]:
+    """Draft a building file for ``out_path`` from a map_server YAML; (building, draft, text).
+
+    The floor plan is referenced relative to ``out_path``'s folder. The building is
+    validated before it is returned; nothing is written here.
+    """
+    grid_yaml, out_path = Path(grid_yaml), Path(out_path)
+    plan = load_ros_map(grid_yaml)
+    d = draft_from_plan(plan, params)
+    rel = os.path.relpath(grid_yaml.resolve(), out_path.resolve().parent)
+    data = d.building_data(name or grid_yaml.stem, Path(rel).as_posix())
+    base = out_path.parent if out_path.parent.is_dir() else None
+    b = building_from_data(data, str(out_path), base)
+    return b, d, draft_text(data, d, grid_yaml)
+
+
+def _flow(item: dict) -> str:
+    import yaml
+
+    return yaml.safe_dump(item, default_flow_style=True, sort_keys=False, width=10**6).strip()
+
+
+def draft_text(data: dict, d: Draft, source: Path) -> str:
+    """The building file, with ``todo`` comments for what the grid cannot tell."""
+    import yaml
+
+    head = {k: data[k] for k in ("schema_version", "name", "kind", "description", "corridor_width")}
+    lines = [
+        f"# Drafted by 'pmnav map draft' from {source.name}: a start, not a finished file.",
+        "# todo: give every room its name, aliases and the text on its sign; delete door",
+        "#       candidates that are not doors and add closed doors the grid cannot show;",
+        "#       add landmarks (elevators, stairs, desks, signs); check which end is 'start'.",
+        "# Then: pmnav validate THIS_FILE, and look at pmnav map THIS_FILE --image map.png.",
+    ]
+    for note in d.notes:
+        lines.append(f"# note: {note}")
+    for i, a in enumerate(d.open_areas):
+        lines.append(
+            f"# todo: open area {i + 1} (wider than a corridor) at x {a.xmin}..{a.xmax}, "
+            f"y {a.ymin}..{a.ymax}: left out of the corridors; add corridor edges across "
+            "it if the robot should use it"
+        )
+    lines.append(yaml.safe_dump(head, sort_keys=False, width=100).strip())
+    lines.append(f"floor_plan: {_flow(data['floor_plan'])}")
+    lines.append("waypoints:")
+    lines += [f"  - {_flow(w)}" for w in data["waypoints"]]
+    lines.append("edges:")
+    lines += [f"  - {_flow(e)}" for e in data["edges"]]
+    if data["rooms"]:
+        lines.append("rooms:  # door candidates: an opening in the corridor wall with space behind")
+        lines += [f"  - {_flow(r)}  # todo: name, sign" for r in data["rooms"]]
+    else:
+        lines.append("rooms: []  # todo: no door openings found; add the rooms by hand")
+    return "\n".join(lines) + "\n"
+
+
+# -- a picture of the steps -------------------------------------------------------------
+
+
+def draw_steps(plan: FloorPlanImage, d: Draft, path: str | Path) -> Path:
+    """The grid with the corridor space, skeleton, open areas, corridors and doors drawn."""
+    img = plan.bgr().copy()
+    tint = img.copy()
+    tint[d.corridor] = (200, 230, 200)
+    img = cv2.addWeighted(img, 0.5, tint, 0.5, 0)
+    img[d.skeleton] = (0, 140, 255)
+    for a in d.open_areas:
+        p = plan.world_to_pixel([[a.xmin, a.ymin], [a.xmax, a.ymax]]).round().astype(int)
+        cv2.rectangle(img, tuple(p[0]), tuple(p[1]), (200, 0, 200), 2)
+    pos = {w["id"]: np.array(w["pos"]) for w in d.waypoints}
+    for e in d.edges:
+        p = plan.world_to_pixel([pos[e["from"]], pos[e["to"]]]).round().astype(int)
+        cv2.line(img, tuple(p[0]), tuple(p[1]), (200, 60, 0), 2)
+    for w in d.waypoints:
+        p = plan.world_to_pixel([w["pos"]]).round().astype(int)[0]
+        cv2.circle(img, tuple(p), 5, (0, 0, 220), -1)
+    for r in d.rooms:
+        p = plan.world_to_pixel([r["door"]]).round().astype(int)[0]
+        cv2.drawMarker(img, tuple(p), (0, 160, 0), cv2.MARKER_TILTED_CROSS, 9, 2)
+    path = Path(path)
+    cv2.imwrite(str(path), img)
+    return path
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m pmnav_bt.map.draft GRID.yaml -o building.yaml [--image steps.png]``."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("grid")
+    ap.add_argument("-o", "--out", required=True)
+    ap.add_argument("--image")
+    args = ap.parse_args(argv)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    b, d, text = draft_building(args.grid, args.out)
+    Path(args.out).write_text(text, encoding="utf-8")
+    if args.image:
+        draw_steps(load_ros_map(args.grid), d, args.image)
+    n = f"{len(b.waypoints)} waypoints, {len(b.edges)} corridors, {len(b.rooms)} door candidates"
+    print(f"wrote {args.out}: {n}")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

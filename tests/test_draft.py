@@ -1,0 +1,85 @@
+"""Draft extraction: grids rasterised from the built-in buildings give back their corridors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pmnav_bt.map.building import builtin_buildings, load_building
+from pmnav_bt.map.draft import DraftError, draft_building
+from pmnav_bt.map.floorplan import FloorPlanImage, rasterize_building, save_ros_map
+
+
+def _draft(name, tmp_path):
+    truth = load_building(name)
+    grid = save_ros_map(rasterize_building(truth), tmp_path / f"{name}.yaml")
+    drafted, draft, text = draft_building(grid, tmp_path / "out" / "building.yaml")
+    return truth, drafted, draft, text
+
+
+@pytest.mark.parametrize("name", builtin_buildings())
+def test_draft_recovers_builtin_building(name, tmp_path):
+    truth, got, _, _ = _draft(name, tmp_path)
+    dp = {w.id: np.array(w.pos) for w in got.waypoints}
+    match = {}
+    for w in truth.waypoints:
+        near = min(dp, key=lambda k: np.linalg.norm(dp[k] - w.pos))
+        assert np.linalg.norm(dp[near] - w.pos) <= 0.5, f"{w.id} at {w.pos}: nearest {near}"
+        match[w.id] = near
+    assert len(set(match.values())) == len(truth.waypoints) == len(got.waypoints)
+    want = {frozenset((match[e.a], match[e.b])): truth.edge_width(e) for e in truth.edges}
+    have = {frozenset((e.a, e.b)): got.edge_width(e) for e in got.edges}
+    assert set(want) == set(have), "corridor graph topology differs"
+    for k, w in want.items():
+        assert abs(have[k] - w) <= 0.3, f"width of {sorted(k)}: {have[k]} vs {w}"
+    for w in truth.waypoints:
+        assert got.waypoint(match[w.id]).kind.value in (w.kind.value, "start", "end") or (
+            w.kind.value in ("start", "end")
+        )
+    t = np.array([r.door for r in truth.rooms])
+    d = np.array([r.door for r in got.rooms]).reshape(-1, 2)
+    dist = np.linalg.norm(t[:, None] - d[None], axis=2)
+    recall = (dist.min(axis=1) < 0.5).mean()
+    precision = (dist.min(axis=0) < 0.5).mean() if len(d) else 0.0
+    assert recall >= 0.9 and precision >= 0.9, (precision, recall)
+
+
+def test_doors_lie_exactly_on_the_annotated_wall(tmp_path):
+    _, got, _, _ = _draft("t_school", tmp_path)
+    from pmnav_bt.map.floorplan import door_frames
+
+    for f in door_frames(got):
+        off = np.dot(np.subtract(f.door, f.foot), f.out)
+        assert off == pytest.approx(f.wall, abs=0.011)
+
+
+def test_draft_marks_what_a_person_must_add(tmp_path):
+    _, got, _, text = _draft("l_hospital", tmp_path)
+    assert "todo: name, sign" in text
+    assert got.floor_plan.ros_map == "../l_hospital.yaml"  # relative to the output file
+    assert sum(w.kind.value == "start" for w in got.waypoints) == 1
+    assert all(r.name == "" for r in got.rooms)
+
+
+def test_open_area_is_flagged_not_made_a_corridor(tmp_path):
+    b = load_building("straight_office")
+    plan = rasterize_building(b)
+    # Carve a 10 m x 10 m hall at the west end.
+    xy = plan.world_to_pixel([[b.waypoints[0].pos[0] - 1, -5], [b.waypoints[0].pos[0] + 9, 5]])
+    (c0, r1), (c1, r0) = np.round(xy).astype(int)
+    plan.image[max(r0, 0) : r1, max(c0, 0) : c1] = 254
+    grid = save_ros_map(plan, tmp_path / "hall.yaml")
+    got, draft, text = draft_building(grid, tmp_path / "b.yaml")
+    assert len(draft.open_areas) == 1
+    assert "open area 1" in text
+    a = draft.open_areas[0]
+    for w in got.waypoints:  # no corridor waypoint deep inside the hall
+        inside = a.xmin + 1 < w.pos[0] < a.xmax - 1 and a.ymin + 1 < w.pos[1] < a.ymax - 1
+        assert not inside, w
+
+
+def test_a_grid_without_corridors_is_a_draft_error(tmp_path):
+    img = np.full((40, 40), 205, np.uint8)
+    grid = save_ros_map(FloorPlanImage(img, 0.05, (0.0, 0.0, 0.0)), tmp_path / "empty.yaml")
+    with pytest.raises(DraftError, match="no free cells"):
+        draft_building(grid, tmp_path / "b.yaml")
