@@ -53,9 +53,13 @@ def buildings() -> None:
 
 
 @app.command()
-def validate(file: str = typer.Argument(..., help=FILE_HELP)) -> None:
-    """Check a building file and list every problem (exit 1 if there are any)."""
+def validate(
+    file: str = typer.Argument(..., help=FILE_HELP),
+    strict: bool = typer.Option(False, "--strict", help="Treat warnings as problems (exit 1)."),
+) -> None:
+    """Check a building file: list every problem (exit 1), then warnings about runs."""
     from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.checks import building_warnings
     from pmnav_bt.map.priori_map import parse_building
 
     try:
@@ -71,6 +75,13 @@ def validate(file: str = typer.Argument(..., help=FILE_HELP)) -> None:
         f"{file}: OK: {b.name}: {len(b.rooms)} rooms, {len(b.landmarks)} landmarks, "
         f"{len(b.waypoints)} key waypoints, {len(b.edges)} corridors, {len(pm.segments)} segments"
     )
+    warnings = building_warnings(b, _folder(file))
+    for w in warnings:
+        typer.echo(f"{file}: warning: {w}", err=True)
+    if warnings:
+        typer.echo(f"{len(warnings)} warning(s)", err=True)
+        if strict:
+            raise typer.Exit(1)
 
 
 def _check_floor_plan(file: str, b) -> None:

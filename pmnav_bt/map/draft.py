@@ -37,6 +37,7 @@ import numpy as np
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
 from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map
+from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask, largest_component
 
 
 class DraftError(PmNavError):
@@ -104,25 +105,6 @@ class Draft:
 # -- masks ----------------------------------------------------------------------------
 
 
-def free_mask(plan: FloorPlanImage, params: DraftParams = DraftParams()) -> np.ndarray:
-    """map_server's free cells (bool, rows as in the image), specks closed, largest part only."""
-    free = (plan.occupancy() == 0).astype(np.uint8)
-    k = max(1, round(params.clean_m / plan.resolution))
-    if k > 1:
-        free = cv2.morphologyEx(free, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
-    free = _largest_component(free)
-    # Small islands of non-free cells enclosed by free space are clutter, not walls.
-    n, lab, stats, _ = cv2.connectedComponentsWithStats((~free).astype(np.uint8), connectivity=8)
-    h, w = free.shape
-    small = params.clutter_m / plan.resolution
-    for i in range(1, n):
-        x, y, bw, bh, _ = stats[i]
-        inside = x > 0 and y > 0 and x + bw < w and y + bh < h
-        if inside and max(bw, bh) <= small:
-            free[lab == i] = True
-    return free
-
-
 def corridor_mask(free: np.ndarray, resolution: float, params: DraftParams) -> np.ndarray:
     """The free space without door gaps and the rooms behind them.
 
@@ -132,16 +114,8 @@ def corridor_mask(free: np.ndarray, resolution: float, params: DraftParams) -> n
     """
     r = round(params.door_max_m / 2.0 / resolution) + 1
     disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1,) * 2)
-    core = _largest_component(cv2.erode(free.astype(np.uint8), disc))
+    core = largest_component(cv2.erode(free.astype(np.uint8), disc))
     return cv2.dilate(core.astype(np.uint8), disc).astype(bool) & free
-
-
-def _largest_component(mask: np.ndarray) -> np.ndarray:
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=4)
-    if n <= 1:
-        return np.zeros(mask.shape, bool)
-    best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-    return lab == best
 
 
 # -- skeleton graph ---------------------------------------------------------------------
@@ -327,7 +301,7 @@ def _split_straight(g: nx.MultiGraph, tol_px: float) -> nx.Graph:
 def _merge_close(h: nx.Graph, dist: np.ndarray, min_px: float) -> nx.Graph:
     """Contract corridor pieces shorter than ``min_px`` or than the corridor is wide.
 
-    A piece shorter than its width (a chamfer at a corner, a kink at a junction) is
+    A piece shorter than the corridors are wide (a chamfer at a corner, a kink at a junction) is
     no corridor a robot could follow; its two ends become one waypoint.
     """
 
@@ -461,7 +435,7 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
     res = plan.resolution
     if abs(plan.origin[2]) > 1e-9:
         raise DraftError(f"{plan.source}: origin yaw must be 0 for a draft (got {plan.origin[2]})")
-    free = free_mask(plan, params)
+    free = free_mask(plan, params.clean_m, params.clutter_m)
     if not free.any():
         raise DraftError(f"{plan.source}: the grid has no free cells")
     corridor = corridor_mask(free, res, params)
@@ -470,7 +444,7 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
             f"{plan.source}: no free area wider than a door ({params.door_max_m} m); "
             "check resolution and the free/occupied thresholds"
         )
-    dist = cv2.distanceTransform(free.astype(np.uint8), cv2.DIST_L2, 5)
+    dist = distance_map(free)
     open_mask = open_area_mask(corridor, dist, res, params)
     skel = skeletonize(corridor) & ~open_mask
     g = skeleton_graph(skel)
@@ -501,15 +475,13 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
     lines = _fit_lines(h, world, half)
     pos = _place_nodes(h, world, lines)
 
-    # Widths from the distance transform along the middle of each corridor.
+    # Widths from the distance transform along the fitted centre line, as the robot drives it.
     widths = {}
     for u, v, d in h.edges(data=True):
-        pts, hw = d["world"], d["half"]
-        keep = (np.linalg.norm(pts - pos[u], axis=1) > half[u] + 0.2) & (
-            np.linalg.norm(pts - pos[v], axis=1) > half[v] + 0.2
-        )
-        vals = hw[keep] if keep.sum() >= 3 else hw
-        widths[frozenset((u, v))] = round(float(2.0 * np.median(vals)), 2)
+        w = centre_line_width(plan, dist, pos[u], pos[v], half[u] + 0.2, half[v] + 0.2)
+        if w is None:
+            w = 2.0 * float(np.median(d["half"]))
+        widths[frozenset((u, v))] = round(w, 2)
 
     open_areas = _boxes(open_mask, plan)
     names = _name_nodes(h, pos, open_areas)

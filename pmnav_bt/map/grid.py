@@ -1,0 +1,73 @@
+"""The free space of an occupancy grid, and corridor widths measured in it."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from pmnav_bt.map.floorplan import FloorPlanImage
+
+CLEAN_M = 0.1  # close free-space holes smaller than this (laser speckle)
+CLUTTER_M = 1.25  # fill obstacles no longer than this in free space (bins, desks)
+
+
+def free_mask(
+    plan: FloorPlanImage, clean_m: float = CLEAN_M, clutter_m: float = CLUTTER_M
+) -> np.ndarray:
+    """map_server's free cells (bool, rows as in the image), specks closed, largest part only."""
+    free = (plan.occupancy() == 0).astype(np.uint8)
+    k = max(1, round(clean_m / plan.resolution))
+    if k > 1:
+        free = cv2.morphologyEx(free, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
+    free = largest_component(free)
+    # Small islands of non-free cells enclosed by free space are clutter, not walls.
+    n, lab, stats, _ = cv2.connectedComponentsWithStats((~free).astype(np.uint8), connectivity=8)
+    h, w = free.shape
+    small = clutter_m / plan.resolution
+    for i in range(1, n):
+        x, y, bw, bh, _ = stats[i]
+        inside = x > 0 and y > 0 and x + bw < w and y + bh < h
+        if inside and max(bw, bh) <= small:
+            free[lab == i] = True
+    return free
+
+
+def largest_component(mask: np.ndarray) -> np.ndarray:
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=4)
+    if n <= 1:
+        return np.zeros(mask.shape, bool)
+    best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+    return lab == best
+
+
+def distance_map(free: np.ndarray) -> np.ndarray:
+    """Per free cell, the distance (cells) to the nearest non-free cell centre."""
+    return cv2.distanceTransform(free.astype(np.uint8), cv2.DIST_L2, 5)
+
+
+def centre_line_width(
+    plan: FloorPlanImage,
+    dist: np.ndarray,
+    a,
+    b,
+    trim_a: float = 0.0,
+    trim_b: float = 0.0,
+) -> float | None:
+    """The corridor width along the line a-b: twice the median distance to a wall (metres).
+
+    ``trim_a``/``trim_b`` metres at the ends are left out (junctions widen the space);
+    None when fewer than 5 free cells remain.
+    """
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    length = float(np.linalg.norm(b - a))
+    s = np.linspace(0.0, length, max(2, round(length / plan.resolution) + 1))
+    xy = a + np.outer(s / max(length, 1e-9), b - a)
+    cell = plan.world_to_cell(xy)
+    keep = (s > trim_a) & (s < length - trim_b)
+    keep &= (cell >= 0).all(axis=1) & (cell[:, 0] < plan.width) & (cell[:, 1] < plan.height)
+    c = cell[keep]
+    d = dist[c[:, 1], c[:, 0]] if len(c) else np.zeros(0)
+    d = d[d > 0]
+    if len(d) < 5:
+        return None
+    return 2.0 * (float(np.median(d)) - 0.5) * plan.resolution
