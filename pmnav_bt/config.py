@@ -122,6 +122,10 @@ class SimConfig(_Section):
     odometry_noise: float = Field(
         0.02, ge=0.0, le=1.0, description="std of the relative error of each odometry increment"
     )
+    walls: Literal["corridors", "grid"] = Field(
+        "corridors",
+        description="walls from the annotated corridors, or from the ros_map grid's occupied cells",
+    )
 
 
 class Config(_Section):

@@ -565,6 +565,8 @@ def generate_episodes(
     spec = TIERS[tier]
     pm = _as_map(building)
     name = pm.building.name
+    # Episodes name their building so it loads again: a file by its path, a built-in by name.
+    source = str(building) if isinstance(building, (str, Path)) else name
     rng = np.random.default_rng([seed, zlib.crc32(name.encode()), list(TIERS).index(tier)])
     xy, seg_idx, s_along = _candidates(pm)
     lo, hi = spec.length_band
@@ -622,7 +624,7 @@ def generate_episodes(
         episodes.append(
             Episode(
                 id=f"{name}-{tier}-s{seed}-{len(episodes):03d}",
-                building=name,
+                building=source,
                 tier=tier,
                 start_x=x,
                 start_y=y,

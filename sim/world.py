@@ -27,7 +27,13 @@ from shapely.geometry import LineString, MultiPolygon, Polygon
 from shapely.geometry.polygon import orient
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.map.building import Building, Landmark, WaypointKind, load_building
+from pmnav_bt.map.building import (
+    Building,
+    Landmark,
+    WaypointKind,
+    load_building,
+    resolve_building_path,
+)
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.textures import make_sign, write_png
@@ -48,6 +54,7 @@ CEILING = "ceiling"
 OBSTACLE = "obstacle"
 ROBOT = "robot"
 FIXED_LABELS = (BACKGROUND, FLOOR, WALL, CEILING, OBSTACLE, ROBOT)  # ids 0..5
+WALL_SOURCES = ("corridors", "grid")  # what the simulator builds its walls from
 
 
 def door_label(room_id: str) -> str:
@@ -205,13 +212,31 @@ class SimWorld:
     """A pybullet world built from a Building, with its own physics client and lock.
 
     Parameters: ``building`` (a Building, a built-in name or a path), ``gui`` (use
-    p.GUI; needs a display), ``ceiling`` (add a ceiling at the wall height).
+    p.GUI; needs a display), ``ceiling`` (add a ceiling at the wall height), ``walls``:
+    ``corridors`` builds the walls from the annotated corridor rectangles, ``grid``
+    from the occupied cells of the building's ros_map floor plan (rooms and open areas
+    included; doors and signs still stand on the annotated corridor walls);
+    ``base_dir`` is the folder the floor plan path is relative to (default: the
+    building file's folder).
     """
 
     def __init__(
-        self, building: Building | str | Path, *, gui: bool = False, ceiling: bool = True
+        self,
+        building: Building | str | Path,
+        *,
+        gui: bool = False,
+        ceiling: bool = True,
+        walls: str = "corridors",
+        base_dir: str | Path | None = None,
     ) -> None:
-        self.building = building if isinstance(building, Building) else load_building(building)
+        if walls not in WALL_SOURCES:
+            raise SimError(f"walls {walls!r}: choose {' or '.join(WALL_SOURCES)}")
+        if not isinstance(building, Building):
+            base_dir = base_dir if base_dir is not None else resolve_building_path(building).parent
+            building = load_building(building)
+        self.building = building
+        self.wall_source = walls
+        self._grid_boxes = self._load_grid_boxes(base_dir) if walls == "grid" else []
         self.lock = threading.RLock()
         self.labels: dict[int, str] = {}
         self._label_ids: dict[str, int] = {}
@@ -460,9 +485,29 @@ class SimWorld:
         return Pose2D(float(w.pos[0]), float(w.pos[1]), 0.0)
 
     def bounds(self, margin: float = 0.0) -> tuple[float, float, float, float]:
-        """(xmin, ymin, xmax, ymax) of the free space, grown by ``margin``."""
+        """(xmin, ymin, xmax, ymax) of the free space (and grid walls), grown by ``margin``."""
         x0, y0, x1, y1 = self.free_space.bounds
+        for bx in self._grid_boxes:
+            x0, y0 = min(x0, bx.xmin), min(y0, bx.ymin)
+            x1, y1 = max(x1, bx.xmax), max(y1, bx.ymax)
         return x0 - margin, y0 - margin, x1 + margin, y1 + margin
+
+    def _load_grid_boxes(self, base_dir: str | Path | None) -> list:
+        from pmnav_bt.map.floorplan import load_floor_plan
+        from pmnav_bt.sim.grid_walls import grid_wall_boxes
+
+        fp = self.building.floor_plan
+        if fp is None or fp.ros_map is None:
+            raise SimError(
+                f"{self.building.name}: walls from the grid need a floor_plan with ros_map "
+                "(a map_server map); use walls 'corridors' or add the map"
+            )
+        if base_dir is None and not Path(fp.ros_map).is_absolute():
+            raise SimError(
+                f"{self.building.name}: walls from the grid need the building file's folder "
+                "to find floor_plan.ros_map; pass the file's path"
+            )
+        return grid_wall_boxes(load_floor_plan(self.building, base_dir or "."))
 
     # -- building ------------------------------------------------------------------------
 
@@ -499,9 +544,18 @@ class SimWorld:
         for room in b.rooms:
             self._build_room_sign(room.id, room.sign_text)
 
+    def _build_grid_walls(self) -> None:
+        h = self.building.wall_height
+        for bx in self._grid_boxes:
+            (cx, cy), (hx, hy) = bx.centre, bx.half
+            self.add_box((cx, cy, h / 2.0), (hx, hy, h / 2.0), 0.0, WALL_RGBA, WALL)
+
     def _build_walls(self) -> None:
         h = self.building.wall_height
         t = WALL_THICKNESS
+        grid = self.wall_source == "grid"
+        if grid:
+            self._build_grid_walls()
         for ring in _rings(self.free_space):
             n = len(ring)
             pts = [np.asarray(q, float) for q in ring]
@@ -520,6 +574,9 @@ class SimWorld:
                 mid = (a + b) / 2.0 + tan * (ext_b - ext_a) / 2.0 - inward * t / 2.0
                 yaw = math.atan2(tan[1], tan[0])
                 half_len = length / 2.0 + (ext_a + ext_b) / 2.0
+                self.walls.append(WallSegment(_xy(a), _xy(b), _xy(inward)))
+                if grid:  # the annotated walls only carry the doors and signs
+                    continue
                 self.add_box(
                     (mid[0], mid[1], h / 2.0), (half_len, t / 2.0, h / 2.0), yaw, WALL_RGBA, WALL
                 )
@@ -533,7 +590,6 @@ class SimWorld:
                     solid=False,
                     collision=False,
                 )
-                self.walls.append(WallSegment(_xy(a), _xy(b), _xy(inward)))
 
     # -- placing things on walls ---------------------------------------------------------
 

@@ -90,7 +90,7 @@ def run_episode(
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     """
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.building import load_building, resolve_building_path
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.episodes import score_episode
     from pmnav_bt.sim.odometry import NoisyOdometry
@@ -102,7 +102,8 @@ def run_episode(
     pm = parse_building(b)
     sim = config.sim
     t0 = time.perf_counter()
-    with SimWorld(b) as world:
+    folder = resolve_building_path(episode.building).parent
+    with SimWorld(b, walls=sim.walls, base_dir=folder) as world:
         if setup_world is not None:
             setup_world(world)
         inner = SimBase(world, pose=episode.start_pose, width=sim.width, height=sim.height)

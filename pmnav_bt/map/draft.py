@@ -364,8 +364,10 @@ def _place_nodes(h: nx.Graph, world: dict, lines: dict) -> dict:
         if crossing:
             a = np.zeros((2, 2))
             b = np.zeros(2)
-            for c, d in ls:
-                m = np.eye(2) - np.outer(d, d)
+            for (c, d), m_ in zip(ls, h.neighbors(n), strict=True):
+                # Long corridors weigh more than short stubs (a spur into a room).
+                wgt = float(np.linalg.norm(world[m_] - p0)) ** 2
+                m = (np.eye(2) - np.outer(d, d)) * wgt
                 a += m
                 b += m @ c
             p = np.linalg.solve(a, b)

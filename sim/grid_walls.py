@@ -1,0 +1,104 @@
+"""Walls from an occupancy grid: the cells that bound the free space, merged into boxes.
+
+The simulator normally builds its walls from the annotated corridor rectangles, which
+tests the annotation rather than the building. With a ros_map floor plan it can build
+them from the grid instead: every non-free cell next to free space (occupied walls,
+and unknown cells where the scan saw nothing) becomes wall, open areas and rooms
+included. Cells are merged into few boxes: runs along each image row, then runs of the
+same columns in consecutive rows, so a straight wall is one box.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from pmnav_bt.map.floorplan import FloorPlanImage
+from pmnav_bt.map.grid import free_mask
+
+BAND_CELLS = 2  # wall thickness: non-free cells within this many cells of free space
+SMOOTH_M = 0.15  # free-space specks and slivers thinner than this are dropped
+
+
+@dataclass(frozen=True)
+class Box:
+    """An axis-aligned rectangle in the map frame (metres)."""
+
+    xmin: float
+    ymin: float
+    xmax: float
+    ymax: float
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        return (self.xmin + self.xmax) / 2.0, (self.ymin + self.ymax) / 2.0
+
+    @property
+    def half(self) -> tuple[float, float]:
+        return (self.xmax - self.xmin) / 2.0, (self.ymax - self.ymin) / 2.0
+
+
+def sim_free(plan: FloorPlanImage) -> np.ndarray:
+    """The free space the simulator keeps: the largest part, specks and slivers smoothed."""
+    free = free_mask(plan, clean_m=SMOOTH_M, clutter_m=0.0)
+    k = max(1, round(SMOOTH_M / plan.resolution))
+    free = cv2.morphologyEx(free.astype(np.uint8), cv2.MORPH_OPEN, np.ones((k, k), np.uint8)) > 0
+    # Nothing is known beyond the image: its border cells are wall.
+    b = BAND_CELLS
+    free[:b], free[-b:], free[:, :b], free[:, -b:] = False, False, False, False
+    return free
+
+
+def wall_cells(free: np.ndarray, band: int = BAND_CELLS) -> np.ndarray:
+    """Non-free cells within ``band`` cells of a free cell (bool, rows as in the image)."""
+    k = cv2.getStructuringElement(cv2.MORPH_RECT, (2 * band + 1, 2 * band + 1))
+    near = cv2.dilate(free.astype(np.uint8), k).astype(bool)
+    return near & ~free
+
+
+def merge_cells(must: np.ndarray, may: np.ndarray | None = None) -> list[tuple[int, int, int, int]]:
+    """Rectangles (row0, col0, row1, col1), ends exclusive, covering every ``must`` cell.
+
+    Rectangles may also cover ``may`` cells (default: only ``must``), and may overlap.
+    Greedy: from each uncovered cell in row order, grow right as far as allowed, then
+    down while the whole span is allowed. Letting walls grow into the unknown cells
+    behind them turns a ragged laser border into a few big boxes.
+    """
+    ok = must if may is None else (must | may)
+    h, w = ok.shape
+    # bad[r, c] = number of disallowed cells in row r before column c.
+    bad = np.zeros((h, w + 1), np.int32)
+    bad[:, 1:] = np.cumsum(~ok, axis=1)
+    covered = np.zeros_like(must, dtype=bool)
+    rects = []
+    for r in range(h):
+        todo = np.nonzero(must[r] & ~covered[r])[0]
+        for c0 in todo:
+            if covered[r, c0]:
+                continue
+            # Right: up to the first disallowed cell.
+            stops = np.nonzero(~ok[r, c0:])[0]
+            c1 = c0 + (int(stops[0]) if len(stops) else w - c0)
+            r1 = r + 1
+            while r1 < h and bad[r1, c1] - bad[r1, c0] == 0:
+                r1 += 1
+            covered[r:r1, c0:c1] = True
+            rects.append((r, int(c0), r1, int(c1)))
+    return rects
+
+
+def grid_wall_boxes(plan: FloorPlanImage, band: int = BAND_CELLS) -> list[Box]:
+    """The grid's walls as map-frame boxes (the grid must not be rotated)."""
+    if abs(plan.origin[2]) > 1e-9:
+        raise ValueError(f"{plan.source}: walls from a rotated grid (yaw {plan.origin[2]})")
+    res = plan.resolution
+    ox, oy = plan.origin[0], plan.origin[1]
+    h = plan.height
+    out = []
+    free = sim_free(plan)
+    for r0, c0, r1, c1 in merge_cells(wall_cells(free, band), ~free):
+        # Image row r covers map y from oy + (h - 1 - r) * res to oy + (h - r) * res.
+        out.append(Box(ox + c0 * res, oy + (h - r1) * res, ox + c1 * res, oy + (h - r0) * res))
+    return out
