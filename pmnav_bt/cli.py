@@ -104,6 +104,9 @@ def map_(
     file: str = typer.Argument(..., help=FILE_HELP),
     as_json: bool = typer.Option(False, "--json", help="Print the priori-map as JSON."),
     image: Path | None = typer.Option(None, "--image", help="Write the annotated map PNG here."),
+    grid: float | None = typer.Option(
+        None, "--grid", help="Draw a metre grid on the image, lines this many metres apart."
+    ),
 ) -> None:
     """Print the semantic priori-map (structured text or JSON); optionally draw it."""
     if image is not None:
@@ -113,7 +116,7 @@ def map_(
     if image is not None:
         from pmnav_bt.render.annotate import render_annotated_map
 
-        render_annotated_map(pm, path=image, base_dir=_folder(file))
+        render_annotated_map(pm, path=image, base_dir=_folder(file), grid_m=grid)
         typer.echo(f"wrote {image}", err=True)
 
 

@@ -174,3 +174,31 @@ def test_bare_corridor_renders(tmp_path):
     assert layout.texts("waypoint") == {"start", "end1"} and layout.texts("segment") == {"seg1"}
     with pytest.raises(PmNavError, match="no_such_dir"):
         render_annotated_map(pm, tmp_path / "no_such_dir" / "map.png")
+
+
+def test_corridor_widths_and_doors_show_over_a_floor_plan():
+    pm = parse_building(load_building("fig2_hospital"))
+    white = FloorPlanImage(np.full((100, 100), 254, np.uint8), 1.0, (-20.0, -20.0, 0.0))
+    img = render_annotated_map(pm, scale_px_per_m=20.0, floor_plan=white)
+    canvas = make_canvas(pm, scale_px_per_m=20.0)
+    inside = img[canvas.ipx((0.9, 15.0))[::-1]]  # in the west corridor, 0.3 m from its wall
+    outside = img[canvas.ipx((1.5, 15.0))[::-1]]  # 0.3 m beyond the wall
+    assert outside.tolist() == [254, 254, 254]
+    assert inside[0] > inside[2] + 20  # tinted blue: the corridor's annotated width
+    u, v = canvas.ipx((-1.2, 26.0))  # room1's door on the west wall
+    assert np.abs(img[v, u].astype(int) - (30, 80, 170)).max() < 40
+
+
+def test_metre_grid_is_optional():
+    pm = parse_building(load_building("straight_office"))
+    plain = render_annotated_map(pm, scale_px_per_m=20.0)
+    grid = render_annotated_map(pm, scale_px_per_m=20.0, grid_m=1.0)
+    canvas = make_canvas(pm, scale_px_per_m=20.0)
+    v = canvas.map_top + canvas.map_height - 10  # in the padding below the building
+    u, _ = canvas.ipx((25.0, 0.0))  # on a 5 m line
+    u2, _ = canvas.ipx((25.5, 0.0))  # between lines
+    assert plain[v, u].tolist() == [255, 255, 255]
+    assert grid[v, u].tolist() != [255, 255, 255]
+    assert grid[v, u2].tolist() == [255, 255, 255]
+    with pytest.raises(PmNavError, match="grid spacing"):
+        render_annotated_map(pm, grid_m=-1.0)

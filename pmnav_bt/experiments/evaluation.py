@@ -144,7 +144,7 @@ def run_episode(
     plot_path = None
     if out_dir is not None and plot:
         plot_path = out_dir / f"{safe_filename(episode.id)}.trajectory.png"
-        _plot(pm, ctx.trace, truth, plot_path, result, config, outcome)
+        _plot(pm, ctx.trace, truth, plot_path, result, config, outcome, folder)
     return EpisodeRun(result, plot_path, log_path)
 
 
@@ -156,7 +156,9 @@ class _null:
         return False
 
 
-def _plot(pm, trace, truth, path: Path, result: EpisodeResult, config: Config, outcome) -> None:
+def _plot(
+    pm, trace, truth, path: Path, result: EpisodeResult, config: Config, outcome, base_dir="."
+) -> None:
     """The Fig. 4-style plot: planned path, driven path, key nodes with thumbnails."""
     import numpy as np
 
@@ -183,7 +185,8 @@ def _plot(pm, trace, truth, path: Path, result: EpisodeResult, config: Config, o
         f"SPL {result.spl:.2f}; {result.path_length:.1f} m driven, "
         f"{result.shortest_path_length:.1f} m shortest; {outcome.actions} actions"
     )
-    render_trajectory(pm, planned, [(x, y) for _, x, y in truth], nodes, path, caption)
+    actual = [(x, y) for _, x, y in truth]
+    render_trajectory(pm, planned, actual, nodes, path, caption, base_dir=base_dir)
 
 
 # -- evaluation over many episodes ---------------------------------------------------------

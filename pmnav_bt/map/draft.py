@@ -498,18 +498,24 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
         w = widths[frozenset((u, v))]
         edges.append({"from": names[u], "to": names[v], "width": w})
         a, b = pos[u], pos[v]
-        margins = tuple(
-            max((widths[frozenset((x, m))] for m in h.neighbors(x) if m != y), default=-w) / 2.0
-            + 0.1
-            for x, y in ((u, v), (v, u))
-        )
         uu = (b - a) / np.linalg.norm(b - a)
         nn = np.array([-uu[1], uu[0]])
-        for s, side in door_candidates(plan, free, a, b, w, margins, params):
+        others = [(x, m) for x, y in ((u, v), (v, u)) for m in h.neighbors(x) if m != y]
+        for s, side in door_candidates(plan, free, a, b, w, (0.0, 0.0), params):
             door = a + uu * s + side * nn * (w / 2.0)
+            if any(_beside(door, pos[x], pos[m], widths[frozenset((x, m))]) for x, m in others):
+                continue  # the mouth of a corridor meeting this one, not a door
             xy = [round(float(x), 2) for x in door]
             rooms.append({"id": f"room{len(rooms) + 1}", "door": xy})
     return Draft(waypoints, edges, rooms, open_areas, notes, free, corridor, skel)
+
+
+def _beside(p: np.ndarray, a: np.ndarray, b: np.ndarray, width: float) -> bool:
+    """Whether ``p`` lies within the corridor a-b (past ``a``, within its half width)."""
+    d = b - a
+    t = float(np.dot(p - a, d) / np.dot(d, d))
+    perp = float(np.linalg.norm(p - (a + t * d)))
+    return t > -0.05 and perp < width / 2.0 + 0.2
 
 
 def _name_nodes(h: nx.Graph, pos: dict, open_areas: list[OpenArea]) -> dict:

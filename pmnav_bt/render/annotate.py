@@ -55,6 +55,10 @@ STYLE = {
 }
 PLACE_ORDER = ("waypoint", "room", "landmark", "segment")
 CORRIDOR_FILL = (205, 232, 248)
+CORRIDOR_TINT = (235, 170, 90)  # BGR, corridors over a floor plan (blended)
+CORRIDOR_EDGE = (190, 110, 40)
+GRID_MINOR = (225, 225, 225)
+GRID_MAJOR = (170, 170, 170)
 ROOM_FILL, ROOM_EDGE = (246, 246, 246), (175, 175, 175)
 WALL, DOOR, CENTRE_LINE, LEADER = (60, 60, 60), (30, 80, 170), (175, 175, 175), (90, 90, 90)
 PATH_COLOUR = (220, 90, 20)
@@ -417,11 +421,15 @@ def render_annotated_map(
     path_xy: list[tuple[float, float]] | None = None,
     floor_plan: FloorPlanImage | None = None,
     base_dir: str | Path = ".",
+    grid_m: float | None = None,
 ) -> np.ndarray:
     """Draw the annotated priori-map (BGR) and write it to ``path`` (PNG) when given.
 
     ``floor_plan`` overrides the building's own plan, whose files are looked up
-    relative to ``base_dir``. ``path_xy`` (map points) is drawn as a blue polyline.
+    relative to ``base_dir``; over a plan, the corridors are drawn translucent at their
+    annotated widths with the doors marked on the annotated walls, so a mismatch with
+    the plan shows. ``path_xy`` (map points) is drawn as a blue polyline; ``grid_m``
+    adds a metre grid with lines that many metres apart.
     """
     canvas = make_canvas(pm, scale_px_per_m)
     if floor_plan is None:
@@ -429,8 +437,11 @@ def render_annotated_map(
     img = np.full((canvas.height, canvas.width, 3), 255, dtype=np.uint8)
     if floor_plan is not None:
         _draw_plan_background(img, floor_plan, canvas)
+        _draw_annotation_over_plan(img, pm, canvas)
     else:
         _draw_building(img, pm, canvas)
+    if grid_m:
+        _draw_metre_grid(img, canvas, grid_m)
     layout = layout_labels(pm, canvas, img)
     _draw_centre_lines(img, pm, canvas)
     if path_xy:
@@ -439,7 +450,7 @@ def render_annotated_map(
     _draw_markers(img, pm, canvas)
     _draw_labels(img, layout)
     _draw_header(img, pm, canvas)
-    _draw_footer(img, canvas, layout, bool(path_xy), floor_plan is None)
+    _draw_footer(img, canvas, layout, bool(path_xy), True)
     if path is not None and not cv2.imwrite(str(path), img):
         raise PmNavError(f"{path}: cannot write the PNG; check that the folder exists")
     return img
@@ -459,6 +470,43 @@ def _draw_plan_background(img: np.ndarray, plan: FloorPlanImage, canvas: Canvas)
     )
     x0, y0, x1, y1 = canvas.map_box
     img[y0:y1, x0:x1] = warped[y0:y1, x0:x1]
+
+
+def _draw_annotation_over_plan(img: np.ndarray, pm: PrioriMap, canvas: Canvas) -> None:
+    """Corridors at their widths (translucent, outlined) and door marks over a floor plan."""
+    tint = img.copy()
+    quads = [_poly(canvas, q) for q in corridor_quads(pm.building)]
+    for q in quads:
+        cv2.fillConvexPoly(tint, q, CORRIDOR_TINT, cv2.LINE_AA)
+    cv2.addWeighted(tint, 0.35, img, 0.65, 0.0, dst=img)
+    for q in quads:
+        cv2.polylines(img, [q], True, CORRIDOR_EDGE, 1, cv2.LINE_AA)
+    for f in door_frames(pm.building):
+        a, b = _door_mark(f)
+        cv2.line(img, canvas.ipx(a), canvas.ipx(b), DOOR, 5, cv2.LINE_AA)
+
+
+def _draw_metre_grid(img: np.ndarray, canvas: Canvas, step: float) -> None:
+    """Light lines every ``step`` metres over the map area, darker every fifth."""
+    if not (math.isfinite(step) and step > 0):
+        raise PmNavError(f"grid spacing must be a positive number of metres, got {step}")
+    w0, w1 = _corners(canvas)
+    for axis in (0, 1):
+        lo, hi = sorted((w0[axis], w1[axis]))
+        for k in range(math.ceil(lo / step), math.floor(hi / step) + 1):
+            v = k * step
+            pts = [[v, w0[1]], [v, w1[1]]] if axis == 0 else [[w0[0], v], [w1[0], v]]
+            a, b = (canvas.ipx(p) for p in pts)
+            major = abs(v / step) % 5 == 0
+            cv2.line(img, a, b, GRID_MAJOR if major else GRID_MINOR, 1)
+
+
+def _corners(canvas: Canvas) -> tuple[np.ndarray, np.ndarray]:
+    """Map coordinates of the map area's bottom-left and top-right pixels."""
+    x0, y0, x1, y1 = canvas.map_box
+    inv = np.linalg.inv(np.vstack([canvas.affine(), [0.0, 0.0, 1.0]]))[:2]
+    pts = np.array([[x0, y1, 1.0], [x1, y0, 1.0]]) @ inv.T
+    return pts[0], pts[1]
 
 
 def _draw_building(img: np.ndarray, pm: PrioriMap, canvas: Canvas) -> None:

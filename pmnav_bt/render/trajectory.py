@@ -62,9 +62,13 @@ def render_trajectory(
     nodes: list[KeyNode],
     path: str | Path | None = None,
     caption: str = "",
+    base_dir: str | Path = ".",
 ) -> np.ndarray:
-    """Draw the plot (BGR) and write it to ``path`` when given."""
-    img = render_annotated_map(pm, path_xy=planned_xy or None)
+    """Draw the plot (BGR) and write it to ``path`` when given.
+
+    ``base_dir``: the folder the building's floor plan path is relative to.
+    """
+    img = render_annotated_map(pm, path_xy=planned_xy or None, base_dir=base_dir)
     canvas = make_canvas(pm)
     if len(actual_xy) >= 2:
         pts = np.rint(canvas.to_px(actual_xy)).astype(np.int32)
