@@ -172,6 +172,14 @@ def map_draft(
     )
 
 
+@app.command()
+def annotate(file: Path = typer.Argument(..., help="The building file to edit (YAML).")) -> None:
+    """Edit a building over its floor plan in a window (Tk): rooms, waypoints, corridors, signs."""
+    from pmnav_bt.render.tk_annotate import run
+
+    run(file)
+
+
 def _mount_subcommands() -> None:
     # Both import only typer at module level: pybullet and py_trees load inside commands.
     from pmnav_bt.sim.cli import app as sim_app
