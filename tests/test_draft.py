@@ -83,3 +83,19 @@ def test_a_grid_without_corridors_is_a_draft_error(tmp_path):
     grid = save_ros_map(FloorPlanImage(img, 0.05, (0.0, 0.0, 0.0)), tmp_path / "empty.yaml")
     with pytest.raises(DraftError, match="no free cells"):
         draft_building(grid, tmp_path / "b.yaml")
+
+
+def test_draft_of_the_real_hospital_map_is_valid(hospital_grid, tmp_path):
+    got, draft, text = draft_building(hospital_grid, tmp_path / "hospital.yaml")
+    assert len(got.edges) >= 10 and len(got.rooms) >= 10
+    assert draft.open_areas  # the lobby is flagged, not made a corridor
+    assert got.floor_plan.ros_map.endswith("hospital.yaml")
+
+
+def test_example_hospital_building_has_no_warnings():
+    from pathlib import Path
+
+    from pmnav_bt.map.checks import building_warnings
+
+    f = Path(__file__).resolve().parents[1] / "examples" / "hospital" / "building.yaml"
+    assert building_warnings(load_building(f), f.parent) == []

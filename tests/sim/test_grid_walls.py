@@ -79,3 +79,13 @@ def test_hospital_grid_boxes_stay_few(hospital_grid):
 
     boxes = grid_wall_boxes(load_ros_map(hospital_grid))
     assert 0 < len(boxes) < 1500
+
+
+def test_example_hospital_builds_with_grid_walls():
+    from pathlib import Path
+
+    f = Path(__file__).resolve().parents[2] / "examples" / "hospital" / "building.yaml"
+    with SimWorld(f, walls="grid", ceiling=False) as w:
+        start = w.start_pose()
+        assert w.clearance(start.x, start.y, 0.17) > 0.0  # Create 3 radius
+        assert len(w.doors) == len(w.building.rooms)
