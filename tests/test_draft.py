@@ -99,3 +99,16 @@ def test_example_hospital_building_has_no_warnings():
 
     f = Path(__file__).resolve().parents[1] / "examples" / "hospital" / "building.yaml"
     assert building_warnings(load_building(f), f.parent) == []
+
+
+def test_pmnav_map_draft_command(tmp_path, capsys):
+    from pmnav_bt.cli import main
+
+    grid = save_ros_map(rasterize_building(load_building("l_hospital")), tmp_path / "g.yaml")
+    out = tmp_path / "new" / "b.yaml"
+    with pytest.raises(SystemExit) as ex:
+        main(["map", "draft", str(grid), "-o", str(out), "--image", str(tmp_path / "s.png")])
+    assert ex.value.code == 0
+    assert load_building(out).floor_plan.ros_map == "../g.yaml"
+    assert (tmp_path / "s.png").is_file()
+    assert "3 key waypoints, 2 corridors, 31 door candidates" in capsys.readouterr().out
