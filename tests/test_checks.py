@@ -86,6 +86,16 @@ def test_centre_line_leaving_the_free_space():
     assert grid_warnings(_b(_corridor()), plan) == []
 
 
+def test_centre_line_through_an_obstacle():
+    plan = rasterize_building(_b(_corridor()))
+    ((c, r),) = plan.world_to_pixel([[10.0, 0.0]]).round().astype(int)
+    plan.image[r - 6 : r + 7, c - 6 : c + 7] = 0  # a 0.65 m pillar on the centre line
+    w = grid_warnings(_b(_corridor()), plan)
+    assert [x.field for x in w] == ["edges[0]"]
+    assert "runs into an obstacle in the corridor" in w[0].message
+    assert "(10.0" in w[0].message
+
+
 def test_width_disagreeing_with_the_grid():
     plan = rasterize_building(_b(_corridor()))
     w = grid_warnings(_b(_corridor(width=4.0)), plan)

@@ -5,7 +5,8 @@ A building that loads is well formed; these checks look for what makes runs fail
 
 - a door off its corridor's annotated wall (the robot stops short of it);
 - very short corridor edges, and turns back to back (no corridor to take);
-- a centre line through walls of the floor-plan grid, or a width the grid disagrees with;
+- a centre line through walls or obstacles of the floor-plan grid, or a width the grid
+  disagrees with;
 - corridor stretches with fewer than two readable signs within reading range
   (localization has nothing to match there);
 - no start waypoint.
@@ -164,7 +165,8 @@ def sign_warnings(b: Building, range_m: float = SIGN_RANGE_M) -> list[Problem]:
 def grid_warnings(b: Building, plan: FloorPlanImage) -> list[Problem]:
     """Centre lines through non-free grid cells; widths the grid disagrees with."""
     free = free_mask(plan)  # map_server's free cells, small clutter (bins, desks) filled
-    dist = distance_map(free)
+    dist = distance_map(free)  # widths: clutter does not narrow a corridor
+    open_ = free_mask(plan, clutter_m=0.0)  # the path: clutter on the centre line blocks it
     seg_a, seg_b = _segments(b)
     half_at = {}
     for e in b.edges:
@@ -177,15 +179,22 @@ def grid_warnings(b: Building, plan: FloorPlanImage) -> list[Problem]:
         cell = plan.world_to_cell(xy)
         inside = (cell >= 0).all(axis=1) & (cell[:, 0] < plan.width) & (cell[:, 1] < plan.height)
         ok = np.zeros(len(s), bool)
-        ok[inside] = free[cell[inside, 1], cell[inside, 0]]
+        ok[inside] = open_[cell[inside, 1], cell[inside, 0]]
         for lo, hi in _runs(~ok):
             if (hi - lo) * step >= OFF_FREE_M:
                 mid = xy[(lo + hi) // 2]
+                c = cell[(lo + hi) // 2]
+                what = (
+                    "runs into an obstacle in the corridor"
+                    if free[c[1], c[0]]
+                    else "leaves the grid's free space"
+                )
                 out.append(
                     Problem(
                         f"edges[{i}]",
-                        f"{e.a}-{e.b} leaves the grid's free space for {(hi - lo) * step:.2f} m "
-                        f"near ({mid[0]:.2f}, {mid[1]:.2f}): move its waypoints onto the corridor",
+                        f"{e.a}-{e.b} {what} for {(hi - lo) * step:.2f} m near "
+                        f"({mid[0]:.2f}, {mid[1]:.2f}): the robot follows the centre line and "
+                        "stops there; move the waypoints",
                     )
                 )
         measured = centre_line_width(
