@@ -10,12 +10,12 @@ same columns in consecutive rows, so a straight wall is one box.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
 
-from pmnav_bt.map.floorplan import FloorPlanImage
+from pmnav_bt.map.floorplan import FREE, FloorPlanError, FloorPlanImage, fill_world_polygons
 from pmnav_bt.map.grid import free_mask
 
 BAND_CELLS = 2  # wall thickness: non-free cells within this many cells of free space
@@ -89,10 +89,20 @@ def merge_cells(must: np.ndarray, may: np.ndarray | None = None) -> list[tuple[i
     return rects
 
 
-def grid_wall_boxes(plan: FloorPlanImage, band: int = BAND_CELLS) -> list[Box]:
-    """The grid's walls as map-frame boxes (the grid must not be rotated)."""
+def grid_wall_boxes(plan: FloorPlanImage, band: int = BAND_CELLS, clear=()) -> list[Box]:
+    """The grid's walls as map-frame boxes (the grid must not be rotated).
+
+    ``clear``: convex map-frame polygons whose cells count as free (kept clear of walls).
+    """
     if abs(plan.origin[2]) > 1e-9:
-        raise ValueError(f"{plan.source}: walls from a rotated grid (yaw {plan.origin[2]})")
+        raise FloorPlanError(
+            plan.source,
+            "origin",
+            f"walls from a rotated grid are not supported (yaw {plan.origin[2]})",
+        )
+    if len(clear):
+        plan = replace(plan, image=plan.image.copy())
+        fill_world_polygons(plan, list(clear), FREE)
     res = plan.resolution
     ox, oy = plan.origin[0], plan.origin[1]
     h = plan.height

@@ -55,6 +55,7 @@ OBSTACLE = "obstacle"
 ROBOT = "robot"
 FIXED_LABELS = (BACKGROUND, FLOOR, WALL, CEILING, OBSTACLE, ROBOT)  # ids 0..5
 WALL_SOURCES = ("corridors", "grid")  # what the simulator builds its walls from
+ITEM_CLEAR_BEHIND, ITEM_CLEAR_FRONT = 0.05, 0.3  # m of grid wall cleared around wall items
 
 
 def door_label(room_id: str) -> str:
@@ -236,7 +237,7 @@ class SimWorld:
             building = load_building(building)
         self.building = building
         self.wall_source = walls
-        self._grid_boxes = self._load_grid_boxes(base_dir) if walls == "grid" else []
+        self._grid_plan = self._load_grid_plan(base_dir) if walls == "grid" else None
         self.lock = threading.RLock()
         self.labels: dict[int, str] = {}
         self._label_ids: dict[str, int] = {}
@@ -487,14 +488,14 @@ class SimWorld:
     def bounds(self, margin: float = 0.0) -> tuple[float, float, float, float]:
         """(xmin, ymin, xmax, ymax) of the free space (and grid walls), grown by ``margin``."""
         x0, y0, x1, y1 = self.free_space.bounds
-        for bx in self._grid_boxes:
-            x0, y0 = min(x0, bx.xmin), min(y0, bx.ymin)
-            x1, y1 = max(x1, bx.xmax), max(y1, bx.ymax)
+        if self._grid_plan is not None:
+            c = self._grid_plan.corners_world()
+            x0, y0 = min(x0, c[:, 0].min()), min(y0, c[:, 1].min())
+            x1, y1 = max(x1, c[:, 0].max()), max(y1, c[:, 1].max())
         return x0 - margin, y0 - margin, x1 + margin, y1 + margin
 
-    def _load_grid_boxes(self, base_dir: str | Path | None) -> list:
+    def _load_grid_plan(self, base_dir: str | Path | None):
         from pmnav_bt.map.floorplan import load_floor_plan
-        from pmnav_bt.sim.grid_walls import grid_wall_boxes
 
         fp = self.building.floor_plan
         if fp is None or fp.ros_map is None:
@@ -507,7 +508,7 @@ class SimWorld:
                 f"{self.building.name}: walls from the grid need the building file's folder "
                 "to find floor_plan.ros_map; pass the file's path"
             )
-        return grid_wall_boxes(load_floor_plan(self.building, base_dir or "."))
+        return load_floor_plan(self.building, base_dir or ".")
 
     # -- building ------------------------------------------------------------------------
 
@@ -543,10 +544,31 @@ class SimWorld:
             self._build_landmark(lm)
         for room in b.rooms:
             self._build_room_sign(room.id, room.sign_text)
+        if self._grid_plan is not None:
+            self._build_grid_walls()
 
     def _build_grid_walls(self) -> None:
+        """Walls from the grid's cells, kept clear in front of every door, sign and landmark.
+
+        Items stand on the annotated walls; where the grid's wall bulges a few
+        centimetres past them it would hide them, so the cells just in front of each
+        item are taken as free.
+        """
+        from pmnav_bt.sim.grid_walls import grid_wall_boxes
+
         h = self.building.wall_height
-        for bx in self._grid_boxes:
+        clear = []
+        for it in (
+            *self.doors.values(),
+            *self.signs.values(),
+            *self.landmarks.values(),
+            *self.landmark_signs.values(),
+        ):
+            c, n = np.asarray(it.centre), np.asarray(it.normal)
+            t = np.array([n[1], -n[0]]) * (it.width / 2.0 + 0.05)
+            back, front = c - n * ITEM_CLEAR_BEHIND, c + n * ITEM_CLEAR_FRONT
+            clear.append(np.array([back - t, back + t, front + t, front - t]))
+        for bx in grid_wall_boxes(self._grid_plan, clear=clear):
             (cx, cy), (hx, hy) = bx.centre, bx.half
             self.add_box((cx, cy, h / 2.0), (hx, hy, h / 2.0), 0.0, WALL_RGBA, WALL)
 
@@ -554,8 +576,6 @@ class SimWorld:
         h = self.building.wall_height
         t = WALL_THICKNESS
         grid = self.wall_source == "grid"
-        if grid:
-            self._build_grid_walls()
         for ring in _rings(self.free_space):
             n = len(ring)
             pts = [np.asarray(q, float) for q in ring]
