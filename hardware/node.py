@@ -2,13 +2,20 @@
 
 API (all standard messages; names relative to the node's namespace):
 
-- in ``goal`` (std_msgs/String): a room name, id or alias. A new goal preempts the
-  one running (its result says CANCELLED). In ``cancel`` (std_msgs/Empty).
+- action ``navigate_to_room`` (pmnav_interfaces/action/NavigateToRoom, when built:
+  ``hardware/action_server.py``): goal, feedback, cancel, a numeric error code.
+- in ``goal`` (std_msgs/String): a room name, id or alias; in ``goal_pose``
+  (geometry_msgs/PoseStamped, RViz's "2D Goal Pose", frame ``map``): the room whose
+  door is nearest. A new goal preempts the one running (its result says
+  CANCELLED). In ``cancel`` (std_msgs/Empty).
+- readiness (``hardware/readiness.py``): a goal that arrives before odometry and the
+  camera are fresh waits for them, up to ``ready_timeout_s``.
 - out ``result`` (std_msgs/String, JSON): ``{"id", "goal", "success", "code",
   "message", "duration_s", "ticks", "actions", "fix_attempts", "replans",
   "pose_odom", "pose_map"}``; ``code`` is a FailureCode (INVALID_GOAL,
   SENSOR_TIMEOUT, ...) or null.
-- out ``status`` (std_msgs/String, JSON, ``status_hz``): idle/running, the goal,
+- out ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, ``status_hz``) and ``status``
+  (std_msgs/String, JSON): ready or the missing inputs, idle/running, the goal,
   sensor ages, the current fault.
 - out ``tree`` (std_msgs/String, JSON): one snapshot per tick (statuses, feedback,
   blackboard changes; the format of ``pmnav tree replay``); ``tree/structure``
@@ -21,7 +28,9 @@ API (all standard messages; names relative to the node's namespace):
   tf2_msgs can be imported.
 
 The tree runs in the main thread (``run_tree`` with ``sync_workers=False`` and a
-RosClock); rclpy spins in a background executor. Parameters: see ``PARAMETERS``.
+RosClock); rclpy spins in a background executor. Parameters: see ``PARAMETERS``
+(``pmnav-ros --help``); an unknown ``-p`` name is an error. ``--record FILE.mcap``
+records the run (``hardware/recorder.py``).
 """
 
 from __future__ import annotations
@@ -31,12 +40,20 @@ import math
 import queue
 import sys
 import threading
+import time
 import traceback
 from dataclasses import dataclass, field, fields
 from typing import Any
 
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.hardware import action_server
 from pmnav_bt.hardware.create3 import Create3Options
+from pmnav_bt.hardware.diagnostics import diagnostic_array
+from pmnav_bt.hardware.messages import pose_stamped
+from pmnav_bt.hardware.params import check_unknown, usage, wants_help
+from pmnav_bt.hardware.readiness import Readiness
+from pmnav_bt.hardware.recorder import McapRecorder
+from pmnav_bt.hardware.requests import GoalPoseError, GoalRequest, goal_from_pose, progress
 from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR, Pose2D
 
 # name -> (default, description). Types follow the defaults.
@@ -48,6 +65,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "budget": (0, "action budget; 0: the config's tree.budget_actions"),
     "seed": (0, "seed of the perception back ends"),
     "max_duration_s": (900.0, "a mission ends with TIMEOUT after this long"),
+    "ready_timeout_s": (60.0, "a goal waits this long for fresh odometry and camera (s)"),
     "cmd_vel_topic": ("cmd_vel", ""),
     "odom_topic": ("odom", ""),
     "image_topic": ("camera/image_raw", "sensor_msgs/Image rgb8 or bgr8"),
@@ -81,6 +99,10 @@ class Cancelled(Exception):  # noqa: N818 - raised out of run_tree to end a run
     """Raised from the tick handler to end a run early."""
 
 
+class NotReadyError(PmNavError):
+    """Odometry or the camera did not become fresh within ``ready_timeout_s``."""
+
+
 def read_parameters(node) -> dict[str, Any]:
     """Declare every parameter of ``PARAMETERS`` on ``node`` and return their values,
     checked against their ranges (hardware/param_limits.py)."""
@@ -104,6 +126,7 @@ def declare_parameters(node, spec: dict[str, tuple[Any, str]]) -> dict[str, Any]
                 f"parameter {name!r}: expected a {kind} like {default!r} ({err})"
             ) from None
         out[name] = node.get_parameter(name).value
+    check_unknown(node, spec)
     return out
 
 
@@ -120,6 +143,16 @@ class _Run:
     goal: str
     cancel: threading.Event = field(default_factory=threading.Event)
     reason: str = ""
+    request: GoalRequest | None = None
+
+    def cancelled(self) -> bool:
+        """Set by a cancel/preempt, or the action client asked to cancel."""
+        if not self.cancel.is_set() and self.request is not None:
+            ask = self.request.cancel_requested
+            if ask is not None and ask():
+                self.reason = self.reason or "cancelled by the action client"
+                self.cancel.set()
+        return self.cancel.is_set()
 
 
 class _SnapshotWriter:
@@ -149,7 +182,8 @@ class _SnapshotWriter:
 class PmNavController:
     """The pmnav-ros node's logic: parameters, topics, the goal queue and the mission loop."""
 
-    def __init__(self, node, runtime) -> None:
+    def __init__(self, node, runtime, record: str = "") -> None:
+        from diagnostic_msgs.msg import DiagnosticArray
         from geometry_msgs.msg import PoseStamped, TransformStamped
         from nav_msgs.msg import Path
         from std_msgs.msg import Empty, String
@@ -180,10 +214,11 @@ class PmNavController:
         self.building = load_building(p["building"])
         self.pm = parse_building(self.building)
         self.base = Create3Base(node, create3_options(p))
+        self.readiness = Readiness(self.base, p["odom_timeout"], p["camera_timeout"])
         self.map_frame, self.odom_frame = p["map_frame"], p["odom_frame"]
 
         self._String = String
-        self._goals: queue.Queue[str] = queue.Queue()
+        self._goals: queue.Queue[GoalRequest] = queue.Queue()
         self._run: _Run | None = None
         self._runs = 0
         self._lock = threading.Lock()
@@ -198,6 +233,7 @@ class PmNavController:
         self.pub_pose = node.create_publisher(PoseStamped, "pose", ev)
         self.pub_markers = node.create_publisher(MarkerArray, "markers", latched)
         self.pub_map_odom = node.create_publisher(TransformStamped, "map_to_odom", ev)
+        self.pub_diag = node.create_publisher(DiagnosticArray, "/diagnostics", ev)
         self.pub_tf = None
         if p["publish_tf"]:
             try:
@@ -207,26 +243,93 @@ class PmNavController:
             else:
                 self.pub_tf = node.create_publisher(TFMessage, "/tf", qos.events(100))
         node.create_subscription(String, "goal", self._on_goal, ev)
+        node.create_subscription(PoseStamped, "goal_pose", self._on_goal_pose, ev)
         node.create_subscription(Empty, "cancel", self._on_cancel, ev)
         node.create_timer(1.0 / max(0.1, float(p["status_hz"])), self._publish_status)
+        self.action = None
+        if action_server.available():
+            self.action = action_server.NavigateActionServer(
+                node,
+                self.building,
+                self.submit,
+                runtime.executor.wake,
+                lambda q: pose_stamped(Pose2D(*q), self._stamp(), self.map_frame),
+                self.map_frame,
+            )
+        else:
+            self.log.warn(
+                "pmnav_interfaces is not built (interfaces/build.sh): no navigate_to_room "
+                "action, goals on the goal topics only"
+            )
+        self.recorder = None
+        if record:
+            self.recorder = McapRecorder(node, record, self._recorded_topics())
+            self.log.info(f"recording to {record}")
         self._publish_map_markers()
+        action = node.resolve_topic_name(action_server.ACTION_NAME) if self.action else None
         self.log.info(
-            f"pmnav-ros ready: building {self.building.name}, "
-            f"{len(self.building.rooms)} rooms; send a room name on "
-            f"{node.resolve_topic_name('goal')}"
+            f"pmnav-ros started: building {self.building.name}, "
+            f"{len(self.building.rooms)} rooms; goals: action {action}, "
+            f"{node.resolve_topic_name('goal')} (a room name), "
+            f"{node.resolve_topic_name('goal_pose')} (the nearest door); waiting for sensors"
         )
+
+    def _stamp(self):
+        return self.node.get_clock().now().to_msg()
+
+    def _recorded_topics(self) -> list[tuple[str, type, object]]:
+        from diagnostic_msgs.msg import DiagnosticArray
+        from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
+        from nav_msgs.msg import Odometry, Path
+        from sensor_msgs.msg import CameraInfo, Image
+        from std_msgs.msg import String
+        from visualization_msgs.msg import MarkerArray
+
+        from pmnav_bt.hardware import qos
+
+        p, sensor, ev, latched = self.params, qos.sensor(), qos.events(), qos.latched()
+        return [
+            (p["image_topic"], Image, sensor),
+            (p["camera_info_topic"], CameraInfo, sensor),
+            (p["odom_topic"], Odometry, sensor),
+            (p["cmd_vel_topic"], Twist, ev),
+            ("plan", Path, latched),
+            ("trajectory", Path, ev),
+            ("pose", PoseStamped, ev),
+            ("markers", MarkerArray, latched),
+            ("map_to_odom", TransformStamped, ev),
+            ("tree", String, ev),
+            ("tree/structure", String, latched),
+            ("result", String, ev),
+            ("/diagnostics", DiagnosticArray, ev),
+        ]
 
     # -- goals -------------------------------------------------------------------------------
 
-    def _on_goal(self, msg) -> None:
-        goal = msg.data.strip()
-        self.log.info(f"goal {goal!r} received")
+    def submit(self, req: GoalRequest) -> None:
+        """Queue a goal; it preempts the running one."""
+        self.log.info(f"goal {req.goal!r} received ({req.source})")
         with self._lock:
             if self._run is not None:
-                self._run.reason = f"preempted by goal {goal!r}"
+                self._run.reason = f"preempted by goal {req.goal!r}"
                 self._run.cancel.set()
                 self.base.clock.interrupt()
-            self._goals.put(goal)
+            self._goals.put(req)
+
+    def _on_goal(self, msg) -> None:
+        self.submit(GoalRequest(msg.data.strip(), "topic"))
+
+    def _on_goal_pose(self, msg) -> None:
+        p = msg.pose.position
+        try:
+            room, dist = goal_from_pose(
+                self.building, msg.header.frame_id, float(p.x), float(p.y), self.map_frame
+            )
+        except GoalPoseError as err:
+            self.log.error(str(err))
+            return
+        self.log.info(f"goal pose ({p.x:.1f}, {p.y:.1f}): nearest door {room.id} at {dist:.1f} m")
+        self.submit(GoalRequest(room.id, "goal_pose"))
 
     def _on_cancel(self, _msg) -> None:
         with self._lock:
@@ -234,8 +337,13 @@ class PmNavController:
                 self._run.reason = "cancelled on request"
                 self._run.cancel.set()
                 self.base.clock.interrupt()
+            dropped = []
             while not self._goals.empty():
-                self._goals.get_nowait()
+                dropped.append(self._goals.get_nowait())
+        for req in dropped:
+            req.finish(
+                {"goal": req.goal, "success": False, "code": "CANCELLED", "message": "cancelled"}
+            )
 
     def request_stop(self) -> None:
         """Signal handler side: end the current run (the main loop then exits)."""
@@ -250,24 +358,78 @@ class PmNavController:
         stop = self.runtime.stop_requested
         while not stop.is_set():
             try:
-                goal = self._goals.get(timeout=0.1)
+                req = self._goals.get(timeout=0.1)
             except queue.Empty:
                 continue
             if stop.is_set():
+                req.finish({"goal": req.goal, "success": False, "code": "CANCELLED",
+                            "message": "the node is shutting down"})  # fmt: skip
                 break
             try:
-                self.execute(goal)
-            except Exception:  # noqa: BLE001 - one bad run must not end the node
-                self.log.error(f"goal {goal!r} failed:\n{traceback.format_exc()}")
+                self.execute(req)
+            except Exception as err:  # noqa: BLE001 - one bad run must not end the node
+                self.log.error(f"goal {req.goal!r} failed:\n{traceback.format_exc()}")
                 self.base.stop()
+                if not req.done.is_set():
+                    req.finish({"goal": req.goal, "success": False, "code": "INTERNAL_ERROR",
+                                "message": f"{type(err).__name__}: {err}"})  # fmt: skip
 
-    def execute(self, goal: str) -> dict:
+    def _room_fields(self, goal: str) -> dict:
+        from pmnav_bt.planning.resolve import resolve_room
+
+        try:
+            room = self.building.room(resolve_room(self.pm, goal))
+        except Exception:  # noqa: BLE001 - an unknown room: the tree reports INVALID_GOAL
+            return {"room_id": "", "room_name": ""}
+        return {"room_id": room.id, "room_name": room.sign_text}
+
+    def _wait_ready(self, run: _Run, req: GoalRequest, w0: float) -> None:
+        """Wait for fresh sensors (feedback meanwhile); NotReadyError after the timeout."""
+        if self.readiness.ready():
+            return
+
+        def on_wait(missing: list[str], waited: float) -> None:
+            if req.feedback is not None:
+                req.feedback({"phase": "waiting_for_sensors", "missing": missing,
+                              "step_text": "waiting for: " + "; ".join(missing),
+                              "elapsed": time.monotonic() - w0})  # fmt: skip
+
+        timeout = float(self.params["ready_timeout_s"])
+        self.log.info(f"goal {req.goal!r} waits for: {'; '.join(self.readiness.missing())}")
+        missing = self.readiness.wait(timeout, run.cancelled, on_wait)
+        if run.cancelled():
+            raise Cancelled(run.reason or "cancelled")
+        if missing:
+            raise NotReadyError(f"not ready after {timeout:g} s: {'; '.join(missing)}")
+
+    def _feedback_fn(self, req: GoalRequest, viz: _Viz, w0: float):
+        """A tick handler part: feedback to ``req`` every 0.5 s and on each step change."""
+        last = {"t": -math.inf, "step": None}
+
+        def send() -> None:
+            if req.feedback is None:
+                return
+            now = time.monotonic()
+            step = viz._bb("step_index")
+            if now - last["t"] < 0.5 and step == last["step"]:
+                return
+            last.update(t=now, step=step)
+            est = viz.map_pose(self.base.pose())
+            fb = progress(viz._bb, est, now - w0)
+            fb["pose_map"] = (est.x, est.y, est.yaw)
+            req.feedback(fb)
+
+        return send
+
+    def execute(self, req: GoalRequest) -> dict:
         """Run the tree for one goal and publish its result."""
         from pmnav_bt.trees.runner import make_context, run_tree
 
+        goal = req.goal
+        w0 = time.monotonic()
         with self._lock:
             self._runs += 1
-            run = self._run = _Run(self._runs, goal)
+            run = self._run = _Run(self._runs, goal, request=req)
         p, cfg = self.params, self.config
         self.base.clock.clear()
         t0 = self.base.clock.now()
@@ -276,14 +438,17 @@ class PmNavController:
         viz = _Viz(self, ctx)
         tee = open(p["tree_log"], "a", encoding="utf-8") if p["tree_log"] else None  # noqa: SIM115
         writer = _SnapshotWriter(self.pub_tree, self.pub_structure, tee)
+        feedback = self._feedback_fn(req, viz, w0)
 
         def on_tick(tree) -> None:
             viz.update()
-            if run.cancel.is_set():
+            feedback()
+            if run.cancelled():
                 raise Cancelled(run.reason or "cancelled")
 
-        result: dict[str, Any] = {"id": run.id, "goal": goal}
+        result: dict[str, Any] = {"id": run.id, "goal": goal, **self._room_fields(goal)}
         try:
+            self._wait_ready(run, req, w0)
             max_ticks = max(1, int(float(p["max_duration_s"]) * cfg.tree.tick_hz))
             out = run_tree(ctx, goal, max_ticks, log=writer, on_tick=on_tick, sync_workers=False)
             result.update(
@@ -297,6 +462,8 @@ class PmNavController:
             )
         except Cancelled as c:
             result.update(success=False, code="CANCELLED", message=str(c))
+        except NotReadyError as err:
+            result.update(success=False, code="SENSOR_TIMEOUT", message=str(err))
         except PmNavError as err:
             result.update(success=False, code="ERROR", message=str(err))
         except Exception as err:  # noqa: BLE001 - reported, the node goes on
@@ -319,6 +486,7 @@ class PmNavController:
             pose_map=[round(est.x, 3), round(est.y, 3), round(est.yaw, 4)],
         )
         self.pub_result.publish(self._String(data=json.dumps(result)))
+        req.finish(result)
         # (rclpy ties a severity to each call site: one call per severity)
         if result["success"]:
             self.log.info(f"goal {goal!r}: SUCCESS: {result['message']}")
@@ -332,7 +500,10 @@ class PmNavController:
         run = self._run
         fault = self.base.fault()
         s = self.base.sensors()
+        missing = self.readiness.missing()
         status = {
+            "ready": not missing,
+            "missing": missing,
             "state": "running" if run is not None else "idle",
             "goal": run.goal if run is not None else None,
             "runs": self._runs,
@@ -351,6 +522,7 @@ class PmNavController:
                 "max": round(1000 * per[-1], 1),
             }
         self.pub_status.publish(self._String(data=json.dumps(status)))
+        self.pub_diag.publish(diagnostic_array(status, self._stamp(), self.building.name))
 
     def _publish_map_markers(self) -> None:
         from visualization_msgs.msg import MarkerArray
@@ -483,11 +655,49 @@ def _marker_pair(mid, ns, stamp, frame, xy, text, rgb, size):
     return out
 
 
+HELP = """The PM-Nav controller for an iRobot Create 3 (or pmnav-sim-create3).
+Goals: the navigate_to_room action (pmnav_interfaces/action/NavigateToRoom), a room
+name on the goal topic, or a PoseStamped on goal_pose (the nearest room door).
+Status on /diagnostics. --record FILE.mcap writes the run (camera, odometry,
+cmd_vel, plan, trajectory, markers, tree snapshots) as ROS 2 MCAP. docs/ros2.md."""
+EXAMPLE = "pmnav-ros --ros-args -p building:=fig2_hospital"
+
+
+def split_record(args: list[str]) -> tuple[str, list[str]]:
+    """(the ``--record`` path or "", the arguments left for rclpy)."""
+    head, tail = args, []
+    if "--ros-args" in args:
+        i = args.index("--ros-args")
+        head, tail = args[:i], args[i:]
+    record, rest = "", head[:1]
+    i = 1
+    while i < len(head):
+        a = head[i]
+        if a == "--record" or a.startswith("--record="):
+            value = a.split("=", 1)[1] if "=" in a else (head[i + 1] if i + 1 < len(head) else "")
+            if not value.endswith(".mcap"):
+                raise PmNavError(f"--record needs a FILE.mcap, not {value!r}")
+            record = value
+            i += 1 if "=" in a else 2
+            continue
+        rest.append(a)
+        i += 1
+    return record, rest + tail
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console script ``pmnav-ros``: ``pmnav-ros --ros-args -p building:=fig2_hospital``."""
     from pmnav_bt.hardware.runtime import RosRuntime
 
     args = list(sys.argv if argv is None else argv)
+    if wants_help(args):
+        print(usage("pmnav-ros [--record FILE.mcap]", HELP, PARAMETERS, EXAMPLE))
+        sys.exit(0)
+    try:
+        record, args = split_record(args)
+    except PmNavError as err:
+        print(f"pmnav-ros: {err}", file=sys.stderr)
+        sys.exit(2)
     # The cmd_vel heartbeat thread must get the GIL quickly while the tree and the
     # perception worker run: hand it over every 1 ms instead of 5 ms.
     sys.setswitchinterval(0.001)
@@ -502,7 +712,7 @@ def main(argv: list[str] | None = None) -> None:
     controller = None
     code = 0
     try:
-        controller = PmNavController(node, runtime)
+        controller = PmNavController(node, runtime, record=record)
         runtime.add(node)
         runtime.install_signals(controller.request_stop)
         runtime.start()
@@ -516,6 +726,8 @@ def main(argv: list[str] | None = None) -> None:
         if controller is not None:
             controller.base.close()
         runtime.shutdown()
+        if controller is not None and controller.recorder is not None:
+            controller.recorder.close()
     sys.exit(code)
 
 

@@ -249,9 +249,15 @@ class SimCreate3:
 def main(argv: list[str] | None = None) -> None:
     """Console script ``pmnav-sim-create3``: ``pmnav-sim-create3 --ros-args -p
     building:=fig2_hospital -p start_pose:=22,0,0``."""
+    from pmnav_bt.hardware.params import usage, wants_help
     from pmnav_bt.hardware.runtime import RosRuntime
 
     args = list(sys.argv if argv is None else argv)
+    if wants_help(args):
+        print(usage("pmnav-sim-create3", (__doc__ or "").split("\n\n")[0], PARAMETERS,
+                    "pmnav-sim-create3 --ros-args -p building:=fig2_hospital "
+                    "-p start_pose:=47,20,0"))  # fmt: skip
+        sys.exit(0)
     try:
         runtime = RosRuntime(args=args)
     except PmNavError as err:  # rclpy missing, or bad --ros-args
