@@ -9,7 +9,7 @@ OUT ?= out
 
 .PHONY: setup demo test lint bench clean
 
-setup: $(VENV)/.installed
+setup: $(VENV)/.installed $(VENV)/.interfaces
 
 $(VENV)/.installed: pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -17,6 +17,12 @@ $(VENV)/.installed: pyproject.toml
 	$(BIN)/pip install --quiet torch==2.13.0
 	$(BIN)/pip install --quiet -e ".[dev,ros]"
 	touch $@
+
+# The ROS 2 interface package (NavigateToRoom action), built with rosidl + ament_cmake from
+# PyPI into the venv (~35 s). Needs cmake and a C++ compiler; without them pmnav-ros runs
+# with its goal topics only and the action tests are skipped.
+$(VENV)/.interfaces: $(VENV)/.installed interfaces/build.sh $(wildcard interfaces/pmnav_interfaces/*.*) $(wildcard interfaces/pmnav_interfaces/action/*)
+	interfaces/build.sh $(VENV) && touch $@ || echo "make: pmnav_interfaces not built (see above); the action is unavailable"
 
 demo: setup
 	mkdir -p $(OUT)

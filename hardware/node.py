@@ -144,6 +144,7 @@ class _Run:
     cancel: threading.Event = field(default_factory=threading.Event)
     reason: str = ""
     request: GoalRequest | None = None
+    waiting: bool = False  # for fresh sensors, before the tree starts
 
     def cancelled(self) -> bool:
         """Set by a cancel/preempt, or the action client asked to cancel."""
@@ -381,7 +382,7 @@ class PmNavController:
             room = self.building.room(resolve_room(self.pm, goal))
         except Exception:  # noqa: BLE001 - an unknown room: the tree reports INVALID_GOAL
             return {"room_id": "", "room_name": ""}
-        return {"room_id": room.id, "room_name": room.sign_text}
+        return {"room_id": room.id, "room_name": room.display_name}
 
     def _wait_ready(self, run: _Run, req: GoalRequest, w0: float) -> None:
         """Wait for fresh sensors (feedback meanwhile); NotReadyError after the timeout."""
@@ -396,7 +397,11 @@ class PmNavController:
 
         timeout = float(self.params["ready_timeout_s"])
         self.log.info(f"goal {req.goal!r} waits for: {'; '.join(self.readiness.missing())}")
-        missing = self.readiness.wait(timeout, run.cancelled, on_wait)
+        run.waiting = True
+        try:
+            missing = self.readiness.wait(timeout, run.cancelled, on_wait)
+        finally:
+            run.waiting = False
         if run.cancelled():
             raise Cancelled(run.reason or "cancelled")
         if missing:
@@ -505,6 +510,7 @@ class PmNavController:
             "ready": not missing,
             "missing": missing,
             "state": "running" if run is not None else "idle",
+            "waiting_for_sensors": run is not None and run.waiting,
             "goal": run.goal if run is not None else None,
             "runs": self._runs,
             "odom_age": None if s["odom_age"] is None else round(s["odom_age"], 3),

@@ -8,7 +8,7 @@
 Needs the ROS 2 launch packages (``launch``, ``launch_ros``, ``ros2launch``), which the
 PyPI wheels this project installs do not include: run it on a ROS 2 Jazzy install
 (``source /opt/ros/jazzy/setup.bash``) with this project pip-installed into that
-Python, or start the two console scripts by hand (docs/ros2.md). The nodes are the
+Python. Without them, ``pmnav-launch`` (same arguments) starts the same processes. The nodes are the
 console scripts ``pmnav-sim-create3`` and ``pmnav-ros`` (``ExecuteProcess``: they are
 pip entry points, not ament packages).
 """
@@ -20,22 +20,13 @@ from launch.actions import DeclareLaunchArgument, ExecuteProcess, LogInfo
 from launch.conditions import IfCondition
 from launch.substitutions import LaunchConfiguration
 
-ARGS = {
-    "sim": ("true", "start pmnav-sim-create3 (false: a real Create 3 and camera)"),
-    "building": ("fig2_hospital", "building file (YAML) or built-in name"),
-    "start_pose": ("", "simulator start x,y,yaw_deg (empty: the building's start)"),
-    "width": ("320", "simulated camera width"),
-    "height": ("240", "simulated camera height"),
-    "camera_rate_hz": ("5.0", "simulated camera rate"),
-    "config": ("", "PM-Nav config file"),
-    "overrides": ("", "config overrides 'section.key=value;...'"),
-    "namespace": ("/", "robot namespace (a Create 3's, e.g. /robot1)"),
-    "image_topic": ("camera/image_raw", ""),
-    "camera_info_topic": ("camera/camera_info", ""),
-    "depth_topic": ("camera/depth/image_raw", ""),
-    "segmentation_topic": ("camera/segmentation", "empty on a real robot"),
-    "tree_log": ("", "also write tree snapshots (JSON lines) here"),
-}
+from pmnav_bt.hardware.launcher import ARGS as LAUNCHER_ARGS
+from pmnav_bt.hardware.launcher import CONTROLLER_STRINGS, SIM_NUMBERS, SIM_STRINGS
+
+# The arguments and the parameters each node gets are shared with ``pmnav-launch``
+# (pmnav_bt/hardware/launcher.py), the launcher that runs without the launch packages
+# (it is what the tests run).
+ARGS = {k: v for k, v in LAUNCHER_ARGS.items() if k != "record"}
 
 
 def _ros_args(node: str, strings: list[str], numbers: tuple[str, ...] = ()) -> list:
@@ -53,29 +44,13 @@ def _ros_args(node: str, strings: list[str], numbers: tuple[str, ...] = ()) -> l
 def generate_launch_description() -> LaunchDescription:
     decls = [DeclareLaunchArgument(k, default_value=v, description=d) for k, (v, d) in ARGS.items()]
     sim = ExecuteProcess(
-        cmd=["pmnav-sim-create3"]
-        + _ros_args(
-            "sim_create3", ["building", "start_pose"], ("width", "height", "camera_rate_hz")
-        ),
+        cmd=["pmnav-sim-create3"] + _ros_args("sim_create3", list(SIM_STRINGS), SIM_NUMBERS),
         name="sim_create3",
         output="screen",
         condition=IfCondition(LaunchConfiguration("sim")),
     )
     controller = ExecuteProcess(
-        cmd=["pmnav-ros"]
-        + _ros_args(
-            "pmnav",
-            [
-                "building",
-                "config",
-                "overrides",
-                "image_topic",
-                "camera_info_topic",
-                "depth_topic",
-                "segmentation_topic",
-                "tree_log",
-            ],
-        ),
+        cmd=["pmnav-ros"] + _ros_args("pmnav", list(CONTROLLER_STRINGS)),
         name="pmnav",
         output="screen",
         # SIGINT first: pmnav-ros sends a zero cmd_vel before it exits.
