@@ -2,7 +2,11 @@
 
 - ``create3``: the iRobot Create 3 as a ``Base`` over rclpy (cmd_vel heartbeat, odom,
   camera, safety stops); ``clock``: ``RosClock``;
-- ``node``: the ``pmnav-ros`` controller node; ``goal``: ``pmnav-ros-goal``;
+- ``node``: the ``pmnav-ros`` controller node, wiring ``readiness`` (fresh sensors before a
+  goal), ``requests`` (goals from any front end, feedback), ``action_server`` (the
+  ``navigate_to_room`` action), ``diagnostics`` (/diagnostics), ``params`` (validation,
+  --help) and ``recorder`` (--record FILE.mcap); ``goal``: ``pmnav-ros-goal``;
+  ``launcher``: ``pmnav-launch``, what launch/pmnav.launch.py does without launch_ros;
 - ``sim_create3``: ``pmnav-sim-create3``, the pybullet simulator behind the robot's topics;
 - ``env``, ``runtime``, ``qos``, ``messages``, ``testing``: environment, executor, QoS,
   message conversions, subprocess helpers.
