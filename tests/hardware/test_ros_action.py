@@ -183,6 +183,32 @@ class TestLaunched:
             "the simulated base to stop",
         )
 
+    def test_goal_pose_goes_to_the_nearest_door(self, launched):
+        """RViz's 2D Goal Pose on goal_pose, 0.5 m from room17's door: the run's goal is
+        room17 (cancelled at once; the result topic says so)."""
+        from geometry_msgs.msg import PoseStamped
+        from std_msgs.msg import Empty
+
+        from pmnav_bt.hardware import qos
+        from pmnav_bt.map.building import load_building
+
+        client, state = launched
+        probe = state["probe"]
+        door = load_building("fig2_hospital").room("room17").door
+        pub = probe.node.create_publisher(PoseStamped, "goal_pose", qos.events())
+        cancel = probe.node.create_publisher(Empty, "cancel", qos.events())
+        _wait(lambda: pub.get_subscription_count() > 0, 10.0, "the goal_pose subscriber")
+        msg = PoseStamped()
+        msg.header.frame_id = "map"
+        msg.pose.position.x, msg.pose.position.y = door[0] + 0.5, door[1]
+        msg.pose.orientation.w = 1.0
+        n = len(probe.results)
+        pub.publish(msg)
+        probe.wait_for(lambda: probe.status and probe.status["goal"] == "room17", 10.0, "run")
+        cancel.publish(Empty())
+        r = probe.wait_for(lambda: probe.results[n:] and probe.results[-1], 30.0, "the result")
+        assert r["goal"] == "room17" and r["code"] == "CANCELLED"
+
     def test_diagnostics_and_status_report_ready(self, launched):
         _, state = launched
         probe = state["probe"]
