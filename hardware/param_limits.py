@@ -13,6 +13,7 @@ LIMITS: dict[str, tuple[float, float]] = {
     "budget": (0, 100_000),
     "seed": (0, 2**63 - 1),
     "max_duration_s": (1.0, 7 * 86_400.0),
+    "ready_timeout_s": (0.0, 86_400.0),
     "cmd_rate_hz": (1.0, 1000.0),
     "odom_timeout": (0.01, 60.0),
     "odom_fault_s": (0.01, 600.0),
