@@ -59,6 +59,7 @@ from pmnav_bt.hardware.messages import (
     stamp_to_sec,
 )
 from pmnav_bt.seams import (
+    CAMERA_HEIGHT_M,
     CREATE3_MAX_ANGULAR,
     CREATE3_MAX_LINEAR,
     FORWARD_STEP_M,
@@ -105,7 +106,7 @@ class Create3Options:
     sync_slop: float = 0.05  # depth/segmentation match the colour frame within this (s)
     max_linear: float = MAX_LINEAR
     max_angular: float = MAX_ANGULAR
-    camera_height: float = 1.6
+    camera_height: float = CAMERA_HEIGHT_M
     hfov_deg: float = 60.0  # intrinsics until a CameraInfo arrives
     stall_s: float = 2.0
 

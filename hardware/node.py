@@ -54,7 +54,7 @@ from pmnav_bt.hardware.params import check_unknown, usage, wants_help
 from pmnav_bt.hardware.readiness import Readiness
 from pmnav_bt.hardware.recorder import McapRecorder
 from pmnav_bt.hardware.requests import GoalPoseError, GoalRequest, goal_from_pose, progress
-from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR, Pose2D
+from pmnav_bt.seams import CAMERA_HEIGHT_M, CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR, Pose2D
 
 # name -> (default, description). Types follow the defaults.
 PARAMETERS: dict[str, tuple[Any, str]] = {
@@ -81,7 +81,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "sync_slop": (0.05, "depth/segmentation match the colour frame within this (s)"),
     "max_linear": (CREATE3_MAX_LINEAR, "m/s"),
     "max_angular": (CREATE3_MAX_ANGULAR, "rad/s"),
-    "camera_height": (1.6, "m above the floor"),
+    "camera_height": (CAMERA_HEIGHT_M, "m above the floor"),
     "hfov_deg": (60.0, "horizontal field of view until a CameraInfo arrives"),
     "stall_s": (2.0, "a motion without progress for this long is BLOCKED"),
     "map_frame": ("map", ""),

@@ -31,7 +31,7 @@ import time
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
-from pmnav_bt.seams import Pose2D
+from pmnav_bt.seams import CAMERA_HEIGHT_M, Pose2D
 
 PARAMETERS = {
     "building": ("fig2_hospital", "building file (YAML) or built-in name"),
@@ -39,7 +39,7 @@ PARAMETERS = {
     "width": (320, "camera image width, pixels"),
     "height": (240, "camera image height, pixels"),
     "hfov_deg": (60.0, "horizontal field of view"),
-    "camera_height": (1.6, "m"),
+    "camera_height": (CAMERA_HEIGHT_M, "m"),
     "camera_rate_hz": (5.0, "frames per second (rendering costs ~25 ms at 320x240)"),
     "odom_rate_hz": (20.0, ""),
     "physics_rate_hz": (50.0, "how often sim time catches up with the wall clock"),

@@ -131,7 +131,9 @@ def plan(
     goal: str = typer.Option(..., "--to", help="Goal room: ID, name or alias."),
     as_json: bool = typer.Option(False, "--json", help="Print the plan as JSON."),
     image: Path | None = typer.Option(None, "--image", help="Draw the plan on the annotated map."),
-    max_gap: float = typer.Option(10.0, help="Most metres between consecutive plan steps."),
+    max_gap: float | None = typer.Option(
+        None, help="Most metres between consecutive plan steps (default: the planner's, 8)."
+    ),
 ) -> None:
     """Plan from a start to a goal room: ordered {landmark: action} steps."""
     from pmnav_bt.planning.graph_planner import GraphPlanner
@@ -140,7 +142,8 @@ def plan(
     if image is not None:
         check_output_file(image, "--image", IMAGE_SUFFIXES)
     pm = _priori_map(file)
-    p = GraphPlanner(max_gap=max_gap).plan(pm, start, goal)
+    planner = GraphPlanner() if max_gap is None else GraphPlanner(max_gap=max_gap)
+    p = planner.plan(pm, start, goal)
     typer.echo(p.to_json() if as_json else p.text())
     if image is not None:
         from pmnav_bt.render.annotate import render_annotated_map

@@ -14,7 +14,9 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from pmnav_bt.errors import ConfigError, PmNavError
+from pmnav_bt.eval.task import BUDGET_ACTIONS, BUDGET_PATH_FACTOR, STOP_OFFSET_M
 from pmnav_bt.loading import InputFileError, load_yaml, parse_yaml_value
+from pmnav_bt.planning.graph_planner import MAX_GAP_M
 from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR
 
 
@@ -73,7 +75,9 @@ class RefinerConfig(_Section):
 class PlannerConfig(_Section):
     backend: str = Field("graph", description="priori-map + start + goal -> plan")
     _check_backend = _registered("planner")
-    max_gap: float = Field(8.0, gt=0.0, le=1000.0, description="most metres between plan steps")
+    max_gap: float = Field(
+        MAX_GAP_M, gt=0.0, le=1000.0, description="most metres between plan steps"
+    )
 
 
 class TreeConfig(_Section):
@@ -84,13 +88,13 @@ class TreeConfig(_Section):
         10.0, ge=0.5, le=1000.0, description="tree ticks per second of the clock"
     )
     budget_actions: int = Field(
-        500, ge=1, le=100_000, description="action budget (Habitat ObjectNav)"
+        BUDGET_ACTIONS, ge=1, le=100_000, description="action budget (Habitat ObjectNav)"
     )
     budget_path_factor: float = Field(
-        3.0,
+        BUDGET_PATH_FACTOR,
         gt=0.0,
         le=100.0,
-        description="budget = max(budget_actions, factor * shortest path in actions)",
+        description="budget = max(budget_actions, factor * corridor route in forward steps)",
     )
     localization_attempts: int = Field(4, ge=1, le=100, description="localization tries")
     explore_distance: float = Field(2.0, gt=0.0, le=100.0, description="m explored between tries")
@@ -108,7 +112,9 @@ class TreeConfig(_Section):
         description="move this far towards a target not found before searching again",
     )
     replans: int = Field(2, ge=0, le=100, description="re-localize-and-replan recoveries")
-    goal_offset: float = Field(0.6, ge=0.0, le=10.0, description="stop this far from the goal door")
+    goal_offset: float = Field(
+        STOP_OFFSET_M, ge=0.0, le=10.0, description="stop this far from the goal door"
+    )
     step_timeout_s: float = Field(
         180.0, gt=0.0, le=86_400.0, description="clock seconds per plan step"
     )

@@ -29,6 +29,8 @@ TURN_STEP_RAD = math.radians(30.0)
 # The iRobot Create 3's speed limits (safety_override none), used by every body and the tree.
 CREATE3_MAX_LINEAR = 0.306  # m/s
 CREATE3_MAX_ANGULAR = 1.9  # rad/s
+CREATE3_RADIUS_M = 0.17  # body radius (342 mm across), for collisions and shortest paths
+CAMERA_HEIGHT_M = 1.6  # camera above the floor (paper), for every body and the simulator
 
 
 @dataclass(frozen=True)
@@ -108,7 +110,7 @@ class Observation:
     depth: np.ndarray | None = None  # (H, W) float32 metres along the optical axis
     segmentation: np.ndarray | None = None  # (H, W) int32
     labels: dict[int, str] = field(default_factory=dict)
-    camera_height: float = 1.6
+    camera_height: float = CAMERA_HEIGHT_M
 
 
 class DiscreteAction(str, Enum):

@@ -104,24 +104,22 @@ def _hold_gui(world) -> None:  # pragma: no cover - needs a display
         pass
 
 
-TIER_NAMES = ("easy", "medium", "hard")
-
-
 def _tiers(tier: str) -> list[str]:
-    if tier == "all":
-        return list(TIER_NAMES)
-    if tier not in TIER_NAMES:
-        raise PmNavError(f"--tier {tier!r}: choose easy, medium, hard or all")
-    return [tier]
+    from pmnav_bt.eval.tiers import parse_tiers
+
+    try:
+        return parse_tiers(tier)
+    except ValueError as err:
+        raise PmNavError(f"--tier: {err}") from None
 
 
 def _buildings(building: str) -> list[str]:
+    """'all' (every built-in building), or comma-separated files and built-in names."""
     from pmnav_bt.map.building import builtin_buildings
 
-    if building != "all":
-        return [b.strip() for b in building.split(",") if b.strip()]
-    six = ["straight_office", "l_hospital", "t_school", "u_office", "loop_hospital", "ring_school"]
-    return [b for b in six if b in builtin_buildings()]
+    if building.strip() == "all":
+        return builtin_buildings()
+    return [b.strip() for b in building.split(",") if b.strip()]
 
 
 def _config(config: Path | None, overrides: list[str] | None):
@@ -137,31 +135,44 @@ SET_OPT = typer.Option(None, "--set", help="Override a config value: section.key
 @app.command()
 def episodes(
     building: str = typer.Argument(..., help="A building file or built-in name."),
-    tier: str = typer.Option("easy", "--tier", help="easy, medium, hard or all."),
+    tier: str = typer.Option("easy", "--tier", help="easy, medium, hard, a list, or all."),
     n: int = typer.Option(20, "-n", min=1, help="Episodes per tier."),
     seed: int = typer.Option(0, "--seed"),
-    out: Path | None = typer.Option(None, "--out", help="JSON file (default: print)."),
+    out: Path | None = typer.Option(None, "--out", help="JSON file (default: standard output)."),
 ) -> None:
-    """Generate seeded episodes of a tier and save them as JSON."""
-    from pmnav_bt.sim.episodes import generate_episodes, save_episodes, tier_definition
+    """Generate seeded episodes of tiers as JSON (on standard output, or to --out).
+
+    The tier definitions go to standard error.
+    """
+    from pmnav_bt.sim.episodes import (
+        episodes_json,
+        generate_episodes,
+        save_episodes,
+        tier_definition,
+    )
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
-    if out is None:
-        out = Path(f"{safe_filename(Path(building).stem)}_{safe_filename(tier)}_episodes.json")
-    check_output_file(out, "--out", (".json",))
+    if out is not None:
+        check_output_file(out, "--out", (".json",))
     eps = []
     for t in _tiers(tier):
         eps += generate_episodes(building, t, n, seed=seed)
+    text = episodes_json(eps)
+    typer.echo(tier_definition(), err=True)
+    if out is None:
+        sys.stdout.write(text)
+        return
     save_episodes(eps, out)
-    typer.echo(tier_definition())
-    typer.echo(f"wrote {len(eps)} episodes to {out}")
+    typer.echo(f"wrote {len(eps)} episodes to {out}", err=True)
 
 
 @app.command()
 def run(
     building: str = typer.Option("fig2_hospital", "--building", help="A building or built-in."),
-    goal: str = typer.Option(..., "--goal", help="The goal room: ID, name or alias."),
+    goal: str | None = typer.Option(
+        None, "--goal", help="The goal room: ID, name or alias (not with --episodes)."
+    ),
     start: str | None = typer.Option(
         None, "--start", help="Start: a segment, waypoint, or pose 'x,y,yaw_deg' (default: start)."
     ),
@@ -183,12 +194,17 @@ def run(
     cfg = _config(config, overrides)
     check_output_dir(out)
     if episode_file is not None:
-        from pmnav_bt.sim.episodes import load_episodes
+        from pmnav_bt.sim.episodes import episode_building_file, load_episodes
 
+        if goal is not None or start is not None:
+            raise PmNavError("--episodes runs a stored episode: drop --goal and --start")
         eps = load_episodes(episode_file)
         if not 0 <= index < len(eps):
             raise PmNavError(f"--index {index}: {episode_file} has {len(eps)} episodes")
         ep = eps[index]
+        episode_building_file(ep)  # a missing or changed building: one clear line, now
+    elif goal is None:
+        raise PmNavError("give --goal ROOM (or --episodes FILE --index N)")
     else:
         ep = custom_episode(building, goal, start, seed)
     live = None
@@ -199,7 +215,7 @@ def run(
     typer.echo(
         f"{VARIANT_NAMES[cfg.tree.variant]} in {ep.building}: {ep.id} ({ep.tier}), "
         f"start ({ep.start_x:.1f}, {ep.start_y:.1f}, {math.degrees(ep.start_yaw):.0f} deg), "
-        f"shortest path {ep.geodesic_length:.1f} m"
+        f"corridor route {ep.route_length:.1f} m"
     )
     if live is not None:
         with live:
@@ -209,8 +225,9 @@ def run(
     res = r.result
     typer.echo(
         f"{'SUCCESS' if res.success else 'FAILURE'}: SPL {res.spl:.3f}, {res.steps} actions, "
-        f"{res.path_length:.1f} m driven, {res.collisions} collisions, stopped "
-        f"{res.distance_to_goal:.2f} m from the door, {res.wall_time:.1f} s wall"
+        f"{res.path_length:.1f} m driven (shortest {res.shortest_path_length:.1f} m), "
+        f"{res.collisions} collisions, stopped {res.distance_to_door:.2f} m from the door, "
+        f"{res.wall_time:.1f} s wall"
     )
     if res.failure_reason:
         typer.echo(f"reason: {res.failure_reason}")
@@ -221,8 +238,10 @@ def run(
 
 @app.command("eval")
 def eval_(
-    building: str = typer.Option("all", "--building", help="Comma-separated buildings, or all."),
-    tier: str = typer.Option("all", "--tier", help="easy, medium, hard or all."),
+    building: str = typer.Option(
+        "all", "--building", help="Comma-separated building files or built-in names, or all."
+    ),
+    tier: str = typer.Option("all", "--tier", help="easy, medium, hard, a list, or all."),
     n: int = typer.Option(20, "-n", min=1, help="Episodes per tier per building."),
     seed: int = typer.Option(0, "--seed"),
     variants: str = typer.Option("pmnav,coarse_only", "--variants", help="Tree variants."),
@@ -233,18 +252,23 @@ def eval_(
     config: Path | None = CONFIG_OPT,
     overrides: list[str] | None = SET_OPT,
 ) -> None:
-    """Run many episodes and print SR/SPL per tier for each tree variant (paper Table 1)."""
+    """Run many episodes and print SR/SPL per tier for each tree variant (paper Table 1).
+
+    Exits 1 when episodes could not be run (errors are counted apart from failures).
+    """
     from rich.progress import Progress
 
+    from pmnav_bt.eval.task import budget_rule
+    from pmnav_bt.eval.tiers import tier_definition
     from pmnav_bt.experiments.evaluation import (
         comparison_markdown,
         episodes_for,
+        error_counts,
         evaluate,
         save_evaluation,
         variant_configs,
     )
     from pmnav_bt.interrupts import Interrupted, JsonlAppender, stop_signals
-    from pmnav_bt.sim.episodes import tier_definition
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
@@ -299,11 +323,19 @@ def eval_(
         f"# PM-Nav evaluation\n\nbuildings: {building}; tiers: {tier}; {n} per tier per "
         f"building; seed {seed}; grounder {g.backend} (miss {g.miss_rate:.0%}, false positives "
         f"{g.false_positive_rate:.0%}); odometry noise {cfg.sim.odometry_noise:.0%}; camera "
-        f"{cfg.sim.width}x{cfg.sim.height}\n\nAction budget: max({cfg.tree.budget_actions}, "
-        f"{cfg.tree.budget_path_factor:g} x shortest path / 0.25 m, the episode's own budget).\n\n"
-        + "Tiers:\n"
-        + tier_definition()
+        f"{cfg.sim.width}x{cfg.sim.height}\n\nTiers:\n"
+        + tier_definition(budget_rule(cfg.tree.budget_actions, cfg.tree.budget_path_factor))
     )
     md = save_evaluation(results, out, header)
     typer.echo(comparison_markdown(results))
     typer.echo(f"wrote {md} and {out / 'results.json'}")
+    errors = error_counts(results)
+    if errors:
+        first = next(r.error for rs in results.values() for r in rs if r.error)
+        counts = ", ".join(f"{name} {c} of {len(results[name])}" for name, c in errors.items())
+        typer.echo(
+            f"error: episodes could not be run ({counts}); first: {first}; "
+            f"see {out / 'results.json'}",
+            err=True,
+        )
+        raise typer.Exit(1)

@@ -1,14 +1,13 @@
-"""Navigation episodes: tiers, geodesic paths, a seeded generator, and the JSON episode file.
+"""Navigation episodes: a seeded generator, corridor routes, the JSON episode file, scoring.
 
-An episode is a start pose on a corridor centre line (yaw along the corridor) and a goal
-room. Its geodesic is the corridor-graph path from the start to the goal room's node on
-the centre line, then straight to the goal *stop point*, ``STOP_OFFSET_M`` from the door
-point towards the corridor centre. Success is stopping within ``SUCCESS_RADIUS_M`` of the
-door point (:mod:`pmnav_bt.eval.metrics`).
-
-The tiers (paper RQ1) are defined once, in ``TIERS``, by structure (goal visible from the
-start, turns and forks on the path) and path length in paper "steps" of ``STEP_M``;
-``tier_definition()`` prints them.
+An episode is a start pose on a corridor centre line (yaw along the corridor), a goal
+room and the building file it was made for (its absolute path and sha256: running an
+episode re-checks that the file has not changed). Its *route* is the corridor-graph path
+from the start to the goal room's node on the centre line, then straight to the goal
+*stop point*, ``STOP_OFFSET_M`` from the door point towards the corridor centre; the
+tiers (:mod:`pmnav_bt.eval.tiers`) and the action budget (:mod:`pmnav_bt.eval.task`)
+are judged on it. SPL's shortest path is not the route but the free-space geodesic to
+the success disc (:func:`goal_geodesic`), which a driven robot can match.
 """
 
 from __future__ import annotations
@@ -25,18 +24,38 @@ import networkx as nx
 import numpy as np
 
 from pmnav_bt.errors import PmNavError, Problem
-from pmnav_bt.eval.metrics import SUCCESS_RADIUS_M, EpisodeResult, spl, success
+from pmnav_bt.eval.geodesic import GeodesicField
+from pmnav_bt.eval.metrics import EpisodeResult, soft_spl, spl, success
+from pmnav_bt.eval.task import STOP_OFFSET_M, SUCCESS_RADIUS_M, action_budget
+from pmnav_bt.eval.tiers import (
+    START_CLEARANCE_M,
+    STEP_M,
+    TIERS,
+    VISIBLE_HALF_FOV_DEG,
+    VISIBLE_RANGE_M,
+    PathFacts,
+    TierSpec,
+    classify,
+    tier_definition,
+    within,
+)
 from pmnav_bt.geometry import Action, heading, point_towards, relative_action, wrap_angle
 from pmnav_bt.loading import InputFileError, atomic_write_text, load_json
-from pmnav_bt.map.building import Building, load_building
+from pmnav_bt.map.building import (
+    Building,
+    building_sha256,
+    builtin_buildings,
+    load_building,
+    resolve_building_path,
+)
+from pmnav_bt.map.free_space import free_space_polygon
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.planning.resolve import resolve_room
-from pmnav_bt.seams import FORWARD_STEP_M, Pose2D
+from pmnav_bt.seams import CREATE3_RADIUS_M, Pose2D
 
 __all__ = [
     "EPISODES_SCHEMA_VERSION",
     "START_CLEARANCE_M",
-    "STEP_BUDGET",
     "STEP_M",
     "STOP_OFFSET_M",
     "SUCCESS_RADIUS_M",
@@ -46,142 +65,29 @@ __all__ = [
     "Episode",
     "EpisodeFileError",
     "EpisodeGenerationError",
+    "EpisodeBuildingError",
     "PathFacts",
     "TierSpec",
     "classify",
+    "episode_building",
+    "episode_building_file",
+    "episodes_json",
     "generate_episodes",
-    "geodesic_length",
     "goal_door",
+    "goal_geodesic",
     "goal_stop_point",
     "load_episodes",
     "path_facts",
+    "route_length",
     "save_episodes",
+    "score_episode",
     "shortest_path_points",
-    "step_budget",
     "tier_definition",
 ]
 
-# -- the numbers, in one place ------------------------------------------------------------
-
-STEP_M = 1.0  # one paper "step" (RQ1 step counts fit moves of about a metre)
-STOP_OFFSET_M = 0.6  # stop point: this far from the door point towards the corridor centre
-VISIBLE_RANGE_M = 10.0  # a door sign is readable up to this distance
-VISIBLE_HALF_FOV_DEG = 25.0  # door centre within +-this of the start heading (60 deg camera)
-START_CLEARANCE_M = 1.5  # starts at least this far from any key waypoint (junction, end)
-STEP_BUDGET = 500  # actions per episode (Habitat ObjectNav), scaled up for long paths
 _GRID_M = 0.05  # spacing of candidate start points along the centre lines
 
-EPISODES_SCHEMA_VERSION = 1
-
-
-@dataclass(frozen=True)
-class TierSpec:
-    """One difficulty tier: path length in steps and the structure the path must have."""
-
-    name: str
-    min_steps: int
-    max_steps: int
-    goal_visible: bool | None  # required value; None: either
-    min_turns: int
-    max_turns: int | None
-    min_forks: int
-    max_forks: int | None
-    paper: str  # the paper's words (RQ1)
-
-    @property
-    def length_band(self) -> tuple[float, float]:
-        """Geodesic length band in metres, [lo, hi): step counts rounded to the nearest step."""
-        return (self.min_steps - 0.5) * STEP_M, (self.max_steps + 0.5) * STEP_M
-
-    def accepts(self, facts: PathFacts) -> bool:
-        lo, hi = self.length_band
-        return (
-            lo <= facts.length < hi
-            and (self.goal_visible is None or facts.goal_visible == self.goal_visible)
-            and _within(facts.turns, self.min_turns, self.max_turns)
-            and _within(facts.forks, self.min_forks, self.max_forks)
-        )
-
-    def describe(self) -> str:
-        lo, hi = self.length_band
-        vis = {True: "goal visible", False: "goal not visible", None: "goal visible or not"}
-        return (
-            f"{self.name}: {vis[self.goal_visible]}; turns {_range(self.min_turns, self.max_turns)}"
-            f"; forks {_range(self.min_forks, self.max_forks)}; "
-            f"{self.min_steps}-{self.max_steps} steps (geodesic {lo:.1f} <= l < {hi:.1f} m)"
-            f"  [paper: {self.paper}]"
-        )
-
-
-def _within(v: int, lo: int, hi: int | None) -> bool:
-    return v >= lo and (hi is None or v <= hi)
-
-
-def _range(lo: int, hi: int | None) -> str:
-    if hi is None:
-        return f">= {lo}"
-    return f"= {lo}" if lo == hi else f"{lo}-{hi}"
-
-
-TIERS: dict[str, TierSpec] = {
-    t.name: t
-    for t in (
-        TierSpec(
-            name="easy",
-            min_steps=3,
-            max_steps=5,
-            goal_visible=True,
-            min_turns=0,
-            max_turns=0,
-            min_forks=0,
-            max_forks=0,
-            paper="goal in view, reachable in 3-5 steps",
-        ),
-        TierSpec(
-            name="medium",
-            min_steps=6,
-            max_steps=10,
-            goal_visible=False,
-            min_turns=1,
-            max_turns=None,
-            min_forks=0,
-            max_forks=0,
-            paper="goal not visible, at least one turn, 6-10 steps",
-        ),
-        TierSpec(
-            name="hard",
-            min_steps=11,
-            max_steps=60,
-            goal_visible=False,
-            min_turns=2,
-            max_turns=None,
-            min_forks=1,
-            max_forks=None,
-            paper="several turns and fork selections, more than 10 steps",
-        ),
-    )
-}
-
-
-def tier_definition() -> str:
-    """The tier definitions as text, to print with results."""
-    lines = [
-        "Episode tiers (PM-Nav RQ1), by structure and geodesic length l from the start to the "
-        f"goal stop point ({STOP_OFFSET_M:g} m from the door towards the corridor centre); "
-        f"1 step = {STEP_M:g} m:",
-    ]
-    lines += [f"- {t.describe()}" for t in TIERS.values()]
-    lines += [
-        f"Goal visible: the goal door is on the start's straight corridor (no key waypoint "
-        f"between), within {VISIBLE_RANGE_M:g} m and +-{VISIBLE_HALF_FOV_DEG:g} deg of the "
-        "start heading. Turn: the path bends by more than 30 deg at a waypoint. Fork: the path "
-        "passes a branch waypoint (3+ corridors meet). The hard tier is capped at "
-        f"{TIERS['hard'].max_steps} steps. Starts lie on a corridor centre line, at least "
-        f"{START_CLEARANCE_M:g} m from any key waypoint, facing along the corridor. "
-        f"Success: stop within {SUCCESS_RADIUS_M:g} m of the door point. Step budget: "
-        f"{STEP_BUDGET} actions, or twice the forward steps of the geodesic if more.",
-    ]
-    return "\n".join(lines)
+EPISODES_SCHEMA_VERSION = 2
 
 
 # -- errors ---------------------------------------------------------------------------------
@@ -202,12 +108,20 @@ class EpisodeGenerationError(PmNavError):
     """No episodes of the asked tier fit the building (or the tier name is unknown)."""
 
 
+class EpisodeBuildingError(PmNavError):
+    """An episode's building file is missing or has changed since the episode was made."""
+
+
 # -- episodes -------------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
 class Episode:
-    """One navigation task: start pose, goal room and the facts of its geodesic."""
+    """One navigation task: start pose, goal room, its building file and route facts.
+
+    ``building`` is the building's name; ``building_path`` its file (absolute) and
+    ``building_sha256`` the file's content hash, checked when the episode is run.
+    """
 
     id: str
     building: str
@@ -216,13 +130,19 @@ class Episode:
     start_y: float
     start_yaw: float  # rad, CCW from +x
     goal: str  # room id
-    geodesic_length: float  # metres, start to the goal stop point
+    route_length: float  # metres along the corridor route, start to the goal stop point
     seed: int  # for everything random inside the episode (noise, detector misses)
     goal_visible: bool
     turns: int
     forks: int
-    route: tuple[str, ...] = ()  # priori-map nodes of the geodesic, ending at the goal node
-    step_budget: int = STEP_BUDGET
+    route: tuple[str, ...] = ()  # priori-map nodes of the route, ending at the goal node
+    step_budget: int = 0  # actions under the default budget rule; 0: compute it
+    building_path: str = ""  # absolute path of the building file ("" : find ``building``)
+    building_sha256: str = ""  # of the building file's bytes ("" : not checked)
+
+    def __post_init__(self) -> None:
+        if self.step_budget <= 0:
+            object.__setattr__(self, "step_budget", action_budget(self.route_length))
 
     @property
     def start_pose(self) -> Pose2D:
@@ -230,8 +150,8 @@ class Episode:
 
     @property
     def steps(self) -> int:
-        """Path length in paper steps of ``STEP_M``."""
-        return int(round(self.geodesic_length / STEP_M))
+        """Route length in paper steps of ``STEP_M``."""
+        return int(round(self.route_length / STEP_M))
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -247,15 +167,17 @@ _FIELD_TYPES: dict[str, tuple[type, ...]] = {
     "start_y": (int, float),
     "start_yaw": (int, float),
     "goal": (str,),
-    "geodesic_length": (int, float),
+    "route_length": (int, float),
     "seed": (int,),
     "goal_visible": (bool,),
     "turns": (int,),
     "forks": (int,),
     "route": (list,),
     "step_budget": (int,),
+    "building_path": (str,),
+    "building_sha256": (str,),
 }
-_OPTIONAL = {"route", "step_budget"}
+_OPTIONAL = {"route", "step_budget", "building_path", "building_sha256"}
 # Plausible magnitudes: a building fits in 1 km; text is short; budgets stay finite.
 _LIMITS: dict[str, tuple[float, float]] = {
     "id": (1, 200),
@@ -264,14 +186,16 @@ _LIMITS: dict[str, tuple[float, float]] = {
     "start_x": (-1000.0, 1000.0),
     "start_y": (-1000.0, 1000.0),
     "start_yaw": (-100.0, 100.0),
-    "geodesic_length": (0.0, 100_000.0),
+    "route_length": (0.0, 100_000.0),
     "seed": (0, 2**63 - 1),
     "turns": (0, 10_000),
     "forks": (0, 10_000),
     "route": (0, 10_000),
     "step_budget": (1, 1_000_000),
+    "building_path": (0, 4096),
+    "building_sha256": (0, 64),
 }
-_LENGTHS = {"id", "building", "goal", "route"}
+_LENGTHS = {"id", "building", "goal", "route", "building_path", "building_sha256"}
 MAX_EPISODES = 100_000
 
 
@@ -313,27 +237,65 @@ def _episode_from_dict(d: Any, where: str) -> tuple[Episode | None, list[Problem
         problems.append(
             Problem(f"{where}.tier", f"unknown tier {d['tier']!r}; known: {', '.join(TIERS)}")
         )
-    if not problems and d["geodesic_length"] < 0:
-        problems.append(Problem(f"{where}.geodesic_length", "must be non-negative"))
+    if not problems and d["route_length"] < 0:
+        problems.append(Problem(f"{where}.route_length", "must be non-negative"))
     if problems:
         return None, problems
     kw = dict(d)
     kw["route"] = tuple(kw.get("route", ()))
-    for k in ("start_x", "start_y", "start_yaw", "geodesic_length"):
+    for k in ("start_x", "start_y", "start_yaw", "route_length"):
         kw[k] = float(kw[k])
     return Episode(**kw), []
 
 
-def save_episodes(episodes: Sequence[Episode], path: str | Path) -> Path:
-    """Write episodes to a JSON file (with the tier definition, for the reader)."""
-    path = Path(path)
+def episodes_json(episodes: Sequence[Episode]) -> str:
+    """Episodes as the JSON text of an episode file (with the tier definition)."""
     data = {
         "format": "pmnav-episodes",
         "schema_version": EPISODES_SCHEMA_VERSION,
         "tier_definition": tier_definition(),
         "episodes": [e.to_dict() for e in episodes],
     }
-    return atomic_write_text(path, json.dumps(data, indent=1) + "\n")
+    return json.dumps(data, indent=1) + "\n"
+
+
+def save_episodes(episodes: Sequence[Episode], path: str | Path) -> Path:
+    """Write episodes to a JSON file (with the tier definition, for the reader)."""
+    return atomic_write_text(path, episodes_json(episodes))
+
+
+def episode_building_file(episode: Episode) -> Path:
+    """The building file an episode was made for, checked against its recorded sha256.
+
+    A recorded path that no longer exists falls back to the built-in building of the
+    episode's name when its content is the same (episode files of built-ins travel).
+    """
+    path = episode.building_path
+    if not path:
+        return resolve_building_path(episode.building)
+    if not Path(path).is_file():
+        if episode.building in builtin_buildings():
+            builtin = resolve_building_path(episode.building)
+            if not episode.building_sha256 or building_sha256(builtin) == episode.building_sha256:
+                return builtin
+        raise EpisodeBuildingError(
+            f"episode {episode.id}: building file {path} not found; the episodes were made "
+            "for it (regenerate them with 'pmnav sim episodes')"
+        )
+    if episode.building_sha256:
+        now = building_sha256(path)
+        if now != episode.building_sha256:
+            raise EpisodeBuildingError(
+                f"episode {episode.id}: building file {path} has changed since the episodes "
+                f"were made (sha256 {now[:12]}..., episodes recorded "
+                f"{episode.building_sha256[:12]}...); regenerate them with 'pmnav sim episodes'"
+            )
+    return Path(path)
+
+
+def episode_building(episode: Episode) -> Building:
+    """The building of ``episode`` (see :func:`episode_building_file`)."""
+    return load_building(episode_building_file(episode))
 
 
 def load_episodes(path: str | Path) -> list[Episode]:
@@ -363,7 +325,8 @@ def load_episodes(path: str | Path) -> list[Episode]:
             [
                 Problem(
                     "schema_version",
-                    f"this version of pmnav reads {EPISODES_SCHEMA_VERSION}, not {version!r}",
+                    f"this version of pmnav reads {EPISODES_SCHEMA_VERSION}, not {version!r}; "
+                    "regenerate the file with 'pmnav sim episodes'",
                 )
             ],
         )
@@ -403,18 +366,6 @@ def goal_stop_point(pm: PrioriMap, room: str) -> tuple[float, float]:
     """``STOP_OFFSET_M`` from the room's door point towards the corridor centre line."""
     door = goal_door(pm, room)
     return point_towards(door, pm.locate(*door).point(pm), STOP_OFFSET_M)
-
-
-@dataclass(frozen=True)
-class PathFacts:
-    """The geodesic from a start pose to a goal room, and its structural facts."""
-
-    length: float
-    turns: int
-    forks: int
-    goal_visible: bool
-    route: tuple[str, ...]  # priori-map nodes, ending at the goal node
-    points: tuple[tuple[float, float], ...]  # polyline: start ... goal node, stop point
 
 
 class _GoalField:
@@ -491,37 +442,50 @@ def path_facts(pm: PrioriMap, start: Pose2D | Sequence[float], goal: str) -> Pat
     return _facts(pm, _GoalField(pm, resolve_room(pm, goal)), xy, yaw)
 
 
-def geodesic_length(pm: PrioriMap, start_xy: Sequence[float], goal: str) -> float:
-    """Corridor-graph distance from ``start_xy`` to room ``goal``'s stop point (metres)."""
+def route_length(pm: PrioriMap, start_xy: Sequence[float], goal: str) -> float:
+    """Corridor-route distance from ``start_xy`` to room ``goal``'s stop point (metres)."""
     return path_facts(pm, tuple(start_xy[:2]), goal).length
 
 
 def shortest_path_points(
     pm: PrioriMap, start_xy: Sequence[float], goal_room: str
 ) -> list[tuple[float, float]]:
-    """The geodesic as a polyline: start, (its projection), map nodes, goal stop point."""
+    """The corridor route as a polyline: start, (its projection), map nodes, stop point."""
     return list(path_facts(pm, tuple(start_xy[:2]), goal_room).points)
 
 
-def classify(facts: PathFacts) -> str | None:
-    """The tier whose definition the path meets, or None."""
-    return next((t.name for t in TIERS.values() if t.accepts(facts)), None)
-
-
-def step_budget(geodesic: float) -> int:
-    """``STEP_BUDGET``, or twice the forward steps the geodesic alone needs if more."""
-    return max(STEP_BUDGET, 2 * math.ceil(geodesic / FORWARD_STEP_M))
+def goal_geodesic(
+    pm: PrioriMap,
+    room: str,
+    obstacles: Sequence = (),
+    robot_radius: float = CREATE3_RADIUS_M,
+    radius: float = SUCCESS_RADIUS_M,
+    floor=None,
+) -> GeodesicField:
+    """SPL's shortest paths to room ``room``: the geodesic through the open floor (the
+    corridors unless ``floor`` says otherwise, e.g. ``SimWorld.floor_space()`` with grid
+    walls), less the robot's radius and the footprints of ``obstacles``, to the success
+    disc of the door."""
+    return GeodesicField(
+        free_space_polygon(pm.building) if floor is None else floor,
+        goal_door(pm, room),
+        radius,
+        robot_radius=robot_radius,
+        obstacles=obstacles,
+    )
 
 
 # -- generation ----------------------------------------------------------------------------
 
 
-def _as_map(b: Building | PrioriMap | str | Path) -> PrioriMap:
+def _as_map(b: Building | PrioriMap | str | Path) -> tuple[PrioriMap, str, str]:
+    """The priori-map, the building file's absolute path and its sha256 ("" if unknown)."""
     if isinstance(b, PrioriMap):
-        return b
-    if not isinstance(b, Building):
-        b = load_building(b)
-    return parse_building(b)
+        return b, "", ""
+    if isinstance(b, Building):
+        return parse_building(b), "", ""
+    path = resolve_building_path(b).resolve()
+    return parse_building(load_building(path)), str(path), building_sha256(path)
 
 
 def _candidates(pm: PrioriMap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -563,10 +527,8 @@ def generate_episodes(
     if n < 0:
         raise EpisodeGenerationError(f"the number of episodes must be >= 0, not {n}")
     spec = TIERS[tier]
-    pm = _as_map(building)
+    pm, building_path, sha = _as_map(building)
     name = pm.building.name
-    # Episodes name their building so it loads again: a file by its path, a built-in by name.
-    source = str(building) if isinstance(building, (str, Path)) else name
     rng = np.random.default_rng([seed, zlib.crc32(name.encode()), list(TIERS).index(tier)])
     xy, seg_idx, s_along = _candidates(pm)
     lo, hi = spec.length_band
@@ -624,19 +586,21 @@ def generate_episodes(
         episodes.append(
             Episode(
                 id=f"{name}-{tier}-s{seed}-{len(episodes):03d}",
-                building=source,
+                building=name,
                 tier=tier,
                 start_x=x,
                 start_y=y,
                 start_yaw=yaw,
                 goal=room,
-                geodesic_length=facts.length,
+                route_length=facts.length,
                 seed=int(rng.integers(2**31 - 1)),
                 goal_visible=facts.goal_visible,
                 turns=facts.turns,
                 forks=facts.forks,
                 route=facts.route,
-                step_budget=step_budget(facts.length),
+                step_budget=action_budget(facts.length),
+                building_path=building_path,
+                building_sha256=sha,
             )
         )
     return episodes
@@ -645,7 +609,7 @@ def generate_episodes(
 def _route_fits(pm: PrioriMap, gf: _GoalField, spec: TierSpec, xy, end: str) -> bool:
     """Whether routes leaving a segment through ``end`` meet the tier's turn/fork counts."""
     f = _facts(pm, gf, xy, None, end)
-    ok = _within(f.turns, spec.min_turns, spec.max_turns) and _within(
+    ok = within(f.turns, spec.min_turns, spec.max_turns) and within(
         f.forks, spec.min_forks, spec.max_forks
     )
     if spec.goal_visible:  # needs a straight run with no key waypoint between
@@ -658,6 +622,7 @@ def score_episode(
     episode: Episode,
     stop_xy: Sequence[float],
     *,
+    geodesic: GeodesicField,
     path_length: float,
     steps: int,
     collisions: int,
@@ -666,25 +631,32 @@ def score_episode(
     trace: list | None = None,
 ) -> EpisodeResult:
     """Score a run that stopped at ``stop_xy``: success within the radius of the goal door
-    (and no ``failure`` reported), SPL against the episode's geodesic."""
+    (and no ``failure`` reported); SPL and soft SPL against the free-space ``geodesic``
+    (:func:`goal_geodesic`) from the start to the success disc."""
     door = goal_door(pm, episode.goal)
-    dist = math.dist((float(stop_xy[0]), float(stop_xy[1])), door)
-    ok = failure is None and success(stop_xy, door)
+    stop = (float(stop_xy[0]), float(stop_xy[1]))
+    dist = math.dist(stop, door)
+    ok = failure is None and success(stop, door)
     reason = failure
     if failure is None and not ok:
         reason = f"STOPPED_AWAY: stopped {dist:.2f} m from the door"
+    shortest = geodesic.distance((episode.start_x, episode.start_y))
+    to_goal = 0.0 if ok else geodesic.distance(stop)
     return EpisodeResult(
         episode_id=episode.id,
         tier=episode.tier,
         success=ok,
-        spl=spl(ok, episode.geodesic_length, path_length),
+        spl=spl(ok, shortest, path_length),
         path_length=path_length,
         steps=steps,
         collisions=collisions,
         wall_time=wall_time,
         failure_reason=reason,
-        shortest_path_length=episode.geodesic_length,
-        distance_to_goal=dist,
+        shortest_path_length=shortest,
+        distance_to_goal=to_goal,
         building=episode.building,
         trace=trace,
+        soft_spl=soft_spl(shortest, to_goal, path_length) if math.isfinite(to_goal) else 0.0,
+        distance_to_door=dist,
+        route_length=episode.route_length,
     )

@@ -1,5 +1,8 @@
 """The oracle agent: follows the geodesic with the ground-truth pose; the ceiling for SR/SPL.
 
+The geodesic is SPL's shortest path: through the free space, less the robot's radius
+and the landmarks' footprints, to the success disc (:func:`goal_geodesic`).
+
 Discrete actions as the agents use them: turn 30 deg until the next polyline point is
 within +-15 deg, then 0.25 m steps. Two fine moves keep the track exact, since 30 deg
 turns and 0.25 m steps cannot land on arbitrary headings and distances: a velocity
@@ -17,21 +20,23 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from pmnav_bt.eval.geodesic import GeodesicField
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
+from pmnav_bt.eval.task import SUCCESS_RADIUS_M
 from pmnav_bt.geometry import heading, wrap_angle
 from pmnav_bt.map.building import Building, builtin_buildings, load_building
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
-from pmnav_bt.seams import FORWARD_STEP_M, DiscreteAction, MotionStatus
+from pmnav_bt.seams import CREATE3_RADIUS_M, FORWARD_STEP_M, DiscreteAction, MotionStatus
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.episodes import (
     TIERS,
     Episode,
     EpisodeGenerationError,
     generate_episodes,
+    goal_geodesic,
     score_episode,
-    shortest_path_points,
 )
-from pmnav_bt.sim.robot import SimBase
+from pmnav_bt.sim.robot import COLLISION_HEIGHT, SimBase
 from pmnav_bt.sim.world import SimWorld
 
 ALIGN_TOL = math.radians(15.0)  # coarse: turn in 30 deg steps until within this
@@ -39,6 +44,7 @@ FINE_TOL = math.radians(0.2)  # fine: velocity turn until within this
 REACH_TOL = 0.01  # metres: a polyline point counts as reached
 ORACLE_TICK = 0.05  # s; coarser than the default clock tick, for speed (motion is kinematic)
 MAX_BLOCKED = 3  # give up after this many blocked motions
+CLEARANCE_M = 0.05  # the oracle's path keeps this far beyond the body's radius from walls
 
 
 class _Runner:
@@ -130,14 +136,23 @@ def follow(runner: _Runner, points: Sequence[tuple[float, float]]) -> None:
 
 
 def run_oracle(
-    base: SimBase, pm: PrioriMap, episode: Episode, trace: bool = False
+    base: SimBase,
+    pm: PrioriMap,
+    episode: Episode,
+    trace: bool = False,
+    fields: tuple[GeodesicField, GeodesicField] | None = None,
 ) -> EpisodeResult:
-    """Place the body at the episode's start, follow the geodesic, stop; score the run."""
+    """Place the body at the episode's start, follow the geodesic, stop; score the run.
+
+    ``fields``: the goal's (scoring, driving) distance fields, if already computed for
+    this world (see :func:`_goal_fields`).
+    """
     t0 = time.perf_counter()
+    score, drive = fields or _goal_fields(base.world, pm, episode.goal)
     base.set_pose(episode.start_pose)
     collisions0 = base.stats.collisions
     runner = _Runner(base, episode.step_budget, trace)
-    follow(runner, shortest_path_points(pm, (episode.start_x, episode.start_y), episode.goal))
+    follow(runner, drive.path((episode.start_x, episode.start_y)))
     base.stop()
     q = base.pose()
     reason = None
@@ -149,6 +164,7 @@ def run_oracle(
         pm,
         episode,
         (q.x, q.y),
+        geodesic=score,
         path_length=runner.travelled,
         steps=runner.actions,
         collisions=base.stats.collisions - collisions0,
@@ -156,6 +172,22 @@ def run_oracle(
         failure=reason,
         trace=runner.trace,
     )
+
+
+def _goal_fields(world: SimWorld, pm: PrioriMap, goal: str) -> tuple[GeodesicField, GeodesicField]:
+    """The goal's distance fields: for scoring (the body's radius) and for driving (with
+    ``CLEARANCE_M`` more, so that the body does not graze corners, and ending
+    ``CLEARANCE_M`` inside the success disc)."""
+    footprints = world.obstacle_footprints(COLLISION_HEIGHT)
+    score = goal_geodesic(pm, goal, footprints)
+    drive = goal_geodesic(
+        pm,
+        goal,
+        footprints,
+        robot_radius=CREATE3_RADIUS_M + CLEARANCE_M,
+        radius=SUCCESS_RADIUS_M - CLEARANCE_M,
+    )
+    return score, drive
 
 
 def evaluate_oracle(
@@ -168,8 +200,14 @@ def evaluate_oracle(
         base = SimBase(
             world, SimClock(tick=ORACLE_TICK), width=16, height=12, depth=False, segmentation=False
         )
+        fields: dict[str, tuple[GeodesicField, GeodesicField]] = {}
         try:
-            return [run_oracle(base, pm, ep, trace) for ep in episodes]
+            out = []
+            for ep in episodes:
+                if ep.goal not in fields:
+                    fields[ep.goal] = _goal_fields(world, pm, ep.goal)
+                out.append(run_oracle(base, pm, ep, trace, fields[ep.goal]))
+            return out
         finally:
             base.close()
 

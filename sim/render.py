@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from pmnav_bt.seams import CameraIntrinsics, Pose2D
+from pmnav_bt.seams import CAMERA_HEIGHT_M, CameraIntrinsics, Pose2D
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.world import LIGHT_AMBIENT, LIGHT_DIFFUSE, LIGHT_DIRECTION
 
@@ -46,7 +46,7 @@ def render_camera(
     yaw: float,
     intrinsics: CameraIntrinsics,
     *,
-    height: float = 1.6,
+    height: float = CAMERA_HEIGHT_M,
     pitch: float = 0.0,
     depth: bool = True,
     segmentation: bool = True,

@@ -16,8 +16,10 @@ from dataclasses import dataclass
 
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.seams import (
+    CAMERA_HEIGHT_M,
     CREATE3_MAX_ANGULAR,
     CREATE3_MAX_LINEAR,
+    CREATE3_RADIUS_M,
     FORWARD_STEP_M,
     TURN_STEP_RAD,
     CameraIntrinsics,
@@ -33,9 +35,9 @@ from pmnav_bt.sim.world import ROBOT, SimWorld
 
 MAX_LINEAR = CREATE3_MAX_LINEAR  # m/s
 MAX_ANGULAR = CREATE3_MAX_ANGULAR  # rad/s
-RADIUS = 0.17  # m
+RADIUS = CREATE3_RADIUS_M  # m
 COLLISION_HEIGHT = 1.7  # the body with its camera mast, for collisions
-CAMERA_HEIGHT = 1.6  # m (paper)
+CAMERA_HEIGHT = CAMERA_HEIGHT_M  # m (paper)
 HFOV = math.radians(60.0)  # horizontal field of view (paper)
 CONTACT_CLEAR = 0.01  # a collision event ends once the body is this far from everything
 _BISECT_TOL = 1e-4

@@ -23,8 +23,7 @@ from pathlib import Path
 
 import numpy as np
 import shapely
-from shapely.geometry import LineString, MultiPolygon, Polygon
-from shapely.geometry.polygon import orient
+from shapely.geometry import MultiPolygon, Polygon
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.map.building import (
@@ -34,7 +33,8 @@ from pmnav_bt.map.building import (
     load_building,
     resolve_building_path,
 )
-from pmnav_bt.seams import Pose2D
+from pmnav_bt.map.free_space import free_space_polygon
+from pmnav_bt.seams import CAMERA_HEIGHT_M, Pose2D
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.textures import make_sign, write_png
 
@@ -101,7 +101,7 @@ DOOR_HEIGHT = 2.1
 FRAME_WIDTH = 0.08
 FRAME_DEPTH = 0.04  # how far door frames stand out of the wall
 PANEL_DEPTH = 0.02
-SIGN_CENTRE_Z = 1.6  # sign plates are centred at camera height
+SIGN_CENTRE_Z = CAMERA_HEIGHT_M  # sign plates are centred at camera height
 SIGN_DEPTH = 0.015
 SIGN_GAP = 0.15  # between a door frame and its sign plate
 ELEVATOR_WIDTH = 1.6
@@ -177,21 +177,6 @@ class RayHit:
     normal: tuple[float, float, float]
 
 
-def free_space_polygon(building: Building) -> Polygon | MultiPolygon:
-    """Union of the corridor rectangles (square ends), oriented (exterior CCW), simplified."""
-    pos = {w.id: w.pos for w in building.waypoints}
-    parts = [
-        LineString([pos[e.a], pos[e.b]]).buffer(
-            building.edge_width(e) / 2.0, cap_style="square", join_style="mitre"
-        )
-        for e in building.edges
-    ]
-    geom = shapely.union_all(parts).simplify(1e-4)
-    if isinstance(geom, MultiPolygon):
-        return MultiPolygon([orient(g, 1.0) for g in geom.geoms])
-    return orient(geom, 1.0)
-
-
 def _rings(geom: Polygon | MultiPolygon) -> list[list[tuple[float, float]]]:
     polys = geom.geoms if isinstance(geom, MultiPolygon) else [geom]
     rings = []
@@ -246,6 +231,7 @@ class SimWorld:
         self._body_label: dict[int, int] = {}
         self._lut: np.ndarray | None = None
         self._solid: set[int] = set()
+        self._boxes: dict[int, tuple[Polygon, float]] = {}  # solid box -> footprint, bottom z
         self._probe_shapes: dict[tuple[float, float], int] = {}
         self._occupied: dict[int, list[tuple[float, float]]] = {}
         self._where: dict[str, tuple[int, float]] = {}  # label -> (wall, s) of the main item
@@ -359,7 +345,39 @@ class SimWorld:
             )
             q = p.getQuaternionFromEuler((0.0, 0.0, yaw))
             body = p.createMultiBody(0.0, col, vis, centre, q, physicsClientId=c)
-            return self.register(body, label, solid)
+        if solid:
+            hx, hy = half_extents[0], half_extents[1]
+            corners = [(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)]
+            cy_, sy_ = math.cos(yaw), math.sin(yaw)
+            footprint = Polygon(
+                [(centre[0] + cy_ * u - sy_ * v, centre[1] + sy_ * u + cy_ * v) for u, v in corners]
+            )
+            self._boxes[body] = (footprint, float(centre[2] - half_extents[2]))
+        return self.register(body, label, solid)
+
+    def floor_space(self) -> Polygon | MultiPolygon:
+        """Where the floor is open, walls aside: the corridor polygon, or with grid walls
+        the grid's extent less the footprints of the solid wall boxes."""
+        if self._grid_plan is None:
+            return self.free_space
+        x0, y0, x1, y1 = self.bounds()
+        wall = self.label_id(WALL)
+        boxes = [
+            fp
+            for body, (fp, _) in self._boxes.items()
+            if body in self._solid and self._body_label.get(body) == wall
+        ]
+        return shapely.box(x0, y0, x1, y1).difference(shapely.union_all(boxes))
+
+    def obstacle_footprints(self, below: float) -> list[Polygon]:
+        """Floor footprints of the solid boxes other than walls whose bottom is under
+        ``below`` metres (landmarks such as desks and stairs, added obstacles)."""
+        wall = self.label_id(WALL)
+        return [
+            fp
+            for body, (fp, z0) in self._boxes.items()
+            if z0 < below and body in self._solid and self._body_label.get(body) != wall
+        ]
 
     def _add_textured_quad(
         self,
@@ -415,6 +433,7 @@ class SimWorld:
             p.removeBody(body, physicsClientId=self.client)
             del self.obstacles[body]
             self._solid.discard(body)
+            self._boxes.pop(body, None)
             self._body_label.pop(body, None)
             self._lut = None
 

@@ -8,7 +8,6 @@ the machine's speed; on the robot it never waits.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -19,12 +18,13 @@ import py_trees
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.config import Config
+from pmnav_bt.eval.task import action_budget as task_action_budget
 from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.perception.ground_truth import GroundTruthGrounder
 from pmnav_bt.perception.refine import CoarseOnly, GeometricRefiner
 from pmnav_bt.planning.graph_planner import GraphPlanner
-from pmnav_bt.seams import FORWARD_STEP_M, Base
+from pmnav_bt.seams import Base
 from pmnav_bt.trees.pmnav import build_pmnav_tree
 from pmnav_bt.trees.snapshots import SnapshotLogger
 from pmnav_bt.worker import Worker
@@ -43,13 +43,10 @@ class RunOutcome:
     actions: int
 
 
-def action_budget(config: Config, shortest_path_m: float | None) -> int:
-    """The action budget: the configured one, scaled up when the shortest path alone needs more."""
-    cfg = config.tree
-    if shortest_path_m is None:
-        return cfg.budget_actions
-    needed = cfg.budget_path_factor * shortest_path_m / FORWARD_STEP_M
-    return max(cfg.budget_actions, int(math.ceil(needed)))
+def action_budget(config: Config, route_m: float | None) -> int:
+    """The config's action budget for a corridor route of ``route_m`` metres
+    (:func:`pmnav_bt.eval.task.action_budget`)."""
+    return task_action_budget(route_m, config.tree.budget_actions, config.tree.budget_path_factor)
 
 
 def make_context(

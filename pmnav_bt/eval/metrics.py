@@ -1,8 +1,12 @@
-"""Navigation metrics: success, SPL, SDF, per-episode results and a per-tier table.
+"""Navigation metrics: success, SPL, soft SPL, SDF, per-episode results and a per-tier table.
 
 - Success: the agent stops within ``SUCCESS_RADIUS_M`` of the goal room's door point.
 - SPL = S * l / max(l, p) (Anderson et al. 2018, "On Evaluation of Embodied Navigation
   Agents"; habitat-lab), l the shortest path length, p the length the agent travelled.
+  l is the free-space geodesic from the start to the success region
+  (:mod:`pmnav_bt.eval.geodesic`), so only an optimal path scores 1.
+- Soft SPL (habitat-lab) = max(0, 1 - d_T / l) * l / max(l, p), d_T the geodesic
+  distance to the success region where the agent stopped (``distance_to_goal``).
 - SDF (PM-Nav paper, eq. 1) is implemented as S * 2 / max(2, d), d the number of
   localisation attempts. The paper prints d / max(2, d), which *rewards* more attempts;
   its Table 3 only fits 2 / max(2, d), so that is what this module computes.
@@ -13,16 +17,16 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
-# The agent succeeds when it stops within this distance (metres) of the goal door point.
-SUCCESS_RADIUS_M = 1.0
+from pmnav_bt.eval.task import SUCCESS_RADIUS_M
+from pmnav_bt.eval.tiers import TIER_NAMES
 
 # Tiers in display order; other tier names follow in alphabetical order.
-TIER_ORDER = ("easy", "medium", "hard")
+TIER_ORDER = TIER_NAMES
 
 
 def success(
@@ -40,6 +44,17 @@ def spl(succeeded: bool | float, shortest: float, travelled: float) -> float:
         raise ValueError("path lengths must be non-negative")
     longest = max(shortest, travelled)
     return 1.0 if longest == 0 else float(shortest / longest)
+
+
+def soft_spl(shortest: float, distance_to_goal: float, travelled: float) -> float:
+    """Habitat's soft SPL: progress towards the goal, max(0, 1 - d_T / l), weighted by
+    l / max(l, p). With l = 0 the progress is 1 if the agent is still at the goal."""
+    if shortest < 0 or travelled < 0 or distance_to_goal < 0:
+        raise ValueError("distances must be non-negative")
+    if shortest == 0:
+        return 1.0 if distance_to_goal == 0 else 0.0
+    progress = max(0.0, 1.0 - distance_to_goal / shortest)
+    return float(progress * shortest / max(shortest, travelled))
 
 
 def sdf_term(succeeded: bool | float, attempts: int) -> float:
@@ -63,8 +78,12 @@ class EpisodeResult:
     """The outcome of one navigation episode.
 
     ``failure_reason`` is None on success, otherwise a short code or sentence
-    ("step budget exhausted", "stopped 2.3 m from the door"). ``trace`` optionally holds
-    the visited poses or tree events.
+    ("step budget exhausted", "stopped 2.3 m from the door"). ``error`` is set instead
+    when the episode could not be run (a crash, a changed building file): such episodes
+    are counted apart, not as navigation failures. ``shortest_path_length`` is SPL's l,
+    ``distance_to_goal`` the geodesic from the stop to the success region,
+    ``distance_to_door`` the straight line from the stop to the door point.
+    ``trace`` optionally holds the visited poses or tree events.
     """
 
     episode_id: str
@@ -76,10 +95,14 @@ class EpisodeResult:
     collisions: int = 0
     wall_time: float = 0.0  # seconds
     failure_reason: str | None = None
-    shortest_path_length: float = float("nan")
-    distance_to_goal: float = float("nan")  # final distance to the door point, metres
+    shortest_path_length: float = float("nan")  # free-space geodesic to the success region
+    distance_to_goal: float = float("nan")  # geodesic from the stop to the success region
     building: str = ""
     trace: list[Any] | None = None
+    soft_spl: float = float("nan")
+    distance_to_door: float = float("nan")  # straight line from the stop to the door point
+    route_length: float = float("nan")  # corridor route (tiers and budget), metres
+    error: str | None = None
 
     def to_dict(self, with_trace: bool = False) -> dict[str, Any]:
         d = asdict(self)
@@ -87,10 +110,20 @@ class EpisodeResult:
             d.pop("trace")
         return {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in d.items()}
 
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> EpisodeResult:
+        """The inverse of ``to_dict``: None in a float field reads back as NaN."""
+        floats = {f.name for f in fields(cls) if f.type in ("float", float)}
+        return cls(**{k: (math.nan if k in floats and v is None else v) for k, v in d.items()})
+
 
 @dataclass(frozen=True)
 class TierRow:
-    """Aggregates over the episodes of one tier (SR and SPL in percent)."""
+    """Aggregates over the episodes of one tier (SR, SPL, soft SPL in percent).
+
+    ``episodes`` counts those that ran; ``errors`` those that could not run, which are
+    left out of every mean.
+    """
 
     tier: str
     episodes: int
@@ -99,6 +132,9 @@ class TierRow:
     mean_steps: float
     mean_path_length: float
     collisions: int
+    soft_spl: float = float("nan")
+    mean_distance_to_goal: float = float("nan")
+    errors: int = 0
 
 
 @dataclass
@@ -111,12 +147,16 @@ class TierTable:
         return next(r for r in self.rows if r.tier == tier)
 
     def to_markdown(self, digits: int = 1) -> str:
-        head = "| tier | episodes | SR (%) | SPL (%) | mean steps | mean path (m) | collisions |"
-        lines = [head, "|---|---:|---:|---:|---:|---:|---:|"]
+        head = (
+            "| tier | episodes | SR (%) | SPL (%) | soft SPL (%) | distance to goal (m) | "
+            "mean steps | mean path (m) | collisions | errors |"
+        )
+        lines = [head, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
         for r in self.rows:
             lines.append(
                 f"| {r.tier} | {r.episodes} | {r.sr:.{digits}f} | {r.spl:.{digits}f} | "
-                f"{r.mean_steps:.1f} | {r.mean_path_length:.1f} | {r.collisions} |"
+                f"{r.soft_spl:.{digits}f} | {r.mean_distance_to_goal:.2f} | "
+                f"{r.mean_steps:.1f} | {r.mean_path_length:.1f} | {r.collisions} | {r.errors} |"
             )
         return "\n".join(lines) + "\n"
 
@@ -131,20 +171,31 @@ def _tier_key(tier: str) -> tuple[int, str]:
     return (TIER_ORDER.index(tier), "") if tier in TIER_ORDER else (len(TIER_ORDER), tier)
 
 
-def _row(tier: str, rs: list[EpisodeResult]) -> TierRow:
+def _mean(values: list[float]) -> float:
+    return float(np.mean(values)) if values else float("nan")
+
+
+def _row(tier: str, all_rs: list[EpisodeResult]) -> TierRow:
+    rs = [r for r in all_rs if r.error is None]
     return TierRow(
         tier=tier,
         episodes=len(rs),
-        sr=100.0 * float(np.mean([bool(r.success) for r in rs])),
-        spl=100.0 * float(np.mean([r.spl for r in rs])),
-        mean_steps=float(np.mean([r.steps for r in rs])),
-        mean_path_length=float(np.mean([r.path_length for r in rs])),
+        sr=100.0 * _mean([float(bool(r.success)) for r in rs]),
+        spl=100.0 * _mean([r.spl for r in rs]),
+        mean_steps=_mean([r.steps for r in rs]),
+        mean_path_length=_mean([r.path_length for r in rs]),
         collisions=int(sum(r.collisions for r in rs)),
+        soft_spl=100.0 * _mean([r.soft_spl for r in rs]),
+        mean_distance_to_goal=_mean([r.distance_to_goal for r in rs]),
+        errors=len(all_rs) - len(rs),
     )
 
 
 def aggregate_by_tier(results: Iterable[EpisodeResult], overall: bool = True) -> TierTable:
-    """SR and SPL (percent) per tier, tiers in easy/medium/hard order, then an "all" row."""
+    """SR, SPL and soft SPL (percent) per tier, in tier order, then an "all" row.
+
+    Errored episodes (``error`` set) are counted per row and left out of the means.
+    """
     results = list(results)
     by: dict[str, list[EpisodeResult]] = {}
     for r in results:

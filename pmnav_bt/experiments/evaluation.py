@@ -37,13 +37,16 @@ class EpisodeRun:
 def custom_episode(building: str, goal: str, start: str | None = None, seed: int = 0) -> Episode:
     """An episode for ``pmnav sim run``: a goal by name, from a start pose or the building's
     start waypoint (facing along its corridor)."""
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.eval.task import action_budget
+    from pmnav_bt.eval.tiers import classify
+    from pmnav_bt.map.building import building_sha256, load_building, resolve_building_path
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.planning.resolve import resolve_room, resolve_start
     from pmnav_bt.seams import Pose2D
-    from pmnav_bt.sim.episodes import Episode, classify, path_facts, step_budget
+    from pmnav_bt.sim.episodes import Episode, path_facts
 
-    b = load_building(building)
+    path = resolve_building_path(building).resolve()
+    b = load_building(path)
     pm = parse_building(b)
     room = resolve_room(pm, goal)
     if start is None:
@@ -62,19 +65,21 @@ def custom_episode(building: str, goal: str, start: str | None = None, seed: int
     facts = path_facts(pm, pose, room)
     return Episode(
         id=f"{b.name}-{room}",
-        building=building,
+        building=b.name,
         tier=classify(facts) or "custom",
         start_x=pose.x,
         start_y=pose.y,
         start_yaw=pose.yaw,
         goal=room,
-        geodesic_length=facts.length,
+        route_length=facts.length,
         seed=seed,
         goal_visible=facts.goal_visible,
         turns=facts.turns,
         forks=facts.forks,
         route=tuple(facts.route),
-        step_budget=step_budget(facts.length),
+        step_budget=action_budget(facts.length),
+        building_path=str(path),
+        building_sha256=building_sha256(path),
     )
 
 
@@ -90,29 +95,32 @@ def run_episode(
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     """
-    from pmnav_bt.map.building import load_building, resolve_building_path
+    from pmnav_bt.map.building import load_building
     from pmnav_bt.map.priori_map import parse_building
-    from pmnav_bt.sim.episodes import score_episode
+    from pmnav_bt.sim.episodes import episode_building_file, goal_geodesic, score_episode
     from pmnav_bt.sim.odometry import NoisyOdometry
-    from pmnav_bt.sim.robot import SimBase
+    from pmnav_bt.sim.robot import COLLISION_HEIGHT, SimBase
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
 
-    b = load_building(episode.building)
+    file = episode_building_file(episode)
+    b = load_building(file)
+    folder = file.parent
     pm = parse_building(b)
     sim = config.sim
     t0 = time.perf_counter()
-    folder = resolve_building_path(episode.building).parent
     with SimWorld(b, walls=sim.walls, base_dir=folder) as world:
         if setup_world is not None:
             setup_world(world)
+        footprints = world.obstacle_footprints(COLLISION_HEIGHT)
+        geodesic = goal_geodesic(pm, episode.goal, footprints, floor=world.floor_space())
         inner = SimBase(world, pose=episode.start_pose, width=sim.width, height=sim.height)
         base = (
             NoisyOdometry(inner, sim.odometry_noise, seed=episode.seed)
             if sim.odometry_noise > 0
             else inner
         )
-        budget = max(episode.step_budget, action_budget(config, episode.geodesic_length))
+        budget = action_budget(config, episode.route_length)
         ctx = make_context(base, pm, config, seed=episode.seed, budget=budget, deferred_work=True)
         truth: list[tuple[float, float, float]] = []
 
@@ -135,6 +143,7 @@ def run_episode(
         pm,
         episode,
         (final.x, final.y),
+        geodesic=geodesic,
         path_length=stats.path_length,
         steps=outcome.actions,
         collisions=stats.collisions,
@@ -208,7 +217,8 @@ def episodes_for(buildings: Iterable[str], tiers: Iterable[str], n: int, seed: i
 
 
 def _run_one(args) -> dict:
-    """One episode in a pool process; a crash becomes a failed result, not a lost run."""
+    """One episode in a pool process; a crash becomes an errored result (counted apart
+    from navigation failures), not a lost run."""
     episode, config_json = args
     config = Config.model_validate_json(config_json)
     try:
@@ -221,9 +231,10 @@ def _run_one(args) -> dict:
             spl=0.0,
             path_length=0.0,
             steps=0,
-            failure_reason=f"ERROR: {type(err).__name__}: {err}",
-            shortest_path_length=episode.geodesic_length,
+            failure_reason=None,
             building=episode.building,
+            route_length=episode.route_length,
+            error=f"{type(err).__name__}: {err}",
         ).to_dict()
     return run.result.to_dict()
 
@@ -252,7 +263,7 @@ def evaluate(
 
         def take(row: dict, name: str = name, got: list = got) -> None:
             nonlocal done
-            r = EpisodeResult(**row)
+            r = EpisodeResult.from_dict(row)
             got.append(r)
             if on_result:
                 on_result(name, r)
@@ -281,33 +292,41 @@ def evaluate(
 
 
 def comparison_markdown(results: dict[str, list[EpisodeResult]]) -> str:
-    """SR/SPL per tier, one column pair per variant (like the paper's Table 1)."""
+    """SR, SPL and soft SPL per tier, one column group per variant (like the paper's
+    Table 1); an errors column when episodes could not be run."""
     tables = {name: aggregate_by_tier(rs) for name, rs in results.items()}
     tiers = []
     for t in tables.values():
         for row in t.rows:
             if row.tier not in tiers:
                 tiers.append(row.tier)
+    errors = any(r.errors for t in tables.values() for r in t.rows)
+    metrics = ("SR", "SPL", "soft SPL") + (("errors",) if errors else ())
     head = (
         "| tier | n | "
-        + " | ".join(
-            f"{VARIANT_NAMES.get(n, n)} SR | {VARIANT_NAMES.get(n, n)} SPL" for n in tables
-        )
+        + " | ".join(f"{VARIANT_NAMES.get(n, n)} {m}" for n in tables for m in metrics)
         + " |"
     )
-    sep = "|---|---|" + "---|---|" * len(tables)
+    sep = "|---|---|" + "---|" * (len(metrics) * len(tables))
     lines = [head, sep]
     for tier in tiers:
         cells, count = [], 0
         for t in tables.values():
             row = next((r for r in t.rows if r.tier == tier), None)
             if row is None:
-                cells.append("- | -")
+                cells.append(" | ".join("-" for _ in metrics))
                 continue
-            count = row.episodes
-            cells.append(f"{row.sr:.1f} | {row.spl:.1f}")
+            count = max(count, row.episodes + row.errors)
+            vals = [f"{row.sr:.1f}", f"{row.spl:.1f}", f"{row.soft_spl:.1f}"]
+            cells.append(" | ".join(vals + ([str(row.errors)] if errors else [])))
         lines.append(f"| {tier} | {count} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def error_counts(results: dict[str, list[EpisodeResult]]) -> dict[str, int]:
+    """Errored episodes per variant (only variants with errors)."""
+    counts = {name: sum(r.error is not None for r in rs) for name, rs in results.items()}
+    return {name: c for name, c in counts.items() if c}
 
 
 def save_evaluation(results: dict[str, list[EpisodeResult]], out_dir: Path, header: str) -> Path:

@@ -11,6 +11,7 @@ Coordinates are metres in the map frame (x east, y north).
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 from enum import Enum
@@ -424,6 +425,17 @@ BUILTIN_DIR = Path(__file__).parent.parent / "data" / "buildings"
 def builtin_buildings() -> list[str]:
     """Names of the buildings shipped with the package."""
     return sorted(p.stem for p in BUILTIN_DIR.glob("*.yaml"))
+
+
+def building_sha256(name_or_path: str | Path) -> str:
+    """The sha256 (hex) of a building file's bytes (a path or a built-in name)."""
+    path = resolve_building_path(name_or_path)
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError as err:
+        raise BuildingFileError(
+            str(path), [Problem("", f"cannot read file: {err.strerror}")]
+        ) from None
 
 
 def resolve_building_path(name_or_path: str | Path) -> Path:

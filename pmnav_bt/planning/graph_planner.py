@@ -22,12 +22,14 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.planning.plan import ForkChoice, Plan, PlanStart, PlanStep
 from pmnav_bt.planning.resolve import StartPoint, resolve_room, resolve_start
 
+MAX_GAP_M = 8.0  # default: most metres between consecutive plan steps (config planner.max_gap)
+
 
 @dataclass(frozen=True)
 class GraphPlanner:
     """Shortest-path planner over the priori-map (the default planner)."""
 
-    max_gap: float = 10.0  # metres between consecutive steps, where landmarks allow
+    max_gap: float = MAX_GAP_M  # metres between consecutive steps, where landmarks allow
 
     name = "graph"
 

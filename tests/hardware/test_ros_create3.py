@@ -123,7 +123,7 @@ def _run_episode(probe, domain_id, tmp_path, ep, timeout: float) -> None:
         assert gaps and gaps[len(gaps) // 2] == pytest.approx(0.05, abs=0.01)
         assert all(v >= 0.0 and v <= 0.306 + 1e-9 and abs(w) <= 1.9 + 1e-9 for _, v, w in cmds)
         print(
-            f"{ep.id} ({ep.goal}, {ep.geodesic_length:.1f} m): {elapsed:.1f} s, "
+            f"{ep.id} ({ep.goal}, {ep.route_length:.1f} m): {elapsed:.1f} s, "
             f"{r['actions']} actions, {dist:.2f} m from the door"
         )
     finally:

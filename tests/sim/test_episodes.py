@@ -2,28 +2,35 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
+import shutil
 
 import pytest
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.map.building import builtin_buildings, load_building
+from pmnav_bt.map.building import BUILTIN_DIR, builtin_buildings, load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.sim.episodes import (
     START_CLEARANCE_M,
     STOP_OFFSET_M,
     TIERS,
+    EpisodeBuildingError,
     EpisodeFileError,
     EpisodeGenerationError,
     classify,
+    episode_building,
+    episode_building_file,
+    episodes_json,
     generate_episodes,
-    geodesic_length,
     goal_door,
+    goal_geodesic,
     goal_stop_point,
     load_episodes,
     path_facts,
+    route_length,
     save_episodes,
     shortest_path_points,
     tier_definition,
@@ -60,9 +67,9 @@ def test_generated_episodes_meet_their_tier(maps, name, tier):
             ep.goal_visible,
         )
         assert facts.route == ep.route
-        assert ep.geodesic_length == pytest.approx(facts.length, abs=1e-3)
+        assert ep.route_length == pytest.approx(facts.length, abs=1e-3)
         lo, hi = spec.length_band
-        assert lo <= ep.geodesic_length < hi
+        assert lo <= ep.route_length < hi
         # On a centre line, facing along the corridor, clear of junctions and ends.
         loc = pm.locate(ep.start_x, ep.start_y)
         assert loc.offset < 2e-3
@@ -95,7 +102,7 @@ def test_same_seed_same_episodes(maps):
     a = generate_episodes(maps["ring_school"], "hard", 10, seed=7)
     b = generate_episodes("ring_school", "hard", 10, seed=7)  # by built-in name
     c = generate_episodes(maps["ring_school"], "hard", 10, seed=8)
-    assert a == b
+    assert a == [dataclasses.replace(e, building_path="", building_sha256="") for e in b]
     assert a != c
     assert generate_episodes(maps["ring_school"], "hard", 4, seed=7) == a[:4]  # a prefix
     assert len({e.id for e in a}) == 10
@@ -111,7 +118,7 @@ def test_shortest_path_points_hand_case(maps):
     assert (0.0, 0.0) in pts
     length = sum(math.dist(p, q) for p, q in zip(pts, pts[1:], strict=False))
     assert length == pytest.approx(25 + 24 + 0.6)
-    assert geodesic_length(pm, (0.0, 25.0), "room7") == pytest.approx(length)
+    assert route_length(pm, (0.0, 25.0), "room7") == pytest.approx(length)
     assert goal_door(pm, "room7") == (24.0, 1.2)
     assert math.dist(goal_stop_point(pm, "room7"), goal_door(pm, "room7")) == pytest.approx(
         STOP_OFFSET_M
@@ -140,7 +147,8 @@ def test_json_round_trip(tmp_path, maps):
     path = save_episodes(eps, tmp_path / "eps.json")
     assert load_episodes(path) == eps
     data = json.loads(path.read_text())
-    assert data["schema_version"] == 1 and "tier_definition" in data
+    assert data["schema_version"] == 2 and "tier_definition" in data
+    assert json.loads(episodes_json(eps)) == data
 
 
 def _write(tmp_path, data, name="bad.json"):
@@ -194,3 +202,50 @@ def test_an_off_centre_start_adds_no_turn(maps):
     on = path_facts(pm, (0.0, 25.0, -math.pi / 2), "room17")
     off = path_facts(pm, (0.6, 25.0, -math.pi / 2), "room17")
     assert off.turns == on.turns and off.length == pytest.approx(on.length + 0.6)
+
+
+def test_episodes_record_the_building_file_and_its_hash(tmp_path, monkeypatch):
+    src = BUILTIN_DIR / "t_school.yaml"
+    own = tmp_path / "plans" / "my_school.yaml"
+    own.parent.mkdir()
+    shutil.copy(src, own)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    eps = generate_episodes("../plans/my_school.yaml", "easy", 2, seed=1)  # relative to cwd
+    assert all(e.building_path == str(own.resolve()) for e in eps)
+    assert all(len(e.building_sha256) == 64 for e in eps)
+    saved = save_episodes(eps, tmp_path / "eps.json")
+    monkeypatch.chdir(tmp_path)  # another directory: the absolute path still finds it
+    ep = load_episodes(saved)[0]
+    assert episode_building_file(ep) == own.resolve()
+    assert episode_building(ep).name == "t_school"
+    own.write_text(own.read_text() + "\n# edited\n")
+    with pytest.raises(EpisodeBuildingError, match="has changed since the episodes were made"):
+        episode_building_file(ep)
+    own.unlink()
+    with pytest.raises(EpisodeBuildingError, match="not found"):
+        episode_building_file(dataclasses.replace(ep, building="my_school"))
+
+
+def test_builtin_episodes_travel_when_the_package_moves(maps):
+    ep = generate_episodes("fig2_hospital", "easy", 1)[0]
+    moved = dataclasses.replace(ep, building_path="/nowhere/fig2_hospital.yaml")
+    assert episode_building_file(moved) == BUILTIN_DIR / "fig2_hospital.yaml"
+    changed = dataclasses.replace(moved, building_sha256="0" * 64)
+    with pytest.raises(EpisodeBuildingError):
+        episode_building_file(changed)
+
+
+def test_geodesic_is_shorter_than_the_route_and_zero_at_the_goal(maps):
+    pm = maps["fig2_hospital"]
+    for ep in generate_episodes(pm, "hard", 3, seed=4) + generate_episodes(pm, "easy", 3):
+        field = goal_geodesic(pm, ep.goal)
+        door = goal_door(pm, ep.goal)
+        shortest = field.distance((ep.start_x, ep.start_y))
+        # The route runs along centre lines to a stop point 0.6 m from the door; the
+        # geodesic cuts corners and ends at the 1 m success disc: at least 0.4 m shorter.
+        assert 0 < shortest <= ep.route_length - 0.39
+        # ... and no shorter than the straight line to the disc.
+        assert shortest >= math.dist((ep.start_x, ep.start_y), door) - 1.0 - 0.01
+        assert field.distance(goal_stop_point(pm, ep.goal)) == 0.0
