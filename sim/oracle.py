@@ -145,10 +145,10 @@ def run_oracle(
     """Place the body at the episode's start, follow the geodesic, stop; score the run.
 
     ``fields``: the goal's (scoring, driving) distance fields, if already computed for
-    this world (see :func:`_goal_fields`).
+    this world (see :func:`goal_fields`).
     """
     t0 = time.perf_counter()
-    score, drive = fields or _goal_fields(base.world, pm, episode.goal)
+    score, drive = fields or goal_fields(base.world, pm, episode.goal)
     base.set_pose(episode.start_pose)
     collisions0 = base.stats.collisions
     runner = _Runner(base, episode.step_budget, trace)
@@ -174,7 +174,7 @@ def run_oracle(
     )
 
 
-def _goal_fields(world: SimWorld, pm: PrioriMap, goal: str) -> tuple[GeodesicField, GeodesicField]:
+def goal_fields(world: SimWorld, pm: PrioriMap, goal: str) -> tuple[GeodesicField, GeodesicField]:
     """The goal's distance fields: for scoring (the body's radius) and for driving (with
     ``CLEARANCE_M`` more, so that the body does not graze corners, and ending
     ``CLEARANCE_M`` inside the success disc)."""
@@ -205,7 +205,7 @@ def evaluate_oracle(
             out = []
             for ep in episodes:
                 if ep.goal not in fields:
-                    fields[ep.goal] = _goal_fields(world, pm, ep.goal)
+                    fields[ep.goal] = goal_fields(world, pm, ep.goal)
                 out.append(run_oracle(base, pm, ep, trace, fields[ep.goal]))
             return out
         finally:

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from pmnav_bt.seams import CAMERA_HEIGHT_M, CameraIntrinsics, Pose2D
+from pmnav_bt.seams import CAMERA_HEIGHT_M, CREATE3_RADIUS_M, CameraIntrinsics, Pose2D
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.world import LIGHT_AMBIENT, LIGHT_DIFFUSE, LIGHT_DIRECTION
 
@@ -223,7 +223,7 @@ def draw_top_down(
 
     if pose is not None:
         c = px((pose.x, pose.y))
-        r = max(3, int(round(0.17 * px_per_m)))
+        r = max(3, int(round(CREATE3_RADIUS_M * px_per_m)))
         reach = 4.0
         for s in (-1, 1):
             end = (

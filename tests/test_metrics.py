@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 
 import pytest
 
@@ -13,9 +15,12 @@ from pmnav_bt.eval.metrics import (
     results_to_json,
     sdf,
     sdf_term,
+    soft_spl,
     spl,
     success,
 )
+from pmnav_bt.eval.task import action_budget
+from pmnav_bt.eval.tiers import TIER_NAMES, parse_tiers
 
 
 def test_success_radius():
@@ -86,3 +91,44 @@ def test_episode_result_json():
     assert d["failure_reason"] == "stopped too far" and "trace" not in d
     assert d["shortest_path_length"] is None  # NaN is written as null
     assert json.loads(results_to_json([r], with_trace=True))[0]["trace"] == [[0.0, 0.0, 0.0]]
+
+
+def test_soft_spl_hand_cases():
+    # habitat-lab: max(0, 1 - d_T / l) * l / max(l, p)
+    assert soft_spl(10.0, 0.0, 10.0) == 1.0
+    assert soft_spl(10.0, 0.0, 12.5) == pytest.approx(0.8)
+    assert soft_spl(10.0, 4.0, 12.5) == pytest.approx(0.6 * 0.8)
+    assert soft_spl(10.0, 15.0, 5.0) == 0.0  # ended farther than it started
+    assert soft_spl(0.0, 0.0, 3.0) == 1.0 and soft_spl(0.0, 1.0, 3.0) == 0.0
+    with pytest.raises(ValueError):
+        soft_spl(-1.0, 0.0, 1.0)
+
+
+def test_errored_episodes_are_counted_apart_from_failures():
+    crashed = dataclasses.replace(_r("easy", False, 0.0), error="RuntimeError: boom")
+    table = aggregate_by_tier([_r("easy", True, 1.0), _r("easy", False, 0.0), crashed])
+    easy = table.row("easy")
+    assert easy.episodes == 2 and easy.errors == 1
+    assert easy.sr == 50.0 and easy.spl == 50.0
+    only = aggregate_by_tier([crashed]).row("easy")
+    assert only.episodes == 0 and only.errors == 1 and math.isnan(only.sr)
+
+
+def test_result_dict_round_trip_keeps_nan():
+    r = _r("easy", True, 1.0)
+    back = EpisodeResult.from_dict(json.loads(json.dumps(r.to_dict())))
+    assert math.isnan(back.soft_spl) and back.error is None and back.tier == "easy"
+
+
+def test_one_budget_rule():
+    assert action_budget(None) == 500
+    assert action_budget(10.0) == 500  # 3 * 10 / 0.25 = 120 < 500
+    assert action_budget(50.0) == 600  # 3 * 50 / 0.25
+    assert action_budget(50.0, actions=100, path_factor=2.0) == 400
+
+
+def test_tiers_parse():
+    assert parse_tiers("all") == list(TIER_NAMES) == ["easy", "medium", "hard"]
+    assert parse_tiers("hard, easy") == ["hard", "easy"]
+    with pytest.raises(ValueError, match="choose easy, medium, hard or all"):
+        parse_tiers("extreme")

@@ -110,10 +110,11 @@ def run_episode(
     sim = config.sim
     t0 = time.perf_counter()
     with SimWorld(b, walls=sim.walls, base_dir=folder) as world:
-        if setup_world is not None:
-            setup_world(world)
+        # SPL's shortest path: in the building as built (landmarks, not added obstacles).
         footprints = world.obstacle_footprints(COLLISION_HEIGHT)
         geodesic = goal_geodesic(pm, episode.goal, footprints, floor=world.floor_space())
+        if setup_world is not None:
+            setup_world(world)
         inner = SimBase(world, pose=episode.start_pose, width=sim.width, height=sim.height)
         base = (
             NoisyOdometry(inner, sim.odometry_noise, seed=episode.seed)

@@ -1,4 +1,4 @@
-"""The oracle follows the geodesic with ground truth: SR 100 and SPL >= 95 everywhere."""
+"""The oracle follows the free-space geodesic with ground truth: SR 100, SPL >= 95."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from pmnav_bt.sim.episodes import (
     generate_episodes,
     shortest_path_points,
 )
-from pmnav_bt.sim.oracle import ORACLE_TICK, evaluate_oracle, run_oracle
+from pmnav_bt.sim.oracle import ORACLE_TICK, evaluate_oracle, goal_fields, run_oracle
 from pmnav_bt.sim.robot import SimBase
 from pmnav_bt.sim.world import SimWorld
 
@@ -45,8 +45,11 @@ def test_oracle_scores_sr_100_and_spl_95(name):
         assert row.spl >= 95.0, (name, row)
     for r in results:
         assert r.failure_reason is None and r.collisions == 0
-        assert r.distance_to_goal <= 1.0
-        assert r.path_length == pytest.approx(r.shortest_path_length, abs=0.05)
+        assert r.distance_to_goal == 0.0 and r.distance_to_door <= 1.0
+        # The geodesic is a lower bound the oracle meets (it keeps 5 cm more clearance
+        # and ends 5 cm inside the success disc).
+        assert r.shortest_path_length - 0.03 <= r.path_length <= r.shortest_path_length + 0.25
+        assert r.path_length <= r.route_length - 0.3  # shorter than the corridor route
         assert len(r.trace) == r.steps + 1
 
 
@@ -83,10 +86,11 @@ def test_blocked_path_is_a_failure_with_a_reason(fig2_world):
     (x0, y0), (x1, y1) = pts[0], pts[1]
     d = math.dist(pts[0], pts[1])
     ox, oy = x0 + (x1 - x0) * 1.0 / d, y0 + (y1 - y0) * 1.0 / d
+    fields = goal_fields(world, pm, ep.goal)  # planned on the building without the obstacle
     body = world.add_obstacle(ox, oy, 2.6)
     base = _base(world)
     try:
-        r = run_oracle(base, pm, ep)
+        r = run_oracle(base, pm, ep, fields=fields)
     finally:
         base.close()
         world.remove_obstacle(body)
