@@ -42,7 +42,7 @@ class GeodesicField:
     ):
         obstacles = list(obstacles)
         space = free_space.difference(shapely.union_all(obstacles)) if obstacles else free_space
-        self.drivable = space.buffer(-robot_radius, join_style="mitre")
+        self.drivable = space.buffer(-robot_radius)  # round: the body is a disc
         self.resolution = res = float(resolution)
         x0, y0, x1, y1 = free_space.bounds
         self.origin = (x0 - 2 * res, y0 - 2 * res)
@@ -97,42 +97,59 @@ class GeodesicField:
         h, w = self.free.shape
         return 0 <= i < h and 0 <= j < w and bool(self.free[i, j])
 
-    def path(self, start: Sequence[float], simplify: float = 0.02) -> list[tuple[float, float]]:
+    def path(self, start: Sequence[float]) -> list[tuple[float, float]]:
         """A shortest path from ``start`` into the goal region, as a polyline (map metres).
 
-        Gradient descent on the distance field in steps of one cell, simplified by
-        ``simplify`` metres; it ends where the distance reaches 0.
+        Steepest descent over the drivable neighbours of each cell of the distance field
+        (it decreases to the region), then pulled taut: each vertex is joined to the
+        farthest later one in straight view inside the drivable space.
         """
-        from shapely.geometry import LineString
+        res = self.resolution
+        h, w = self.field.shape
+        i = int(math.floor((float(start[1]) - self.origin[1]) / res))
+        j = int(math.floor((float(start[0]) - self.origin[0]) / res))
+        if not (0 <= i < h and 0 <= j < w and math.isfinite(self.field[i, j])):
+            raise GeodesicError(f"{tuple(start)} is not in the drivable space")
+        cells = [(i, j)]
+        while self.field[i, j] > 0.0:
+            best = None
+            for di in (-1, 0, 1):
+                for dj in (-1, 0, 1):
+                    a, b = i + di, j + dj
+                    if (di or dj) and 0 <= a < h and 0 <= b < w:
+                        v = self.field[a, b]
+                        if v < self.field[i, j] and (best is None or v < best[0]):
+                            best = (v, a, b)
+            if best is None:  # pragma: no cover - the field decreases to the region
+                break
+            i, j = best[1], best[2]
+            cells.append((i, j))
+        pts = [(float(start[0]), float(start[1]))]
+        pts += [
+            (self.origin[0] + (b + 0.5) * res, self.origin[1] + (a + 0.5) * res)
+            for a, b in cells[1:]
+        ]
+        return self._taut(pts)
 
-        h = self.resolution
-        x, y = float(start[0]), float(start[1])
-        d = self.distance((x, y))
-        if not math.isfinite(d):
-            raise GeodesicError(f"{(x, y)} is not in the drivable space")
-        pts = [(x, y)]
-        turns = [math.radians(11.25 * k) for k in range(-8, 9)]
-        for _ in range(int(4 * d / h) + 10):
-            if d <= 0.0:
-                break
-            gx = self.distance((x + h, y)) - self.distance((x - h, y))
-            gy = self.distance((x, y + h)) - self.distance((x, y - h))
-            if not (math.isfinite(gx) and math.isfinite(gy)) or gx == gy == 0.0:
-                break
-            down = math.atan2(-gy, -gx)
-            step = min(h, d)
-            best = None  # the lowest drivable point one step away, around the gradient
-            for t in turns:
-                cx, cy = x + step * math.cos(down + t), y + step * math.sin(down + t)
-                if self.drivable_at((cx, cy)):
-                    dc = self.distance((cx, cy))
-                    if best is None or dc < best[0]:
-                        best = (dc, cx, cy)
-            if best is None or best[0] >= d:
-                break
-            d, x, y = best
-            pts.append((x, y))
-        if len(pts) < 2:
-            return pts
-        line = LineString(pts).simplify(simplify, preserve_topology=False)
-        return [(float(px), float(py)) for px, py in line.coords]
+    def _taut(self, pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        """Shortcut the polyline wherever a straight segment stays drivable."""
+        from shapely.geometry import LineString
+        from shapely.prepared import prep
+
+        room = prep(self.drivable.buffer(self.resolution / 2))  # grid slack
+        out = [pts[0]]
+        k = 0
+        while k < len(pts) - 1:
+            nxt = k + 1
+            step = 1
+            # gallop forward while in view, then back off to the last visible vertex
+            while nxt + step < len(pts) and room.contains(LineString([pts[k], pts[nxt + step]])):
+                nxt += step
+                step *= 2
+            while step > 1:
+                step //= 2
+                if nxt + step < len(pts) and room.contains(LineString([pts[k], pts[nxt + step]])):
+                    nxt += step
+            out.append(pts[nxt])
+            k = nxt
+        return out
