@@ -261,3 +261,27 @@ def test_cli_show_writes_images(tmp_path):
     assert "sees:" in res.output and "wall" in res.output
     bad = runner.invoke(app, ["show", "straight_office", "--out", str(tmp_path), "--pose", "1,2"])
     assert isinstance(bad.exception, PoseError)
+
+
+def test_obstacle_footprints_are_landmarks_and_obstacles_not_walls(world):
+    from shapely.geometry import Point
+
+    from pmnav_bt.sim.robot import COLLISION_HEIGHT
+
+    prints = world.obstacle_footprints(COLLISION_HEIGHT)
+    # Every footprint touches the free space (things on walls stand out into it) ...
+    assert all(fp.intersects(world.free_space) for fp in prints)
+    # ... but none is a whole wall: walls are left to the free-space polygon.
+    assert all(fp.area < 3.0 for fp in prints)
+    for lm in world.building.landmarks:
+        if lm.kind in ("reception_desk", "stairs"):  # solid and low: the body meets them
+            item = world.landmarks[lm.id]
+            inside = np.add(item.centre, 0.3 * np.asarray(item.normal))  # 30 cm out of the wall
+            assert min(fp.distance(Point(*inside)) for fp in prints) < 1e-6, lm.id
+    body = world.add_obstacle(*world.start_pose().xy(), 0.5)
+    try:
+        assert len(world.obstacle_footprints(COLLISION_HEIGHT)) == len(prints) + 1
+    finally:
+        world.remove_obstacle(body)
+    assert len(world.obstacle_footprints(COLLISION_HEIGHT)) == len(prints)
+    assert len(world.obstacle_footprints(0.0)) == 0  # nothing starts below the floor
