@@ -138,7 +138,8 @@ def plan(
     """Plan from a start to a goal room: ordered {landmark: action} steps."""
     from pmnav_bt.planning.graph_planner import GraphPlanner
 
-    finite(max_gap, "--max-gap", 0.1, 1000.0)
+    if max_gap is not None:
+        finite(max_gap, "--max-gap", 0.1, 1000.0)
     if image is not None:
         check_output_file(image, "--image", IMAGE_SUFFIXES)
     pm = _priori_map(file)
