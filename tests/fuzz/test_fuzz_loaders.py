@@ -23,7 +23,7 @@ from pmnav_bt.config import load_config
 from pmnav_bt.errors import BuildingFileError, ConfigError, PmNavError
 from pmnav_bt.map.building import building_from_data, load_building
 from pmnav_bt.map.floorplan import FloorPlanError, load_ros_map, read_image
-from pmnav_bt.sim.episodes import EpisodeFileError, load_episodes
+from pmnav_bt.sim.episodes import EPISODES_SCHEMA_VERSION, EpisodeFileError, load_episodes
 from pmnav_bt.treelog import read_tree_log
 
 pytestmark = pytest.mark.timeout(120)  # bounded time, whatever regresses
@@ -180,7 +180,7 @@ EPISODE = {
     "start_y": 30.0,
     "start_yaw": -1.57,
     "goal": "room17",
-    "geodesic_length": 12.0,
+    "route_length": 12.0,
     "seed": 0,
     "goal_visible": True,
     "turns": 0,
@@ -195,7 +195,7 @@ def test_episode_with_one_odd_value(tmp_path, key, value):
     ep = dict(EPISODE, **{key: value})
     f = tmp_path / "e.json"
     try:
-        text = json.dumps({"schema_version": 1, "episodes": [ep]})
+        text = json.dumps({"schema_version": EPISODES_SCHEMA_VERSION, "episodes": [ep]})
     except ValueError:
         return
     f.write_text(text)

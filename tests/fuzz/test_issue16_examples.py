@@ -94,7 +94,7 @@ def test_non_utf8_files(capsys, tmp_path, enc, what):
     argv = {
         "building": ["map", f],
         "config": ["sim", "run", "--goal", "room1", "--config", f],
-        "episodes": ["sim", "run", "--goal", "room1", "--episodes", f],
+        "episodes": ["sim", "run", "--episodes", f],
         "ros_map": ["validate", building_file(tmp_path, floor_plan={"ros_map": f.name})],
     }[what]
     if what == "ros_map":
@@ -117,7 +117,7 @@ def test_path_over_255_characters(capsys, where):
     argv = {
         "building": ["map", long],
         "config": ["sim", "run", "--goal", "room1", "--config", long],
-        "episodes": ["sim", "run", "--goal", "room1", "--episodes", long],
+        "episodes": ["sim", "run", "--episodes", long],
     }[where]
     cli_fails(capsys, argv, "path too long")
 
@@ -232,7 +232,7 @@ def test_tree_log_records_are_type_checked(capsys, tmp_path, records, words):
 def test_deep_json(capsys, tmp_path):
     f = tmp_path / "e.json"
     f.write_text("[" * 100_000 + "]" * 100_000)
-    cli_fails(capsys, ["sim", "run", "--goal", "room1", "--episodes", f], "e.json", "nested")
+    cli_fails(capsys, ["sim", "run", "--episodes", f], "e.json", "nested")
     t = tmp_path / "t.jsonl"
     t.write_text(json.dumps(TREE_LINE) + "\n" + "[" * 100_000 + "]" * 100_000 + "\n")
     cli_fails(capsys, ["tree", "replay", t], "t.jsonl", "line 2", "nested")
