@@ -102,7 +102,8 @@ class GeodesicField:
 
         Steepest descent over the drivable neighbours of each cell of the distance field
         (it decreases to the region), then pulled taut: each vertex is joined to the
-        farthest later one in straight view inside the drivable space.
+        farthest later one in straight view inside the drivable space. Its length is
+        within about 1 % of :meth:`distance`.
         """
         res = self.resolution
         h, w = self.field.shape
@@ -117,9 +118,10 @@ class GeodesicField:
                 for dj in (-1, 0, 1):
                     a, b = i + di, j + dj
                     if (di or dj) and 0 <= a < h and 0 <= b < w:
-                        v = self.field[a, b]
-                        if v < self.field[i, j] and (best is None or v < best[0]):
-                            best = (v, a, b)
+                        # the steepest slope, not the lowest value: no drift to diagonals
+                        drop = (self.field[i, j] - self.field[a, b]) / math.hypot(di, dj)
+                        if drop > 0 and (best is None or drop > best[0]):
+                            best = (drop, a, b)
             if best is None:  # pragma: no cover - the field decreases to the region
                 break
             i, j = best[1], best[2]
@@ -132,24 +134,23 @@ class GeodesicField:
         return self._taut(pts)
 
     def _taut(self, pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
-        """Shortcut the polyline wherever a straight segment stays drivable."""
+        """Shortcut the polyline: join each vertex to the farthest later one in straight
+        view inside the drivable space (less half a cell of slack for the grid)."""
         from shapely.geometry import LineString
         from shapely.prepared import prep
 
-        room = prep(self.drivable.buffer(self.resolution / 2))  # grid slack
+        room = prep(self.drivable.buffer(self.resolution / 2))
         out = [pts[0]]
         k = 0
         while k < len(pts) - 1:
-            nxt = k + 1
-            step = 1
-            # gallop forward while in view, then back off to the last visible vertex
-            while nxt + step < len(pts) and room.contains(LineString([pts[k], pts[nxt + step]])):
-                nxt += step
-                step *= 2
-            while step > 1:
-                step //= 2
-                if nxt + step < len(pts) and room.contains(LineString([pts[k], pts[nxt + step]])):
-                    nxt += step
+            nxt = next(
+                (
+                    j
+                    for j in range(len(pts) - 1, k + 1, -1)
+                    if room.contains(LineString([pts[k], pts[j]]))
+                ),
+                k + 1,
+            )
             out.append(pts[nxt])
             k = nxt
         return out
