@@ -179,11 +179,13 @@ def goal_fields(world: SimWorld, pm: PrioriMap, goal: str) -> tuple[GeodesicFiel
     ``CLEARANCE_M`` more, so that the body does not graze corners, and ending
     ``CLEARANCE_M`` inside the success disc)."""
     footprints = world.obstacle_footprints(COLLISION_HEIGHT)
-    score = goal_geodesic(pm, goal, footprints)
+    floor = world.floor_space()
+    score = goal_geodesic(pm, goal, footprints, floor=floor)
     drive = goal_geodesic(
         pm,
         goal,
         footprints,
+        floor=floor,
         robot_radius=CREATE3_RADIUS_M + CLEARANCE_M,
         radius=SUCCESS_RADIUS_M - CLEARANCE_M,
     )

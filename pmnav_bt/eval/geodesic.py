@@ -42,7 +42,11 @@ class GeodesicField:
     ):
         obstacles = list(obstacles)
         space = free_space.difference(shapely.union_all(obstacles)) if obstacles else free_space
-        self.drivable = space.buffer(-robot_radius)  # round: the body is a disc
+        drivable = space.buffer(-robot_radius)  # round: the body is a disc
+        # Only the parts that reach the goal: the rest (outside the building) is no way.
+        disc = shapely.Point(goal[0], goal[1]).buffer(radius)
+        near = [g for g in getattr(drivable, "geoms", [drivable]) if g.intersects(disc)]
+        self.drivable = shapely.union_all(near) if near else drivable
         self.resolution = res = float(resolution)
         x0, y0, x1, y1 = free_space.bounds
         self.origin = (x0 - 2 * res, y0 - 2 * res)
