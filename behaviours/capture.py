@@ -9,28 +9,22 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.control import rotate_command
-from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, wrap_angle
-from pmnav_bt.seams import Detection, Observation
+from pmnav_bt.seams import Entity, View
 
 LOCALIZATION_YAWS_DEG = (30, 90, 150, 210, 270, 330)
 SEARCH_YAWS_DEG = (0, 30, -30, 60, -60, 90, -90)
 
 
-@dataclass
-class CapturedView:
-    """One frame of a panorama: its yaw relative to the heading at the start, and detections."""
-
-    relative_yaw: float
-    observation: Observation
-    detections: list[Detection] = field(default_factory=list)
+# What a panorama grounds in each frame: every readable sign (localization), or one entity.
+READ_SIGNS = "signs"
+Grounding = Entity | str | None  # an Entity, READ_SIGNS, or None (just take the frames)
 
 
 def search_yaws(last_action: Action | None) -> list[float]:
@@ -48,11 +42,14 @@ def sweep_order(yaws: list[float]) -> list[float]:
 
 
 class CaptureViews(PmNavBehaviour):
-    """Turn through ``yaws(bb)`` capturing a frame at each, grounding ``query(bb)`` in it.
+    """Turn through ``yaws(b)`` capturing a frame at each and grounding ``what(b)`` in it:
+    READ_SIGNS (every readable sign, for localization), an Entity (the search target),
+    or None (frames only).
 
-    Blackboard: reads what ``yaws``/``query`` read (``target``, ``last_action``);
-    writes ``views`` (list[CapturedView]). Stops early when ``enough(views)`` is true.
-    Ends facing the last view. FAILURE only if the body faults or a frame cannot be taken.
+    Blackboard: reads what ``yaws``/``what`` read (``target``, ``last_action``);
+    writes ``views`` (list[View]). Stops early when ``enough(views)`` is true. Ends
+    facing the last view. FAILURE if the body faults or a frame cannot be taken or
+    grounded (SENSOR_TIMEOUT for a silent camera, the back end's code otherwise).
     """
 
     READS = ("target", "last_action")
@@ -63,13 +60,13 @@ class CaptureViews(PmNavBehaviour):
         name: str,
         ctx: Context,
         yaws: Callable[[PmNavBehaviour], list[float]],
-        query: Callable[[PmNavBehaviour], str | None],
-        enough: Callable[[list[CapturedView]], bool] | None = None,
+        what: Callable[[PmNavBehaviour], Grounding],
+        enough: Callable[[list[View]], bool] | None = None,
         sweep: bool = True,
     ):
         super().__init__(name, ctx)
         self._yaws = yaws
-        self._query = query
+        self._what = what
         self._enough = enough
         self._sweep = sweep
         self._job = None
@@ -77,23 +74,21 @@ class CaptureViews(PmNavBehaviour):
     def initialise(self) -> None:
         yaws = self._yaws(self)
         self._todo = sweep_order(yaws) if self._sweep else list(yaws)
-        self._query_text = self._query(self)
+        self._grounding = self._what(self)
         self._start_yaw = self.ctx.base.pose().yaw
-        self._views: list[CapturedView] = []
+        self._views: list[View] = []
         self._job = None
         self.feedback_message = f"{len(self._todo)} views"
 
     def update(self) -> Status:
         if self._job is not None:
-            if not self._job.done():
-                return Status.RUNNING
-            try:
-                obs, dets = self._job.result()
-            except Exception as err:  # noqa: BLE001 - reported as a sensor failure
-                return self.fail(FailureCode.SENSOR_TIMEOUT, f"no frame: {err}")
+            status, taken = self.poll(self._job, "taking a view")
+            if status is not None:
+                return status
             self._job = None
+            obs, dets = taken
             rel = wrap_angle(obs.pose.yaw - self._start_yaw)
-            self._views.append(CapturedView(rel, obs, dets))
+            self._views.append(View(rel, obs, dets))
             self._todo.pop(0)
             if not self._todo or (self._enough is not None and self._enough(self._views)):
                 self.bb.set("views", list(self._views))
@@ -104,13 +99,15 @@ class CaptureViews(PmNavBehaviour):
             self.ctx.base.set_velocity(v, w)
             return Status.RUNNING
         self.ctx.base.set_velocity(0.0, 0.0)
-        query, base, grounder = self._query_text, self.ctx.base, self.ctx.grounder
+        what, base, grounder = self._grounding, self.ctx.base, self.ctx.grounder
 
         def take(cancelled):
             obs = base.observe()
-            if cancelled.is_set() or query is None:
-                return obs, []
-            return obs, grounder.detect(obs, query)
+            if cancelled.is_set() or what is None:
+                return obs, None
+            if what == READ_SIGNS:
+                return obs, tuple(grounder.read_signs(obs))
+            return obs, tuple(grounder.detect(obs, what))
 
         self._job = self.ctx.worker.submit(take)
         self.feedback_message = (

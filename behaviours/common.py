@@ -1,12 +1,18 @@
-"""The base class of PM-Nav leaves: context, blackboard client, failure reporting."""
+"""The base class of PM-Nav leaves: context, blackboard client, failure reporting, and
+the one way to collect slow work from the worker (``poll``)."""
 
 from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from typing import Any
 
 import py_trees
 from py_trees.common import Access, Status
 
 from pmnav_bt.behaviours.context import Context
-from pmnav_bt.failures import Failure, FailureCode
+from pmnav_bt.failures import Failure, FailureCode, failure_from
+from pmnav_bt.worker import Job
 
 NAMESPACE = "/pmnav"
 
@@ -18,17 +24,18 @@ KEYS = (
     "plan",  # Plan
     "step_index",  # int: index of the current plan step
     "target",  # PlanStep: the current target
-    "views",  # list[CapturedView]: the last panorama
-    "choice",  # CapturedView + Detection: where the target was seen
+    "views",  # list[View]: the last panorama
+    "choice",  # CoarseChoice (view + detection): where the target was seen
     "bearing",  # float: refined bearing to the target, relative to the chosen view
     "sighting",  # Sighting: the target's position seen, in the odometry frame
     "recent_sightings",  # list[Sighting]: the last verified sightings (pose re-fits)
     "last_action",  # Action: the last plan action carried out
-    "avoid_landmarks",  # frozenset[str]: landmarks that failed and are not used again
+    "avoid_landmarks",  # frozenset[str]: landmark IDs that failed and are not used again
     "blocked_segments",  # frozenset[int]: segments found blocked (twice)
     "blocked_suspects",  # frozenset[int]: segments found blocked once
     "replans",  # int
-    "failure",  # Failure: why the last thing failed
+    "failure",  # Failure: why the last thing failed (its ``cause``: the failure recovered from)
+    "recovering_from",  # Failure | None: what the recovery under way started from
 )
 
 
@@ -52,6 +59,8 @@ class PmNavBehaviour(py_trees.behaviour.Behaviour):
             self.bb.register_key(key=key, access=Access.WRITE)
         if "failure" not in self.WRITES:
             self.bb.register_key(key="failure", access=Access.WRITE)
+        if "recovering_from" not in self.WRITES:
+            self.bb.register_key(key="recovering_from", access=Access.READ)
 
     def get(self, key: str, default=None):
         """A blackboard value, or ``default`` when unset."""
@@ -59,6 +68,37 @@ class PmNavBehaviour(py_trees.behaviour.Behaviour):
 
     def fail(self, code: FailureCode, message: str) -> Status:
         """Record why, and return FAILURE."""
-        self.bb.set("failure", Failure(code, message))
-        self.feedback_message = f"{code.value}: {message}"
+        return self.fail_with(Failure(code, message))
+
+    def fail_with(self, failure: Failure) -> Status:
+        """Record ``failure`` (during a recovery, with what the recovery started from as its
+        ``cause``, so that the root cause survives), and return FAILURE."""
+        root = self.get("recovering_from")
+        if root is not None and failure.cause is None and failure != root:
+            failure = dataclasses.replace(failure, cause=root)
+        self.bb.set("failure", failure)
+        self.feedback_message = str(failure)
         return Status.FAILURE
+
+    def poll(
+        self,
+        job: Job,
+        doing: str,
+        classify: Callable[[BaseException], Failure | None] | None = None,
+    ) -> tuple[Status | None, Any]:
+        """Collect a worker job without blocking: ``(RUNNING, None)`` while it runs,
+        ``(FAILURE, None)`` when it raised (the failure recorded, never an escape from the
+        tick), ``(None, result)`` when it is done.
+
+        An exception becomes a Failure by its type (``failures.failure_from``: a sensor
+        error is SENSOR_TIMEOUT, a VLM error VLM_ERROR, a bug INTERNAL_ERROR with its
+        message); ``classify`` may give a more specific one first. ``doing`` (e.g. "taking a
+        frame") prefixes the message.
+        """
+        if not job.done():
+            return Status.RUNNING, None
+        try:
+            return None, job.result()
+        except Exception as err:  # noqa: BLE001 - every exception becomes a failure code
+            failure = (classify(err) if classify is not None else None) or failure_from(err, doing)
+            return self.fail_with(failure), None

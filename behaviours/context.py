@@ -15,8 +15,7 @@ from pmnav_bt.config import Config
 from pmnav_bt.control import Limits, Odometer
 from pmnav_bt.geometry import se2_compose, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.perception.coarse import DetectorCoarseDirection
-from pmnav_bt.seams import Base, Grounder, Planner, Pose2D, Refiner
+from pmnav_bt.seams import Base, CoarseDirection, Grounder, Planner, Pose2D, Refiner
 from pmnav_bt.worker import Worker
 
 
@@ -40,17 +39,13 @@ class Context:
     pm: PrioriMap
     config: Config
     grounder: Grounder
+    coarse: CoarseDirection
     refiner: Refiner
     planner: Planner
     worker: Worker
-    coarse: DetectorCoarseDirection | None = None  # None: the detector on ``grounder``
     odometer: Odometer = field(default_factory=Odometer)
     trace: list[TraceEvent] = field(default_factory=list)
     budget_actions: int = 500
-
-    def __post_init__(self) -> None:
-        if self.coarse is None:
-            self.coarse = DetectorCoarseDirection(self.grounder, self.config.coarse.min_score)
 
     @property
     def limits(self) -> Limits:

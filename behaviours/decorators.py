@@ -14,7 +14,7 @@ class ClockTimeout(py_trees.decorators.Decorator):
     """FAILURE (TIMEOUT) if the child runs longer than ``duration`` seconds of ``now()``
     (the tree's Clock).
 
-    Writes ``/pmnav/failure`` on timeout.
+    Writes ``/pmnav/failure`` on timeout (reads ``recovering_from``, its cause).
     """
 
     def __init__(
@@ -29,6 +29,7 @@ class ClockTimeout(py_trees.decorators.Decorator):
         self.duration = duration
         self.bb = self.attach_blackboard_client(name=name, namespace="/pmnav")
         self.bb.register_key(key="failure", access=Access.WRITE)
+        self.bb.register_key(key="recovering_from", access=Access.READ)
 
     def initialise(self) -> None:
         self._start = self.now()
@@ -36,10 +37,13 @@ class ClockTimeout(py_trees.decorators.Decorator):
     def update(self) -> Status:
         elapsed = self.now() - self._start
         if self.decorated.status == Status.RUNNING and elapsed > self.duration:
+            cause = self.bb.get("recovering_from") if self.bb.exists("recovering_from") else None
             self.bb.set(
                 "failure",
                 Failure(
-                    FailureCode.TIMEOUT, f"{self.decorated.name} took over {self.duration:.0f} s"
+                    FailureCode.TIMEOUT,
+                    f"{self.decorated.name} took over {self.duration:.0f} s",
+                    cause,
                 ),
             )
             self.feedback_message = "timed out"

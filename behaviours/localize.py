@@ -6,35 +6,33 @@ import math
 
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.capture import LOCALIZATION_YAWS_DEG, CapturedView
+from pmnav_bt.behaviours.capture import LOCALIZATION_YAWS_DEG, READ_SIGNS
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, thumbnail
 from pmnav_bt.control import goto_command, rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.localization import fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance
-from pmnav_bt.planning.resolve import entity_index, normalise
-from pmnav_bt.seams import MotionStatus
-
-ALL_SIGNS = "sign"
+from pmnav_bt.seams import Entity, EntityKind, MotionStatus, View
 
 
 def localization_yaws(_b) -> list[float]:
     return [math.radians(y) for y in LOCALIZATION_YAWS_DEG]
 
 
-def sign_query(_b) -> str:
-    return ALL_SIGNS
+def read_signs(_b) -> str:
+    """What the localization panorama grounds: every readable sign."""
+    return READ_SIGNS
 
 
-def enough_doors(ctx: Context, views: list[CapturedView], n: int = 3) -> bool:
+def enough_doors(views: list[View], n: int = 3) -> bool:
     """Stop the localization panorama early once ``n`` distinct doors have been read."""
-    return sum(e.startswith("room:") for e in distinct_landmarks(ctx, views)) >= n
+    return sum(e.kind is EntityKind.ROOM for e in distinct_landmarks(views)) >= n
 
 
-def distinct_landmarks(ctx: Context, views: list[CapturedView]) -> set[str]:
-    index = entity_index(ctx.pm.building)
-    return {index[k] for v in views for d in v.detections if (k := normalise(d.label)) in index}
+def distinct_landmarks(views: list[View]) -> set[Entity]:
+    """The rooms and landmarks whose signs were read in ``views``."""
+    return {d.entity for v in views for d in v.detections or () if d.entity is not None}
 
 
 class FixPosition(PmNavBehaviour):
@@ -54,7 +52,7 @@ class FixPosition(PmNavBehaviour):
             sightings = [
                 s
                 for v in views
-                for d in v.detections
+                for d in v.detections or ()
                 if (s := sighting(pm, v.observation, d)) is not None
             ]
             return sightings, fix_pose(sightings)
@@ -62,9 +60,10 @@ class FixPosition(PmNavBehaviour):
         self._job = self.ctx.worker.submit(locate)
 
     def update(self) -> Status:
-        if not self._job.done():
-            return Status.RUNNING
-        sightings, fix = self._job.result()
+        status, located = self.poll(self._job, "fixing the position")
+        if status is not None:
+            return status
+        sightings, fix = located
         attempts = (self.get("fix_attempts") or 0) + 1
         self.bb.set("fix_attempts", attempts)
         if fix is None:
@@ -72,7 +71,7 @@ class FixPosition(PmNavBehaviour):
             return self.fail(
                 FailureCode.LOCALIZATION_FAILED,
                 f"attempt {attempts}: {len(seen)} landmark(s) recognised "
-                f"({', '.join(seen) or 'none'})"
+                f"({', '.join(map(str, seen)) or 'none'})"
                 "; two are needed",
             )
         self.bb.set("map_T_odom", fix.map_T_odom)
@@ -80,7 +79,7 @@ class FixPosition(PmNavBehaviour):
         views = self.get("views") or []
         self.ctx.log(
             "fix",
-            "+".join(e.split(":")[1] for e in fix.entities),
+            "+".join(e.id for e in fix.entities),
             thumbnail(views[-1].observation.rgb) if views else None,
             map_pose=[est.x, est.y, est.yaw],
             residual=fix.residual,
@@ -88,7 +87,7 @@ class FixPosition(PmNavBehaviour):
         )
         where = f"({est.x:.1f}, {est.y:.1f})"
         self.feedback_message = (
-            f"at {where} from {', '.join(fix.entities)} (rms {fix.residual:.2f} m)"
+            f"at {where} from {', '.join(map(str, fix.entities))} (rms {fix.residual:.2f} m)"
         )
         return Status.SUCCESS
 

@@ -68,10 +68,10 @@ class DriveTo(PmNavBehaviour):
             if self._bumps >= MAX_BUMPS:
                 base.stop()
                 return self.fail(FailureCode.BLOCKED, f"{self._bumps} collisions on the way")
-        blocked = self._poll_watch(now)
-        if blocked is not None:
+        watched = self._poll_watch(now)
+        if watched is not None:
             base.stop()
-            return self.fail(FailureCode.BLOCKED, blocked)
+            return watched
         est = self.estimate()
         dist = math.hypot(self._goal[0] - est.x, self._goal[1] - est.y)
         if dist < self._best - 0.1:
@@ -87,8 +87,9 @@ class DriveTo(PmNavBehaviour):
         self.feedback_message = f"{dist:.1f} m to go"
         return Status.RUNNING
 
-    def _poll_watch(self, now: float) -> str | None:
-        """Start or collect a depth check of the way ahead; a reason when blocked.
+    def _poll_watch(self, now: float) -> Status | None:
+        """Start or collect a depth check of the way ahead; FAILURE when blocked (BLOCKED)
+        or when the frame or its analysis failed (its code, e.g. SENSOR_TIMEOUT).
 
         The frame is taken and analysed in the worker; the tick only reads the verdict.
         """
@@ -105,18 +106,17 @@ class DriveTo(PmNavBehaviour):
 
                 self._watch_job = self.ctx.worker.submit(watch)
             return None
-        if not self._watch_job.done():
+        status, watched = self.poll(self._watch_job, "watching the way ahead")
+        if status == Status.RUNNING:
             return None
-        try:
-            obs, free, found = self._watch_job.result()
-        except Exception as err:  # noqa: BLE001
-            return f"no camera frame: {err}"
-        finally:
-            self._watch_job = None
+        self._watch_job = None
+        if status is not None:
+            return status
+        obs, free, found = watched
         self.on_watch(found, obs)
         if free is not None:
             self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)
-            return f"obstacle {free:.1f} m ahead"
+            return self.fail(FailureCode.BLOCKED, f"obstacle {free:.1f} m ahead")
         return None
 
     def terminate(self, new_status: Status) -> None:
@@ -260,14 +260,17 @@ class CheckOpening(PmNavBehaviour):
 
     def initialise(self) -> None:
         base, grounder = self.ctx.base, self.ctx.grounder
-        self._job = self.ctx.worker.submit(
-            lambda c: (lambda o: (o, mask_ratios(o, grounder)))(base.observe())
-        )
+
+        def look(cancelled):
+            obs = base.observe()
+            return mask_ratios(obs, grounder)
+
+        self._job = self.ctx.worker.submit(look)
 
     def update(self) -> Status:
-        if not self._job.done():
-            return Status.RUNNING
-        obs, ratios = self._job.result()
+        status, ratios = self.poll(self._job, "checking the way ahead")
+        if status is not None:
+            return status
         t = self.get("target")
         if not is_opening(ratios):
             return self.fail(

@@ -9,51 +9,44 @@ from py_trees.common import Status
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.errors import PlanningError, UnknownNameError
-from pmnav_bt.failures import FailureCode
+from pmnav_bt.failures import Failure, FailureCode, root_cause
 from pmnav_bt.planning.resolve import resolve_room
+from pmnav_bt.seams import PlanConstraints
 
 
 class MakePlan(PmNavBehaviour):
     """Plan from the estimated map pose to the goal (in the worker).
 
     Reads ``goal``, ``map_T_odom``, ``avoid_landmarks``, ``blocked_segments``;
-    writes ``plan``, ``step_index`` (0), ``last_action`` (None), ``target`` (None).
+    writes ``plan``, ``step_index`` (0), ``last_action`` (None), ``target`` (None),
+    ``recovering_from`` (None: a new plan ends the recovery under way).
     FAILURE: INVALID_GOAL for an unknown room, PLANNING_FAILED when no route exists,
-    BLOCKED when only corridors found blocked would serve.
+    BLOCKED when only corridors found blocked would serve; a planner back end's own
+    failure code otherwise (VLM_ERROR, INTERNAL_ERROR, ...).
     """
 
     READS = ("goal", "map_T_odom", "avoid_landmarks", "blocked_segments")
-    WRITES = ("plan", "step_index", "last_action", "target")
+    WRITES = ("plan", "step_index", "last_action", "target", "recovering_from")
 
     def initialise(self) -> None:
         self.bb.set("target", None)  # a planning failure belongs to no step
-        est = map_pose(self.get("map_T_odom"), self.ctx.base.pose())
-        start = f"{est.x:.3f},{est.y:.3f},{math.degrees(est.yaw):.1f}"
+        start = map_pose(self.get("map_T_odom"), self.ctx.base.pose())
         goal = self.get("goal")
-        avoid = self.get("avoid_landmarks") or frozenset()
-        blocked = self.get("blocked_segments") or frozenset()
-        planner, pm = self.ctx.planner, self.ctx.pm
-        self._job = self.ctx.worker.submit(
-            lambda c: planner.plan(pm, start, goal, avoid_landmarks=avoid, blocked_segments=blocked)
+        constraints = PlanConstraints(
+            avoid_landmarks=frozenset(self.get("avoid_landmarks") or ()),
+            blocked_segments=frozenset(self.get("blocked_segments") or ()),
         )
+        planner, pm = self.ctx.planner, self.ctx.pm
+        self._job = self.ctx.worker.submit(lambda c: planner.plan(pm, start, goal, constraints))
 
     def update(self) -> Status:
-        if not self._job.done():
-            return Status.RUNNING
-        try:
-            plan = self._job.result()
-        except (UnknownNameError, PlanningError) as err:
-            blocked = self.get("blocked_segments")
-            if isinstance(err, PlanningError) and blocked:
-                segs = ", ".join(f"seg{i}" for i in sorted(blocked))
-                return self.fail(FailureCode.BLOCKED, f"no route around the blocked {segs}")
-            code = FailureCode.PLANNING_FAILED
-            if isinstance(err, UnknownNameError) and not _names_a_room(self.ctx, self.get("goal")):
-                code = FailureCode.INVALID_GOAL  # the goal, not the start, is unknown
-            return self.fail(code, str(err))
+        status, plan = self.poll(self._job, "planning", self._classify)
+        if status is not None:
+            return status
         self.bb.set("plan", plan)
         self.bb.set("step_index", 0)
         self.bb.set("last_action", None)
+        self.bb.set("recovering_from", None)
         self.ctx.log(
             "plan",
             plan.goal,
@@ -62,6 +55,17 @@ class MakePlan(PmNavBehaviour):
         )
         self.feedback_message = f"{len(plan.steps)} steps, {plan.length:.1f} m"
         return Status.SUCCESS
+
+    def _classify(self, err: BaseException) -> Failure | None:
+        """The planning errors that mean more than their type: a blocked way, a bad goal."""
+        if isinstance(err, PlanningError) and self.get("blocked_segments"):
+            segs = ", ".join(f"seg{i}" for i in sorted(self.get("blocked_segments")))
+            return Failure(FailureCode.BLOCKED, f"no route around the blocked {segs}")
+        if isinstance(err, UnknownNameError) and not _names_a_room(self.ctx, self.get("goal")):
+            return Failure(FailureCode.INVALID_GOAL, str(err))  # the goal, not the start
+        if isinstance(err, (PlanningError, UnknownNameError)):
+            return Failure(FailureCode.PLANNING_FAILED, str(err))
+        return None
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
@@ -150,7 +154,8 @@ class NoteFailure(PmNavBehaviour):
 
     Reads ``failure``, ``target``, ``map_T_odom``, ``replans``, ``avoid_landmarks``,
     ``blocked_segments``, ``blocked_suspects``; writes ``replans``, ``avoid_landmarks``,
-    ``blocked_segments``, ``blocked_suspects``. A target not found is avoided (unless
+    ``blocked_segments``, ``blocked_suspects``, ``recovering_from`` (the root cause: a
+    failure during the recovery reports it as its ``cause``). A target not found is avoided (unless
     it is the goal). A corridor found blocked once is suspected (a poor pose estimate
     can make a wall look like an obstacle; the replan re-localizes first); found
     blocked again, it is not routed through any more.
@@ -165,11 +170,19 @@ class NoteFailure(PmNavBehaviour):
         "blocked_segments",
         "blocked_suspects",
     )
-    WRITES = ("replans", "avoid_landmarks", "blocked_segments", "blocked_suspects")
+    WRITES = (
+        "replans",
+        "avoid_landmarks",
+        "blocked_segments",
+        "blocked_suspects",
+        "recovering_from",
+    )
 
     def update(self) -> Status:
         self.bb.set("replans", (self.get("replans") or 0) + 1)
         failure, t = self.get("failure"), self.get("target")
+        if failure is not None:
+            self.bb.set("recovering_from", self.get("recovering_from") or root_cause(failure))
         plan_goal = t is not None and t.action.value == "arrive"
         not_found = failure is not None and failure.code == FailureCode.TARGET_NOT_FOUND
         if not_found and t is not None and t.look_for and not plan_goal:

@@ -7,15 +7,14 @@ import math
 import numpy as np
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.capture import CapturedView
 from pmnav_bt.behaviours.common import PmNavBehaviour
-from pmnav_bt.behaviours.context import Context, map_pose, thumbnail
+from pmnav_bt.behaviours.context import map_pose, thumbnail
 from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply
 from pmnav_bt.localization import Sighting, fix_pose
-from pmnav_bt.perception.geometry import target_point
-from pmnav_bt.planning.resolve import entity_position
+from pmnav_bt.planning.resolve import entity_position, step_entity
+from pmnav_bt.seams import CoarseChoice, Entity, View
 
 # How far (m) a sighting may be from where the map puts the target and still be it.
 VERIFY_TOLERANCE = 3.0
@@ -27,74 +26,76 @@ REFIT_RESIDUAL = 0.6
 MIN_REFIT_SPREAD = 3.0
 
 
-def target_query(b: PmNavBehaviour) -> str | None:
-    """The text to ground for the current target: its sign as a person would read it."""
+def target_entity(b: PmNavBehaviour) -> Entity | None:
+    """The room or landmark the current target step looks for (None: nothing to see)."""
     t = b.get("target")
     if t is None or t.look_for is None:
         return None
-    entity = target_entity(b.ctx, t.look_for)
-    kind, ident = entity.split(":", 1)
-    bld = b.ctx.pm.building
-    if kind == "room":
-        return bld.room(ident).sign_text
-    lm = bld.landmark(ident)
-    return lm.sign or lm.display_name
-
-
-def target_entity(ctx: Context, look_for: str) -> str:
-    """'room:<id>' or 'landmark:<id>' for a plan step's look_for."""
-    ids = {r.id for r in ctx.pm.building.rooms}
-    return f"room:{look_for}" if look_for in ids else f"landmark:{look_for}"
+    return step_entity(b.ctx.pm.building, t.look_for)
 
 
 class CoarseDirection(PmNavBehaviour):
-    """Pick the view that shows the target, with the context's coarse-direction back end
-    (``detector``: best grounding score across the views).
+    """Pick the view that shows the target with the context's coarse-direction back end
+    (``detector``: the best grounding score across the views; a VLM takes seconds), in
+    the worker.
 
-    Reads ``views``, ``target``; writes ``choice`` (view, detection). FAILURE
-    (TARGET_NOT_FOUND) when no view shows it. ``min_score`` overrides the back end's.
+    Reads ``views``, ``target``; writes ``choice`` (CoarseChoice: view + detection).
+    FAILURE: TARGET_NOT_FOUND when no view shows it; the back end's code when it fails.
     """
 
     READS = ("views", "target")
     WRITES = ("choice",)
 
-    def __init__(self, name: str, ctx: Context, min_score: float | None = None):
-        super().__init__(name, ctx)
-        self.min_score = min_score
+    def initialise(self) -> None:
+        views, target, coarse = tuple(self.get("views") or ()), target_entity(self), self.ctx.coarse
+        self._n_views = len(views)
+        self._job = (
+            None
+            if target is None
+            else self.ctx.worker.submit(lambda c: coarse.choose(views, target))
+        )
 
     def update(self) -> Status:
-        views = self.get("views") or []
-        best = self.ctx.coarse.choose_view(views, target_query(self) or "", self.min_score)
-        if best is None:
+        choice: CoarseChoice | None = None
+        if self._job is not None:
+            status, choice = self.poll(self._job, "choosing the coarse direction")
+            if status is not None:
+                return status
+        if choice is None:
             t = self.get("target")
             return self.fail(
                 FailureCode.TARGET_NOT_FOUND,
-                f"{t.look_for if t else 'target'} not seen in {len(views)} views",
+                f"{t.look_for if t else 'target'} not seen in {self._n_views} views",
             )
-        self.bb.set("choice", best)
+        self.bb.set("choice", choice)
         self.feedback_message = (
-            f"seen at {math.degrees(best[0].relative_yaw):+.0f} deg (score {best[1].score:.2f})"
+            f"seen at {math.degrees(choice.view.relative_yaw):+.0f} deg "
+            f"(score {choice.detection.score:.2f})"
         )
         return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
+            self._job.cancel()
 
 
 class Ground(PmNavBehaviour):
     """Grounding: face the coarse direction and ground the target in a fresh frame.
 
-    Reads ``choice``; writes ``choice`` (the new frame and its best detection, with a
-    mask). Facing the target keeps its mask off the image border, where a cut-off
+    Reads ``choice``, ``target``; writes ``choice`` (the new frame and its best detection,
+    with a mask). Facing the target keeps its mask off the image border, where a cut-off
     mask would bias the bearing and range. If the fresh frame misses the target, the
     coarse view's detection stands.
     """
 
-    READS = ("choice",)
+    READS = ("choice", "target")
     WRITES = ("choice",)
 
     def initialise(self) -> None:
-        view, det = self.get("choice")
-        obs = view.observation
+        choice: CoarseChoice = self.get("choice")
+        obs, det = choice.view.observation, choice.detection
         self._yaw = obs.pose.yaw + obs.intrinsics.pixel_bearing(det.centre[0])
-        self._query = det.label
+        self._target = target_entity(self) or det.entity
         self._job = None
 
     def update(self) -> Status:
@@ -105,21 +106,24 @@ class Ground(PmNavBehaviour):
                 base.set_velocity(v, w)
                 return Status.RUNNING
             base.set_velocity(0.0, 0.0)
-            query, grounder = self._query, self.ctx.grounder
+            target, grounder = self._target, self.ctx.grounder
 
             def take(cancelled):
                 obs = base.observe()
-                return obs, ([] if cancelled.is_set() else grounder.detect(obs, query))
+                if cancelled.is_set() or target is None:
+                    return obs, ()
+                return obs, tuple(grounder.detect(obs, target))
 
             self._job = self.ctx.worker.submit(take)
             return Status.RUNNING
-        if not self._job.done():
-            return Status.RUNNING
-        obs, dets = self._job.result()
-        dets = [d for d in dets if d.mask is not None]
-        if dets:
-            best = max(dets, key=lambda d: d.score)
-            self.bb.set("choice", (CapturedView(0.0, obs, dets), best))
+        status, taken = self.poll(self._job, "grounding the target")
+        if status is not None:
+            return status
+        obs, dets = taken
+        masked = [d for d in dets if d.mask is not None]
+        if masked:
+            best = max(masked, key=lambda d: d.score)
+            self.bb.set("choice", CoarseChoice(View(0.0, obs, dets), best))
             self.feedback_message = f"grounded, score {best.score:.2f}"
         else:
             self.feedback_message = "not in the fresh frame: keeping the coarse view's detection"
@@ -136,28 +140,46 @@ class FineDirection(PmNavBehaviour):
     """Refine the bearing to the target and place it in the odometry frame.
 
     Reads ``choice``, ``target``, ``map_T_odom``; writes ``bearing`` (relative to the
-    chosen view) and ``sighting`` (the target seen, odometry frame). With the
-    ``geometric`` refiner the range comes from depth over the mask; without
-    refinement (coarse-only) the target is taken straight ahead of its view, at the
-    distance the map predicts.
+    chosen view) and ``sighting`` (the target seen, odometry frame). The refiner gives
+    the bearing, and the range when it measures one (``Refinement.range``); without a
+    range the target is taken along the bearing, as far as the map predicts. The refiner
+    runs in the worker (FAILURE with its code if it fails). With
+    ``refine=False`` (the coarse-only variant, paper Table 4) the target is taken
+    straight ahead of the view it was seen in.
     """
 
     READS = ("choice", "target", "map_T_odom")
     WRITES = ("bearing", "sighting")
 
+    def __init__(self, name: str, ctx, refine: bool = True):
+        super().__init__(name, ctx)
+        self.refine = refine
+
+    def initialise(self) -> None:
+        choice: CoarseChoice = self.get("choice")
+        obs, det = choice.view.observation, choice.detection
+        refiner = self.ctx.refiner
+        # A refiner may be a network (PixelNav): it runs in the worker.
+        self._job = (
+            self.ctx.worker.submit(lambda c: refiner.refine(obs, det)) if self.refine else None
+        )
+
     def update(self) -> Status:
-        view, det = self.get("choice")
-        obs = view.observation
+        choice: CoarseChoice = self.get("choice")
+        obs, det = choice.view.observation, choice.detection
+        bearing, rng = 0.0, None
+        if self._job is not None:
+            status, refined = self.poll(self._job, "refining the direction")
+            if status is not None:
+                return status
+            bearing, rng = float(refined.bearing), refined.range
         t = self.get("target")
-        entity = target_entity(self.ctx, t.look_for)
-        bearing = float(self.ctx.refiner.refine(obs, det))
+        entity = target_entity(self)
         m = entity_position(self.ctx.pm, entity)
-        body = target_point(obs, det)
-        if self.ctx.refiner.name != "geometric" or body is None:
-            # No grounded range: assume the target lies along the bearing, as far as the map says.
+        if rng is None:
             est = map_pose(self.get("map_T_odom"), obs.pose)
             rng = float(np.hypot(m[0] - est.x, m[1] - est.y))
-            body = np.array([rng * math.cos(bearing), rng * math.sin(bearing)])
+        body = np.array([rng * math.cos(bearing), rng * math.sin(bearing)])
         odom = se2_apply((obs.pose.x, obs.pose.y, obs.pose.yaw), body)
         s = Sighting(entity, (float(m[0]), float(m[1])), (float(odom[0]), float(odom[1])))
         self.bb.set("bearing", bearing)
@@ -167,6 +189,10 @@ class FineDirection(PmNavBehaviour):
         )
         self.feedback_message = f"{t.look_for} at {math.degrees(bearing):+.1f} deg"
         return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
+            self._job.cancel()
 
 
 class Verify(PmNavBehaviour):

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from pmnav_bt.failures import FailureCode
 from pmnav_bt.hardware.requests import GoalPoseError, GoalRequest, goal_from_pose
 
 ACTION_NAME = "navigate_to_room"
@@ -125,7 +126,9 @@ class NavigateActionServer:
             room = self._room(gh.request)
         except GoalPoseError as err:
             gh.abort()
-            return result_message({"success": False, "code": "INVALID_GOAL", "message": str(err)})
+            return result_message(
+                {"success": False, "code": FailureCode.INVALID_GOAL.value, "message": str(err)}
+            )
         done = Future()
 
         def on_done(result: dict) -> None:
@@ -150,7 +153,7 @@ class NavigateActionServer:
         msg = result_message(r, self.pose_msg(tuple(pose)) if pose else None)
         if r.get("success"):
             gh.succeed()
-        elif r.get("code") == "CANCELLED" and gh.is_cancel_requested:
+        elif r.get("code") == FailureCode.CANCELLED.value and gh.is_cancel_requested:
             gh.canceled()
         else:
             gh.abort()

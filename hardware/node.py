@@ -11,9 +11,10 @@ API (all standard messages; names relative to the node's namespace):
 - readiness (``hardware/readiness.py``): a goal that arrives before odometry and the
   camera are fresh waits for them, up to ``ready_timeout_s``.
 - out ``result`` (std_msgs/String, JSON): ``{"id", "goal", "success", "code",
-  "message", "duration_s", "ticks", "actions", "fix_attempts", "replans",
+  "message", "cause", "duration_s", "ticks", "actions", "fix_attempts", "replans",
   "pose_odom", "pose_map"}``; ``code`` is a FailureCode (INVALID_GOAL,
-  SENSOR_TIMEOUT, ...) or null.
+  SENSOR_TIMEOUT, CANCELLED, INTERNAL_ERROR, ...) or null; ``cause`` is the root-cause
+  failure ``{"code", "message"}`` when recoveries failed after it, else null.
 - out ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, ``status_hz``) and ``status``
   (std_msgs/String, JSON): ready or the missing inputs, idle/running, the goal,
   sensor ages, the current fault.
@@ -46,6 +47,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any
 
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.failures import Failure, FailureCode, failure_from
 from pmnav_bt.hardware import action_server
 from pmnav_bt.hardware.create3 import Create3Options
 from pmnav_bt.hardware.diagnostics import diagnostic_array
@@ -195,6 +197,7 @@ class PmNavController:
         from pmnav_bt.hardware.create3 import Create3Base
         from pmnav_bt.map.building import load_building
         from pmnav_bt.map.priori_map import parse_building
+        from pmnav_bt.registry import build_backends
         from pmnav_bt.trees import runner  # noqa: F401 - import the tree now, not at the first
         # goal: a long import holds the GIL and would starve the executor (odometry "stale")
 
@@ -206,14 +209,13 @@ class PmNavController:
         if p["tick_hz"] > 0:
             overrides.append(f"tree.tick_hz={float(p['tick_hz'])}")
         self.config = load_config(p["config"] or None, overrides, label="parameter 'overrides'")
-        if self.config.grounder.backend == "sim_gt" and not p["segmentation_topic"]:
-            raise PmNavError(
-                "grounder.backend 'sim_gt' reads the simulator's segmentation, but the "
-                "segmentation_topic parameter is empty; run against pmnav-sim-create3 "
-                "(it publishes camera/segmentation) or configure a real grounder back end"
-            )
         self.building = load_building(p["building"])
         self.pm = parse_building(self.building)
+        # The back ends, built once; a back end that reads the simulator's labels is refused
+        # (one line, from the registry) unless the simulated Create 3 publishes them.
+        self.backends = build_backends(
+            self.config, self.pm, on_robot=not p["segmentation_topic"], seed=int(p["seed"])
+        )
         self.base = Create3Base(node, create3_options(p))
         self.readiness = Readiness(self.base, p["odom_timeout"], p["camera_timeout"])
         self.map_frame, self.odom_frame = p["map_frame"], p["odom_frame"]
@@ -343,7 +345,12 @@ class PmNavController:
                 dropped.append(self._goals.get_nowait())
         for req in dropped:
             req.finish(
-                {"goal": req.goal, "success": False, "code": "CANCELLED", "message": "cancelled"}
+                {
+                    "goal": req.goal,
+                    "success": False,
+                    "code": FailureCode.CANCELLED.value,
+                    "message": "cancelled",
+                }
             )
 
     def request_stop(self) -> None:
@@ -363,7 +370,8 @@ class PmNavController:
             except queue.Empty:
                 continue
             if stop.is_set():
-                req.finish({"goal": req.goal, "success": False, "code": "CANCELLED",
+                req.finish({"goal": req.goal, "success": False,
+                            "code": FailureCode.CANCELLED.value,
                             "message": "the node is shutting down"})  # fmt: skip
                 break
             try:
@@ -372,8 +380,10 @@ class PmNavController:
                 self.log.error(f"goal {req.goal!r} failed:\n{traceback.format_exc()}")
                 self.base.stop()
                 if not req.done.is_set():
-                    req.finish({"goal": req.goal, "success": False, "code": "INTERNAL_ERROR",
-                                "message": f"{type(err).__name__}: {err}"})  # fmt: skip
+                    failure = failure_from(err)
+                    req.finish({"goal": req.goal, "success": False,
+                                "code": failure.code.value,
+                                "message": failure.message})  # fmt: skip
 
     def _room_fields(self, goal: str) -> dict:
         from pmnav_bt.planning.resolve import resolve_room
@@ -439,7 +449,9 @@ class PmNavController:
         self.base.clock.clear()
         t0 = self.base.clock.now()
         budget = int(p["budget"]) or None
-        ctx = make_context(self.base, self.pm, cfg, seed=int(p["seed"]), budget=budget)
+        ctx = make_context(
+            self.base, self.pm, cfg, seed=int(p["seed"]), budget=budget, backends=self.backends
+        )
         viz = _Viz(self, ctx)
         tee = open(p["tree_log"], "a", encoding="utf-8") if p["tree_log"] else None  # noqa: SIM115
         writer = _SnapshotWriter(self.pub_tree, self.pub_structure, tee)
@@ -460,22 +472,21 @@ class PmNavController:
                 success=out.success,
                 code=out.failure.code.value if out.failure else None,
                 message=out.failure.message if out.failure else "arrived",
+                cause=_failure_dict(out.cause),
                 ticks=out.ticks,
                 actions=out.actions,
                 fix_attempts=out.fix_attempts,
                 replans=out.replans,
             )
         except Cancelled as c:
-            result.update(success=False, code="CANCELLED", message=str(c))
+            result.update(success=False, code=FailureCode.CANCELLED.value, message=str(c))
         except NotReadyError as err:
-            result.update(success=False, code="SENSOR_TIMEOUT", message=str(err))
-        except PmNavError as err:
-            result.update(success=False, code="ERROR", message=str(err))
-        except Exception as err:  # noqa: BLE001 - reported, the node goes on
-            self.log.error(traceback.format_exc())
-            result.update(
-                success=False, code="INTERNAL_ERROR", message=f"{type(err).__name__}: {err}"
-            )
+            result.update(success=False, code=FailureCode.SENSOR_TIMEOUT.value, message=str(err))
+        except Exception as err:  # noqa: BLE001 - reported with its code, the node goes on
+            if not isinstance(err, PmNavError):
+                self.log.error(traceback.format_exc())
+            failure = failure_from(err)
+            result.update(success=False, code=failure.code.value, message=failure.message)
         finally:
             self.base.stop()
             if tee is not None:
@@ -622,6 +633,10 @@ class _Viz:
                 0.25,
             )
         ctl.pub_markers.publish(MarkerArray(markers=ctl._map_markers + arr.markers))
+
+
+def _failure_dict(failure: Failure | None) -> dict | None:
+    return None if failure is None else {"code": failure.code.value, "message": failure.message}
 
 
 def _moved(a: Pose2D, b: Pose2D) -> bool:

@@ -16,8 +16,8 @@ import numpy as np
 from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.perception.geometry import target_point
-from pmnav_bt.planning.resolve import entity_index, entity_position, normalise
-from pmnav_bt.seams import Detection, Observation, Pose2D
+from pmnav_bt.planning.resolve import entity_position
+from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, Pose2D
 
 MAX_RESIDUAL = 0.8  # metres (RMS) for a set of sightings to count as consistent
 
@@ -26,7 +26,7 @@ MAX_RESIDUAL = 0.8  # metres (RMS) for a set of sightings to count as consistent
 class Sighting:
     """A landmark seen: which one, its map position, and where it was seen (odom frame)."""
 
-    entity: str
+    entity: Entity
     map_xy: tuple[float, float]
     odom_xy: tuple[float, float]
 
@@ -36,7 +36,7 @@ class Fix:
     """A localization result: map_T_odom, the landmarks used and the fit residual."""
 
     map_T_odom: tuple[float, float, float]
-    entities: tuple[str, ...]
+    entities: tuple[Entity, ...]
     residual: float
 
     def map_pose(self, odom: Pose2D) -> Pose2D:
@@ -44,20 +44,17 @@ class Fix:
         return Pose2D(x, y, yaw)
 
 
-def sighting(
-    pm: PrioriMap, obs: Observation, det: Detection, entity: str | None = None
-) -> Sighting | None:
-    """A sighting from a detection, if its label names a map entity and depth gives its range."""
-    if entity is None:
-        entity = entity_index(pm.building).get(normalise(det.label))
-    if entity is None or truncated(obs, det):
+def sighting(pm: PrioriMap, obs: Observation, det: Detection) -> Sighting | None:
+    """A sighting from a detection, if the grounder said which entity it is and where it is
+    (its ``point``, or depth over its mask)."""
+    if det.entity is None or truncated(obs, det):
         return None
-    p = target_point(obs, det)
+    p = det.point[:2] if det.point is not None else target_point(obs, det)
     if p is None:
         return None
     odom = se2_apply((obs.pose.x, obs.pose.y, obs.pose.yaw), p)
-    m = entity_position(pm, entity)
-    return Sighting(entity, (float(m[0]), float(m[1])), (float(odom[0]), float(odom[1])))
+    m = entity_position(pm, det.entity)
+    return Sighting(det.entity, (float(m[0]), float(m[1])), (float(odom[0]), float(odom[1])))
 
 
 def truncated(obs: Observation, det: Detection) -> bool:
@@ -72,10 +69,10 @@ def fix_pose(sightings: list[Sighting], max_residual: float = MAX_RESIDUAL) -> F
     Doors are placed exactly by the map; other landmarks (desks, lifts) only roughly. So
     with two or more doors in view only doors are used.
     """
-    doors = [s for s in sightings if s.entity.startswith("room:")]
+    doors = [s for s in sightings if s.entity.kind is EntityKind.ROOM]
     if len({s.entity for s in doors}) >= 2:
         sightings = doors
-    by_entity: dict[str, list[Sighting]] = {}
+    by_entity: dict[Entity, list[Sighting]] = {}
     for s in sightings:
         by_entity.setdefault(s.entity, []).append(s)
     # One averaged sighting per landmark.

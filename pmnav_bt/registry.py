@@ -124,11 +124,6 @@ REFINERS = Registry(
             "pmnav_bt.perception.refiners.geometric:build",
             "goal pixel -> bearing from the intrinsics, range from depth",
         ),
-        BackendSpec(
-            "coarse_only",
-            "pmnav_bt.perception.refiners.geometric:build_coarse_only",
-            "no refinement: straight ahead of the view (paper Table 4 ablation)",
-        ),
     ],
 )
 PLANNERS = Registry(

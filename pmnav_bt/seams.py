@@ -180,7 +180,7 @@ class EntityKind(str, Enum):
     LANDMARK = "landmark"  # elevator, stairs, reception, ...: seen as itself or its sign
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, order=True)
 class Entity:
     """A typed reference to a room or landmark of the building (never a prefixed string)."""
 

@@ -34,7 +34,16 @@ from pmnav_bt.map.building import (
     resolve_building_path,
 )
 from pmnav_bt.map.free_space import free_space_polygon
-from pmnav_bt.seams import CAMERA_HEIGHT_M, Pose2D
+from pmnav_bt.seams import (
+    CAMERA_HEIGHT_M,
+    FLOOR_LABEL,
+    OBSTACLE_LABEL,
+    WALL_LABEL,
+    Pose2D,
+    door_label,
+    landmark_label,
+    sign_label,
+)
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.textures import make_sign, write_png
 
@@ -48,26 +57,16 @@ class SimError(PmNavError):
 # -- labels ------------------------------------------------------------------------------
 
 BACKGROUND = "background"
-FLOOR = "floor"
-WALL = "wall"
+FLOOR = FLOOR_LABEL
+WALL = WALL_LABEL
 CEILING = "ceiling"
-OBSTACLE = "obstacle"
+OBSTACLE = OBSTACLE_LABEL
 ROBOT = "robot"
 FIXED_LABELS = (BACKGROUND, FLOOR, WALL, CEILING, OBSTACLE, ROBOT)  # ids 0..5
 WALL_SOURCES = ("corridors", "grid")  # what the simulator builds its walls from
 ITEM_CLEAR_BEHIND, ITEM_CLEAR_FRONT = 0.05, 0.3  # m of grid wall cleared around wall items
 
-
-def door_label(room_id: str) -> str:
-    return f"door:{room_id}"
-
-
-def sign_label(room_id: str) -> str:
-    return f"sign:{room_id}"
-
-
-def landmark_label(landmark_id: str) -> str:
-    return f"landmark:{landmark_id}"
+# door_label / sign_label / landmark_label: spelled once, in pmnav_bt.seams.
 
 
 # -- appearance and sizes (metres, RGBA) -------------------------------------------------
@@ -772,7 +771,7 @@ class SimWorld:
     def _build_landmark(self, lm: Landmark) -> None:
         kind = lm.kind.lower()
         label = landmark_label(lm.id)
-        text = lm.sign or lm.display_name
+        text = lm.sign_text
         if kind in _ELEVATOR_KINDS:
             item = self._build_elevator(lm, label)
         elif kind in _STAIRS_KINDS:
@@ -842,7 +841,7 @@ class SimWorld:
             s,
             total,
             (0.0, ELEVATOR_HEIGHT + fw),
-            lm.sign or lm.display_name,
+            lm.sign_text,
         )
 
     def _build_stairs(self, lm: Landmark, label: str) -> WallItem:
@@ -854,9 +853,7 @@ class SimWorld:
                 wi, sk, STAIRS_DEPTH, step, 0.0, (k + 1) * STAIRS_RISE, STEP_RGBA[k % 2], label
             )
         top = STAIRS_STEPS * STAIRS_RISE
-        return self._item(
-            lm.id, lm.kind, label, wi, s, STAIRS_LENGTH, (0.0, top), lm.sign or lm.display_name
-        )
+        return self._item(lm.id, lm.kind, label, wi, s, STAIRS_LENGTH, (0.0, top), lm.sign_text)
 
     def _build_desk(self, lm: Landmark, label: str) -> WallItem:
         wi, s = self._snap(f"landmark {lm.id}", lm.pos, (DESK_LENGTH + 0.1) / 2.0)
@@ -879,5 +876,5 @@ class SimWorld:
             s,
             DESK_LENGTH + 0.1,
             (0.0, DESK_HEIGHT),
-            lm.sign or lm.display_name,
+            lm.sign_text,
         )

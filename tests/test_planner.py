@@ -13,6 +13,7 @@ from pmnav_bt.geometry import Action
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.planning.graph_planner import GraphPlanner
 from pmnav_bt.planning.resolve import resolve_start
+from pmnav_bt.seams import PlanConstraints, Pose2D
 
 planner = GraphPlanner()
 
@@ -176,7 +177,9 @@ def test_loop_takes_the_shorter_way_round(loop_map):
 def test_avoided_landmarks_are_not_used_as_steps(fig2_map):
     p = planner.plan(fig2_map, "seg13", "room17")
     assert any(s.look_for == "room8" for s in p.steps)
-    q = planner.plan(fig2_map, "seg13", "room17", avoid_landmarks=frozenset({"room8"}))
+    q = planner.plan(
+        fig2_map, "seg13", "room17", PlanConstraints(avoid_landmarks=frozenset({"room8"}))
+    )
     assert all(s.look_for != "room8" for s in q.steps)
     # turn2 is then predicted by the visible landmark before room8
     pred = next(s for s in q.steps if s.predicts and s.predicts[0] == "turn2")
@@ -184,14 +187,16 @@ def test_avoided_landmarks_are_not_used_as_steps(fig2_map):
 
 
 def test_the_goal_is_never_avoided(fig2_map):
-    q = planner.plan(fig2_map, "seg13", "room17", avoid_landmarks=frozenset({"room17"}))
+    q = planner.plan(
+        fig2_map, "seg13", "room17", PlanConstraints(avoid_landmarks=frozenset({"room17"}))
+    )
     assert q.steps[-1].look_for == "room17"
 
 
 def test_blocked_segments_are_routed_around(loop_map):
     p = planner.plan(loop_map, "seg16", "room13")
     used = {loop_map.graph.edges[u, v]["segment"] for u, v in pairwise(p.nodes)}
-    q = planner.plan(loop_map, "seg16", "room13", blocked_segments=frozenset(used))
+    q = planner.plan(loop_map, "seg16", "room13", PlanConstraints(blocked_segments=frozenset(used)))
     assert q.length > p.length and "branch1" in q.nodes
 
 
@@ -199,4 +204,16 @@ def test_no_route_is_a_planning_error(fig2_map):
     from pmnav_bt.errors import PlanningError
 
     with pytest.raises(PlanningError):
-        planner.plan(fig2_map, "seg13", "room17", blocked_segments=frozenset({14, 12}))
+        planner.plan(
+            fig2_map, "seg13", "room17", PlanConstraints(blocked_segments=frozenset({14, 12}))
+        )
+
+
+def test_a_pose_start_is_typed_radians_and_matches_the_typed_text(fig2_map):
+    """Inside the loop the start is a Pose2D (radians); a person types degrees."""
+    import math
+
+    typed = planner.plan(fig2_map, Pose2D(22.0, 0.0, math.pi / 2), "room17")
+    text = planner.plan(fig2_map, "22,0,90", "room17")
+    assert typed.initial_action is text.initial_action is Action.TURN_RIGHT
+    assert typed.nodes == text.nodes

@@ -1,8 +1,9 @@
 """The PM-Nav tree: localize, plan, then per step "target determination -> search ->
 verification -> target update", with re-search, replanning and a budget.
 
-Variants (paper, Table 4): ``pmnav`` refines the coarse direction with grounding and
-the fine-direction refiner; ``coarse_only`` keeps the coarse view direction.
+Variants (paper, Table 4; ``tree.variant``): ``pmnav`` refines the coarse direction with
+grounding and the refiner back end (``refiner.backend``); ``coarse_only`` keeps the coarse
+view direction and uses no refiner at all.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from pmnav_bt.behaviours.localize import (
     FixPosition,
     enough_doors,
     localization_yaws,
-    sign_query,
+    read_signs,
 )
 from pmnav_bt.behaviours.monitor import Monitor
 from pmnav_bt.behaviours.motion import (
@@ -46,7 +47,7 @@ from pmnav_bt.behaviours.search import (
     FineDirection,
     Ground,
     Verify,
-    target_query,
+    target_entity,
 )
 
 VARIANTS = ("pmnav", "coarse_only")
@@ -64,8 +65,8 @@ def localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour
                 f"{name}Views",
                 ctx,
                 localization_yaws,
-                sign_query,
-                enough=lambda views: enough_doors(ctx, views),
+                read_signs,
+                enough=enough_doors,
             ),
             FixPosition(f"{name}Fix", ctx),
         ],
@@ -89,6 +90,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
     """One plan step: target determination, then search-verify-approach for a visible
     target or drive-turn-check for an unseen turn or fork, then target update."""
     cfg = ctx.config.tree
+    coarse_only = cfg.variant == "coarse_only"
     search_once = Sequence(
         "SearchOnce",
         memory=True,
@@ -97,13 +99,13 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
                 "SearchViews",
                 ctx,
                 lambda b: search_yaws(b.get("last_action")),
-                target_query,
-                enough=lambda views: any(d.score >= 0.5 for d in views[-1].detections),
+                target_entity,
+                enough=lambda views: any(d.score >= 0.5 for d in views[-1].detections or ()),
             ),
             CoarseDirection("CoarseDirection", ctx),
             # coarse-only (Table 4): no grounding and no refinement of the view direction
-            *([] if cfg.variant == "coarse_only" else [Ground("Grounding", ctx)]),
-            FineDirection("FineDirection", ctx),
+            *([] if coarse_only else [Ground("Grounding", ctx)]),
+            FineDirection("FineDirection", ctx, refine=not coarse_only),
             Verify("Verification", ctx),
         ],
     )

@@ -19,11 +19,9 @@ from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.config import Config
 from pmnav_bt.eval.task import action_budget as task_action_budget
-from pmnav_bt.failures import Failure, FailureCode
+from pmnav_bt.failures import Failure, FailureCode, failure_from, root_cause
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.perception.ground_truth import GroundTruthGrounder
-from pmnav_bt.perception.refine import CoarseOnly, GeometricRefiner
-from pmnav_bt.planning.graph_planner import GraphPlanner
+from pmnav_bt.registry import Backends, build_backends
 from pmnav_bt.seams import Base
 from pmnav_bt.trees.pmnav import build_pmnav_tree
 from pmnav_bt.trees.snapshots import SnapshotLogger
@@ -42,6 +40,12 @@ class RunOutcome:
     replans: int
     actions: int
 
+    @property
+    def cause(self) -> Failure | None:
+        """The root-cause failure when recoveries failed after it, else None."""
+        root = root_cause(self.failure)
+        return root if root is not self.failure else None
+
 
 def action_budget(config: Config, route_m: float | None) -> int:
     """The config's action budget for a corridor route of ``route_m`` metres
@@ -56,30 +60,26 @@ def make_context(
     seed: int = 0,
     budget: int | None = None,
     deferred_work: bool = False,
+    *,
+    on_robot: bool = False,
+    backends: Backends | None = None,
 ) -> Context:
-    """The back ends the config names, wired into a Context.
+    """The back ends the config names (``build_backends``), wired into a Context.
 
     ``deferred_work``: background jobs start between ticks (simulation; see Worker).
+    ``on_robot``: the observations carry no simulator labels (back ends that need them are
+    refused). ``backends``: ready-made back ends instead (tests, test doubles).
     """
-    g = config.grounder
-    grounder = GroundTruthGrounder(
-        pm.building,
-        miss_rate=g.miss_rate,
-        false_positive_rate=g.false_positive_rate,
-        mask_noise_px=g.mask_noise_px,
-        min_sign_pixels=g.min_sign_pixels,
-        max_range=g.max_range,
-        hidden=frozenset(g.hidden),
-        seed=seed,
-    )
-    refiner = CoarseOnly() if config.tree.variant == "coarse_only" else GeometricRefiner()
+    if backends is None:
+        backends = build_backends(config, pm, on_robot=on_robot, seed=seed)
     return Context(
         base=base,
         pm=pm,
         config=config,
-        grounder=grounder,
-        refiner=refiner,
-        planner=GraphPlanner(max_gap=config.planner.max_gap),
+        grounder=backends.grounder,
+        coarse=backends.coarse,
+        refiner=backends.refiner,
+        planner=backends.planner,
         worker=Worker(deferred=deferred_work),
         budget_actions=budget if budget is not None else config.tree.budget_actions,
     )
@@ -107,17 +107,23 @@ def run_tree(
     tree = build_pmnav_tree(ctx, goal)
     if log is not None:
         tree.add_post_tick_handler(SnapshotLogger(tree, log, ctx.now))
-    if on_tick is not None:
-        tree.add_post_tick_handler(on_tick)
     period = 1.0 / ctx.config.tree.tick_hz
     status = py_trees.common.Status.RUNNING
+    crash: Failure | None = None
     try:
         tree.setup()
         while tree.count < max_ticks:
             t0 = time.perf_counter()
-            tree.tick()
+            try:
+                tree.tick()
+            except Exception as err:  # noqa: BLE001 - a bug in a leaf ends the run, reported
+                crash = failure_from(err, "tick")
+                status = py_trees.common.Status.FAILURE
+                break
             if tick_durations is not None:
                 tick_durations.append(time.perf_counter() - t0)
+            if on_tick is not None:
+                on_tick(tree)  # outside the guard: a handler may end the run (cancel)
             status = tree.root.status
             if status != py_trees.common.Status.RUNNING:
                 break
@@ -130,8 +136,10 @@ def run_tree(
         ctx.worker.shutdown()
     failure = None
     if status != py_trees.common.Status.SUCCESS:
-        failure = _blackboard("failure") or Failure(
-            FailureCode.TIMEOUT, f"no result after {tree.count} ticks"
+        failure = (
+            crash
+            or _blackboard("failure")
+            or Failure(FailureCode.TIMEOUT, f"no result after {tree.count} ticks")
         )
     return RunOutcome(
         success=status == py_trees.common.Status.SUCCESS,

@@ -136,6 +136,11 @@ class Landmark(_Strict):
     def display_name(self) -> str:
         return self.name or self.id
 
+    @property
+    def sign_text(self) -> str:
+        """The text on the landmark's sign (defaults to the display name)."""
+        return self.sign or self.display_name
+
 
 class FloorPlan(_Strict):
     """An optional floor plan: an image with its scale, or a ROS map_server YAML.

@@ -131,7 +131,7 @@ def sign_warnings(b: Building, range_m: float = SIGN_RANGE_M) -> list[Problem]:
     """
     seg_a, seg_b = _segments(b)
     signs = [r.door for r in b.rooms if r.sign_text] + [
-        lm.pos for lm in b.landmarks if lm.sign or lm.display_name
+        lm.pos for lm in b.landmarks if lm.sign_text
     ]
     if signs:
         pts = np.array(signs, float)

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from pmnav_bt.seams import Grounder, Observation
 
 
@@ -30,19 +28,14 @@ def central_band(shape: tuple[int, int], width_frac: float = 0.3) -> tuple[slice
 
 
 def mask_ratios(obs: Observation, grounder: Grounder) -> MaskRatios:
-    """Wall and floor fractions in the lower-central band, from the grounder's masks."""
-    h, w = obs.rgb.shape[:2]
-    rows, cols = central_band((h, w))
+    """Wall and floor fractions in the lower-central band, from the grounder's surfaces."""
+    rows, cols = central_band(obs.rgb.shape[:2])
     area = (rows.stop - rows.start) * (cols.stop - cols.start)
-    out = {}
-    for cls in ("wall", "floor"):
-        dets = grounder.detect(obs, cls)
-        m = np.zeros((h, w), bool)
-        for d in dets:
-            if d.mask is not None:
-                m |= d.mask
-        out[cls] = float(m[rows, cols].sum()) / area
-    return MaskRatios(out["wall"], out["floor"])
+    masks = grounder.surfaces(obs)
+    return MaskRatios(
+        wall=float(masks.wall[rows, cols].sum()) / area,
+        floor=float(masks.floor[rows, cols].sum()) / area,
+    )
 
 
 def is_corner(r: MaskRatios, max_floor: float = 0.15, min_wall: float = 0.5) -> bool:

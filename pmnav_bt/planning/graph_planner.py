@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from itertools import pairwise
+from typing import TYPE_CHECKING
 
 import networkx as nx
 import numpy as np
@@ -21,6 +22,11 @@ from pmnav_bt.geometry import Action, heading, relative_action, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.planning.plan import ForkChoice, Plan, PlanStart, PlanStep
 from pmnav_bt.planning.resolve import StartPoint, resolve_room, resolve_start
+from pmnav_bt.seams import PlanConstraints
+from pmnav_bt.seams import PlanStart as SeamStart
+
+if TYPE_CHECKING:  # pragma: no cover
+    from pmnav_bt.registry import BackendDeps
 
 MAX_GAP_M = 8.0  # default: most metres between consecutive plan steps (config planner.max_gap)
 
@@ -36,27 +42,38 @@ class GraphPlanner:
     def plan(
         self,
         pm: PrioriMap,
-        start: str | StartPoint,
+        start: SeamStart | StartPoint,
         goal: str,
-        avoid_landmarks: frozenset[str] = frozenset(),
-        blocked_segments: frozenset[int] = frozenset(),
+        constraints: PlanConstraints = PlanConstraints(),
     ) -> Plan:
-        """Plan from ``start`` to the room ``goal``.
-
-        ``avoid_landmarks``: IDs not to use as intermediate steps (they failed to be
-        found); ``blocked_segments``: segment indices the route must not use.
-        """
+        """Plan from ``start`` (a map pose, a name a person types, or a resolved point) to
+        the room ``goal``, using no landmark in ``constraints.avoid_landmarks`` as an
+        intermediate step and no segment in ``constraints.blocked_segments``."""
         goal_id = resolve_room(pm, goal)
-        sp = resolve_start(pm, start) if isinstance(start, str) else start
+        sp = start if isinstance(start, StartPoint) else resolve_start(pm, start)
+        blocked = constraints.blocked_segments
         graph = pm.graph
-        if blocked_segments:
+        if blocked:
             graph = nx.subgraph_view(
-                pm.graph, filter_edge=lambda u, v: graph_segment(pm, u, v) not in blocked_segments
+                pm.graph, filter_edge=lambda u, v: graph_segment(pm, u, v) not in blocked
             )
         nodes, length, start_xy = shortest_route(pm, sp, pm.places[goal_id].node, graph)
         return build_plan(
-            pm, sp, goal_id, nodes, length, start_xy, self.max_gap, self.name, avoid_landmarks
+            pm,
+            sp,
+            goal_id,
+            nodes,
+            length,
+            start_xy,
+            self.max_gap,
+            self.name,
+            constraints.avoid_landmarks,
         )
+
+
+def build(deps: BackendDeps) -> GraphPlanner:
+    """The ``graph`` back end (registry factory)."""
+    return GraphPlanner(max_gap=deps.config.planner.max_gap)
 
 
 def graph_segment(pm: PrioriMap, u: str, v: str) -> int:

@@ -15,7 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from pmnav_bt.errors import UnknownNameError
+from pmnav_bt.map.building import Building
 from pmnav_bt.map.priori_map import PrioriMap, Segment
+from pmnav_bt.seams import Entity, EntityKind, PlanStart, Pose2D
 
 
 def normalise(name: str) -> str:
@@ -77,9 +79,12 @@ class StartPoint:
 _POSE = re.compile(r"^\s*(-?[\d.]+)\s*,\s*(-?[\d.]+)\s*(?:,\s*(-?[\d.]+)\s*)?$")
 
 
-def resolve_start(pm: PrioriMap, spec: str) -> StartPoint:
-    """A start given as a segment ("seg13", "seg13(room14-room7)"), a waypoint or room ID,
-    or a map pose "x,y" / "x,y,yaw_deg" (degrees, counter-clockwise from east)."""
+def resolve_start(pm: PrioriMap, spec: PlanStart) -> StartPoint:
+    """A start given as an estimated map ``Pose2D`` (inside the loop), or as a person types
+    it: a segment ("seg13", "seg13(room14-room7)"), a waypoint or room ID, or a map pose
+    "x,y" / "x,y,yaw_deg" (degrees, counter-clockwise from east)."""
+    if isinstance(spec, Pose2D):
+        return _pose_start(pm, spec.x, spec.y, spec.yaw)
     spec = spec.strip()
     m = _POSE.match(spec)
     if m:
@@ -90,14 +95,7 @@ def resolve_start(pm: PrioriMap, spec: str) -> StartPoint:
             raise UnknownNameError(f"bad pose {spec!r}: expected 'x,y' or 'x,y,yaw_deg'") from None
         if not all(map(math.isfinite, (x, y, yaw if yaw is not None else 0.0))):
             raise UnknownNameError(f"bad pose {spec[:60]!r}: the numbers must be finite")
-        loc = pm.locate(x, y)
-        limit = loc.segment.width / 2.0 + 1.0
-        if loc.offset > limit:
-            raise UnknownNameError(
-                f"pose ({x:.2f}, {y:.2f}) is {loc.offset:.2f} m from the nearest corridor "
-                f"({loc.segment.name}); a start must be in a corridor"
-            )
-        return StartPoint(f"pose ({x:.1f}, {y:.1f})", loc.segment, loc.t, yaw)
+        return _pose_start(pm, x, y, yaw)
     if re.fullmatch(r"(?i)seg\s*\d+.*", spec):
         seg = pm.segment(spec)
         return StartPoint(seg.name, seg, 0.5)
@@ -124,35 +122,62 @@ def resolve_start(pm: PrioriMap, spec: str) -> StartPoint:
     )
 
 
-def entity_index(building) -> dict[str, str]:
-    """Normalised sign text / name / ID / alias -> 'room:<id>' or 'landmark:<id>'.
+def _pose_start(pm: PrioriMap, x: float, y: float, yaw: float | None) -> StartPoint:
+    """The point of the nearest corridor to a map pose (which must be in a corridor)."""
+    loc = pm.locate(x, y)
+    limit = loc.segment.width / 2.0 + 1.0
+    if loc.offset > limit:
+        raise UnknownNameError(
+            f"pose ({x:.2f}, {y:.2f}) is {loc.offset:.2f} m from the nearest corridor "
+            f"({loc.segment.name}); a start must be in a corridor"
+        )
+    return StartPoint(f"pose ({x:.1f}, {y:.1f})", loc.segment, loc.t, yaw)
+
+
+def entity_index(building: Building) -> dict[str, Entity]:
+    """Normalised sign text / name / ID / alias -> the room or landmark it names.
 
     The first entity to claim a name keeps it (rooms before landmarks).
     """
     cached = building.__dict__.get("_entity_index")
     if cached is not None:
         return cached
-    index: dict[str, str] = {}
+    index: dict[str, Entity] = {}
     for r in building.rooms:
         for n in (r.id, r.name, r.sign_text, *r.aliases):
             if n and normalise(n):
-                index.setdefault(normalise(n), f"room:{r.id}")
+                index.setdefault(normalise(n), Entity.room(r.id))
     for lm in building.landmarks:
         for n in (lm.id, lm.name, lm.sign, *lm.aliases):
             if n and normalise(n):
-                index.setdefault(normalise(n), f"landmark:{lm.id}")
+                index.setdefault(normalise(n), Entity.landmark(lm.id))
     building.__dict__["_entity_index"] = index
     return index
 
 
-def entity_position(pm: PrioriMap, entity: str) -> tuple[float, float]:
-    """Where 'room:<id>' or 'landmark:<id>' is seen: a room's door; a landmark's face on
-    the corridor wall nearest to it (landmarks are mounted on the wall; the file may
-    place them behind it)."""
-    kind, ident = entity.split(":", 1)
+def step_entity(building: Building, ident: str) -> Entity:
+    """The entity a plan step looks for (``PlanStep.look_for``: a room or landmark ID)."""
+    if ident in {r.id for r in building.rooms}:
+        return Entity.room(ident)
+    building.landmark(ident)  # an unknown ID is a KeyError here, not a wrong entity later
+    return Entity.landmark(ident)
+
+
+def sign_text(building: Building, entity: Entity) -> str:
+    """What a person reads on the sign of a room or landmark."""
+    if entity.kind is EntityKind.ROOM:
+        return building.room(entity.id).sign_text
+    return building.landmark(entity.id).sign_text
+
+
+def entity_position(pm: PrioriMap, entity: Entity) -> tuple[float, float]:
+    """Where a room or landmark is seen: a room's door; a landmark's face on the corridor
+    wall nearest to it (landmarks are mounted on the wall; the file may place them behind
+    it)."""
     b = pm.building
-    if kind == "room":
-        return b.room(ident).door
+    if entity.kind is EntityKind.ROOM:
+        return b.room(entity.id).door
+    ident = entity.id
     pos = np.asarray(b.landmark(ident).pos, dtype=float)
     place = pm.places[ident]
     node = pm.node_xy(place.node)

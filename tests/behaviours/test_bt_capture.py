@@ -19,11 +19,11 @@ from pmnav_bt.behaviours.localize import (
     distinct_landmarks,
     enough_doors,
     localization_yaws,
-    sign_query,
+    read_signs,
 )
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, wrap_angle
-from pmnav_bt.seams import Pose2D
+from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
 # On the start-turn1 corridor (x = 0) facing south: room4 (104) and room2 (102) are
 # either side at y = 22 and 18, the reception desk behind.
@@ -61,7 +61,7 @@ def test_sweep_order_starts_at_the_nearer_extreme():
 
 def test_capture_turns_through_the_yaws_taking_one_view_at_each(make_rig):
     rig = make_rig(SOUTH_AT_20)
-    cap = CaptureViews("Views", rig.ctx, localization_yaws, sign_query)
+    cap = CaptureViews("Views", rig.ctx, localization_yaws, read_signs)
     seen = rig.run(cap, max_ticks=300)
 
     rig.expect(seen, Status.SUCCESS)
@@ -93,7 +93,7 @@ def test_capture_keeps_the_given_order_without_sweep(make_rig):
     rig.expect(rig.run(cap, max_ticks=200), Status.SUCCESS)
     views = rig.get("views")
     assert rel_deg(views) == [60, -30]
-    assert all(v.detections == [] for v in views)  # no query: frames only
+    assert all(v.detections is None for v in views)  # nothing to ground: frames only
 
 
 def test_search_views_after_a_left_turn_skip_minus_90(make_rig):
@@ -110,7 +110,7 @@ def test_search_views_after_a_left_turn_skip_minus_90(make_rig):
 def test_capture_stops_early_once_enough(make_rig):
     rig = make_rig(SOUTH_AT_20)
     cap = CaptureViews(
-        "Views", rig.ctx, localization_yaws, sign_query, enough=lambda views: len(views) >= 2
+        "Views", rig.ctx, localization_yaws, read_signs, enough=lambda views: len(views) >= 2
     )
     rig.expect(rig.run(cap, max_ticks=200), Status.SUCCESS)
     views = rig.get("views")
@@ -127,21 +127,21 @@ def test_localization_capture_stops_once_enough_doors_are_read(make_rig):
         "Views",
         ctx,
         localization_yaws,
-        sign_query,
-        enough=lambda views: enough_doors(ctx, views, n=2),
+        read_signs,
+        enough=lambda views: enough_doors(views, n=2),
     )
     rig.expect(rig.run(cap, max_ticks=300), Status.SUCCESS)
     views = rig.get("views")
     assert len(views) < len(LOCALIZATION_YAWS_DEG)
-    assert enough_doors(ctx, views, n=2)
-    assert not enough_doors(ctx, views[:-1], n=2)  # it stopped at the first view that did it
-    doors = {e for e in distinct_landmarks(ctx, views) if e.startswith("room:")}
-    assert doors == {"room:room1", "room:room4"}
+    assert enough_doors(views, n=2)
+    assert not enough_doors(views[:-1], n=2)  # it stopped at the first view that did it
+    doors = {e for e in distinct_landmarks(views) if e.kind is EntityKind.ROOM}
+    assert doors == {Entity.room("room1"), Entity.room("room4")}
 
 
 def test_terminate_while_turning_stops_the_base(make_rig):
     rig = make_rig(SOUTH_AT_20)
-    cap = CaptureViews("Views", rig.ctx, localization_yaws, sign_query)
+    cap = CaptureViews("Views", rig.ctx, localization_yaws, read_signs)
     assert rig.tick(cap) == Status.RUNNING
     assert rig.body.velocity_command[1] > 0.0  # turning left towards +30 deg
     rig.wait()
@@ -157,7 +157,7 @@ def test_terminate_while_turning_stops_the_base(make_rig):
 def test_terminate_with_a_frame_in_flight_cancels_the_job_and_stops(make_rig):
     rig = make_rig(SOUTH_AT_20)
     release = rig.hold_worker()  # the frame job stays queued behind this one
-    cap = CaptureViews("Views", rig.ctx, lambda b: [0.0], sign_query)
+    cap = CaptureViews("Views", rig.ctx, lambda b: [0.0], read_signs)
     assert rig.tick(cap) == Status.RUNNING  # already facing 0: the frame is requested
     job = cap._job
     assert job is not None and not job.done()
@@ -176,12 +176,12 @@ def test_terminate_with_a_frame_in_flight_cancels_the_job_and_stops(make_rig):
     assert len(rig.get("views")) == 1
 
 
-def test_a_frame_that_cannot_be_grounded_fails_sensor_timeout(make_rig):
+def test_a_frame_the_grounder_cannot_read_fails_backend_error(make_rig):
     rig = make_rig(SOUTH_AT_20, segmentation=False)  # the ground-truth grounder needs it
-    cap = CaptureViews("Views", rig.ctx, lambda b: [0.0, math.radians(30)], sign_query)
+    cap = CaptureViews("Views", rig.ctx, lambda b: [0.0, math.radians(30)], read_signs)
     seen = rig.run(cap, max_ticks=50)
     rig.expect(seen, Status.FAILURE)
     assert len(seen) == 2  # request the frame, then collect the error
-    assert rig.failure.code == FailureCode.SENSOR_TIMEOUT
+    assert rig.failure.code == FailureCode.BACKEND_ERROR
     assert "segmentation" in rig.failure.message
     assert rig.get("views") is None

@@ -13,7 +13,7 @@ from pmnav_bt.behaviours.localize import (
     FixPosition,
     enough_doors,
     localization_yaws,
-    sign_query,
+    read_signs,
 )
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.seams import Pose2D
@@ -23,7 +23,7 @@ SOUTH = math.radians(-90)
 
 def capture(rig, yaws=localization_yaws, enough=None):
     """Run a localization panorama to the end; its views (also on the blackboard)."""
-    cap = CaptureViews("LocalizeViews", rig.ctx, yaws, sign_query, enough=enough)
+    cap = CaptureViews("LocalizeViews", rig.ctx, yaws, read_signs, enough=enough)
     rig.expect(rig.run(cap, max_ticks=400), Status.SUCCESS)
     return rig.get("views")
 
@@ -45,7 +45,7 @@ def test_fix_from_doors_in_view_maps_drifted_odometry_onto_the_true_pose(make_ri
     assert rig.yaw_error(true.yaw, odom.yaw) > math.radians(8)  # ... in position and heading
 
     ctx = rig.ctx
-    capture(rig, enough=lambda views: enough_doors(ctx, views))
+    capture(rig, enough=enough_doors)
     fix = FixPosition("Fix", ctx)
     seen = rig.run(fix)  # the fix is computed in the worker: RUNNING, then SUCCESS
     rig.expect(seen, Status.SUCCESS)
@@ -59,7 +59,7 @@ def test_fix_from_doors_in_view_maps_drifted_odometry_onto_the_true_pose(make_ri
     event = ctx.trace[-1]
     assert event.kind == "fix" and event.data["attempts"] == 1
     assert event.data["map_pose"] == pytest.approx([est.x, est.y, est.yaw])
-    assert "room:" in fix.feedback_message
+    assert "from room " in fix.feedback_message
     assert rig.failure is None
 
 
@@ -67,7 +67,7 @@ def test_fix_facing_a_blank_wall_fails_localization_failed(make_rig):
     # At turn1, facing the blank south wall of the corner (1.2 m away).
     rig = make_rig(Pose2D(0.0, 0.0, SOUTH))
     views = capture(rig, yaws=lambda b: [0.0, math.radians(10)])
-    assert all(v.detections == [] for v in views)
+    assert all(v.detections == () for v in views)
     fix = FixPosition("Fix", rig.ctx)
     rig.expect(rig.run(fix), Status.FAILURE)
     assert rig.failure.code == FailureCode.LOCALIZATION_FAILED

@@ -8,7 +8,6 @@ targets are steps of a real plan: from (0, 29) south to room3, {room4: go straig
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -22,12 +21,14 @@ from pmnav_bt.behaviours.search import (
     FineDirection,
     Ground,
     Verify,
-    target_query,
+    target_entity,
 )
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply
 from pmnav_bt.localization import Sighting
-from pmnav_bt.seams import Pose2D
+from pmnav_bt.perception.coarse import DetectorCoarseDirection
+from pmnav_bt.planning.resolve import sign_text
+from pmnav_bt.seams import CoarseChoice, Entity, Pose2D
 
 # On the start-turn1 corridor facing south, 4.5 m short of room4's door.
 NORTH_OF_ROOM4 = Pose2D(0.0, 26.5, math.radians(-90))
@@ -44,25 +45,32 @@ def targets(rig) -> dict:
 def search(rig, target) -> list:
     """Put ``target`` on the blackboard and take the search views for it."""
     rig.set(target=target)
-    cap = CaptureViews("SearchViews", rig.ctx, lambda b: search_yaws(None), target_query)
+    cap = CaptureViews("SearchViews", rig.ctx, lambda b: search_yaws(None), target_entity)
     rig.expect(rig.run(cap, max_ticks=300), Status.SUCCESS)
     return rig.get("views")
+
+
+def choice(rig) -> tuple:
+    """The chosen view and detection on the blackboard."""
+    c: CoarseChoice = rig.get("choice")
+    return c.view, c.detection
 
 
 def rel_deg(view) -> int:
     return round(math.degrees(view.relative_yaw) / 10) * 10
 
 
-def test_target_query_is_the_sign_a_person_reads(make_rig):
+def test_the_target_is_a_typed_entity_whose_sign_a_person_reads(make_rig):
     rig = make_rig(NORTH_OF_ROOM4)
     steps = targets(rig)
-    cap = CaptureViews("SearchViews", rig.ctx, lambda b: [], target_query)
+    cap = CaptureViews("SearchViews", rig.ctx, lambda b: [], target_entity)
     for landmark, text in [("room4", "104 Laboratory"), ("room5", "105")]:
         rig.set(target=steps[landmark])
-        assert target_query(cap) == text
+        assert target_entity(cap) == Entity.room(landmark)
+        assert sign_text(rig.pm.building, target_entity(cap)) == text
     turn = rig.plan("0,3,-90", "room11").steps[0]  # {turn1: turn left}: nothing to read
     rig.set(target=turn)
-    assert target_query(cap) is None
+    assert target_entity(cap) is None
 
 
 def test_coarse_direction_picks_the_view_with_the_best_score(make_rig):
@@ -70,9 +78,9 @@ def test_coarse_direction_picks_the_view_with_the_best_score(make_rig):
     views = search(rig, targets(rig)["room4"])
     seen = [(v, d) for v in views for d in v.detections]
     assert len({id(v) for v, _ in seen}) >= 2  # a real choice between views
-    coarse = CoarseDirection("CoarseDirection", rig.ctx, min_score=0.3)
-    assert rig.tick(coarse) == Status.SUCCESS
-    view, det = rig.get("choice")
+    coarse = CoarseDirection("CoarseDirection", rig.ctx)
+    rig.expect(rig.run(coarse), Status.SUCCESS)
+    view, det = choice(rig)
     best_view, best_det = max(seen, key=lambda vd: vd[1].score)
     assert view is best_view and det is best_det
     assert det.label == "104 Laboratory" and det.mask is not None
@@ -83,9 +91,9 @@ def test_coarse_direction_picks_the_view_with_the_best_score(make_rig):
 def test_coarse_direction_fails_target_not_found_when_no_view_shows_it(make_rig):
     rig = make_rig(NORTH_OF_ROOM4)
     views = search(rig, targets(rig)["room3"])  # 16 m away: the sign is unreadable
-    assert all(v.detections == [] for v in views)
+    assert all(v.detections == () for v in views)
     coarse = CoarseDirection("CoarseDirection", rig.ctx)
-    assert rig.tick(coarse) == Status.FAILURE
+    rig.expect(rig.run(coarse), Status.FAILURE)
     assert rig.failure.code == FailureCode.TARGET_NOT_FOUND
     assert rig.failure.message == f"room3 not seen in {len(views)} views"
     assert rig.get("choice") is None
@@ -96,16 +104,18 @@ def test_coarse_direction_ignores_detections_below_min_score(make_rig):
     views = search(rig, targets(rig)["room4"])
     scores = [d.score for v in views for d in v.detections]
     assert scores and max(scores) < 0.9
-    assert rig.tick(CoarseDirection("Strict", rig.ctx, min_score=0.9)) == Status.FAILURE
+    rig.ctx.coarse = DetectorCoarseDirection(rig.ctx.grounder, min_score=0.9)
+    rig.expect(rig.run(CoarseDirection("Strict", rig.ctx)), Status.FAILURE)
     assert rig.failure.code == FailureCode.TARGET_NOT_FOUND
-    assert rig.tick(CoarseDirection("Lenient", rig.ctx, min_score=0.3)) == Status.SUCCESS
+    rig.ctx.coarse = DetectorCoarseDirection(rig.ctx.grounder, min_score=0.3)
+    rig.expect(rig.run(CoarseDirection("Lenient", rig.ctx)), Status.SUCCESS)
 
 
 def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig):
     rig = make_rig(NORTH_OF_ROOM4)
     search(rig, targets(rig)["room4"])
-    rig.tick(CoarseDirection("CoarseDirection", rig.ctx))
-    view, det = rig.get("choice")
+    rig.run(CoarseDirection("CoarseDirection", rig.ctx))
+    view, det = choice(rig)
     obs = view.observation
     toward = obs.pose.yaw + obs.intrinsics.pixel_bearing(det.centre[0])
     assert rig.yaw_error(rig.true_pose().yaw, toward) > 0.2  # the sweep ended elsewhere
@@ -116,7 +126,7 @@ def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig
     assert len(seen) > 3  # turned first, then took a frame in the worker
     assert rig.yaw_error(rig.true_pose().yaw, toward) <= 0.035
     assert rig.stopped()
-    view2, det2 = rig.get("choice")
+    view2, det2 = choice(rig)
     assert view2 is not view  # a fresh frame ...
     assert rig.yaw_error(view2.observation.pose.yaw, toward) <= 0.035  # ... facing the target
     assert det2.label == det.label and det2.mask is not None and det2 in view2.detections
@@ -127,19 +137,18 @@ def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig
 def test_ground_keeps_the_coarse_detection_when_the_fresh_frame_misses(make_rig):
     rig = make_rig(NORTH_OF_ROOM4)
     search(rig, targets(rig)["room4"])
-    rig.tick(CoarseDirection("CoarseDirection", rig.ctx))
-    view, det = rig.get("choice")
-    wrong = (view, replace(det, label="118 Cashier"))  # not readable from here
-    rig.set(choice=wrong)
+    rig.run(CoarseDirection("CoarseDirection", rig.ctx))
+    coarse = rig.get("choice")
+    rig.ctx.grounder.hidden = frozenset({"room4"})  # the fresh frame cannot read it
     rig.expect(rig.run(Ground("Grounding", rig.ctx), max_ticks=100), Status.SUCCESS)
-    assert rig.get("choice") is wrong
+    assert rig.get("choice") is coarse
     assert rig.failure is None
 
 
 def test_ground_terminate_while_turning_stops_the_base(make_rig):
     rig = make_rig(NORTH_OF_ROOM4)
     search(rig, targets(rig)["room4"])
-    rig.tick(CoarseDirection("CoarseDirection", rig.ctx))
+    rig.run(CoarseDirection("CoarseDirection", rig.ctx))
     ground = Ground("Grounding", rig.ctx)
     assert rig.tick(ground) == Status.RUNNING
     assert rig.body.velocity_command != (0.0, 0.0)
@@ -151,9 +160,9 @@ def fine_and_verify(rig, map_T_odom):
     """CoarseDirection -> Ground -> FineDirection -> Verify on the current views, as the
     tree ticks them; the Verify behaviour, ticked once."""
     rig.set(map_T_odom=map_T_odom)
-    assert rig.tick(CoarseDirection("CoarseDirection", rig.ctx)) == Status.SUCCESS
+    rig.expect(rig.run(CoarseDirection("CoarseDirection", rig.ctx)), Status.SUCCESS)
     rig.expect(rig.run(Ground("Grounding", rig.ctx), max_ticks=100), Status.SUCCESS)
-    assert rig.tick(FineDirection("FineDirection", rig.ctx)) == Status.SUCCESS
+    rig.expect(rig.run(FineDirection("FineDirection", rig.ctx)), Status.SUCCESS)
     verify = Verify("Verification", rig.ctx)
     rig.tick(verify)
     return verify
@@ -166,12 +175,12 @@ def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_tru
     offset = (0.5, 1.0, 0.0)
     verify = fine_and_verify(rig, offset)
     assert verify.status == Status.SUCCESS
-    assert verify.feedback_message.startswith("room:room4 verified")
+    assert verify.feedback_message.startswith("room room4 verified")
 
-    view, det = rig.get("choice")
+    view, det = choice(rig)
     bearing, s = rig.get("bearing"), rig.get("sighting")
     assert bearing == pytest.approx(view.observation.intrinsics.pixel_bearing(det.centre[0]))
-    assert s.entity == "room:room4" and s.map_xy == ROOM4_DOOR
+    assert s.entity == Entity.room("room4") and s.map_xy == ROOM4_DOOR
     assert math.dist(s.odom_xy, ROOM4_DOOR) < 0.5  # seen where the door is (odom = truth)
     p = view.observation.pose
     seen_dir = math.atan2(s.odom_xy[1] - p.y, s.odom_xy[0] - p.x)
@@ -196,8 +205,8 @@ def test_verify_refits_heading_on_recent_sightings_spread_apart(make_rig):
     search(rig, targets(rig)["room4"])
     # Earlier verified sightings of room1 and room2, seen where they are (odom = map).
     recent = [
-        Sighting("room:room1", (-1.2, 26.0), (-1.2, 26.0)),
-        Sighting("room:room2", (-1.2, 18.0), (-1.2, 18.0)),
+        Sighting(Entity.room("room1"), (-1.2, 26.0), (-1.2, 26.0)),
+        Sighting(Entity.room("room2"), (-1.2, 18.0), (-1.2, 18.0)),
     ]
     rig.set(recent_sightings=recent)
     wrong_heading = (0.0, 0.0, math.radians(4))
@@ -207,9 +216,9 @@ def test_verify_refits_heading_on_recent_sightings_spread_apart(make_rig):
     tf = rig.get("map_T_odom")
     assert abs(tf[2]) < math.radians(1.5)  # heading re-fitted from the landmarks
     assert [r.entity for r in rig.get("recent_sightings")] == [
-        "room:room1",
-        "room:room2",
-        "room:room4",
+        Entity.room("room1"),
+        Entity.room("room2"),
+        Entity.room("room4"),
     ]
 
 
@@ -220,7 +229,7 @@ def test_a_sighting_of_the_wrong_place_fails_target_not_found(make_rig):
     search(rig, targets(rig)["room5"])
     assert fine_and_verify(rig, None).status == Status.FAILURE
     s = rig.get("sighting")
-    assert s.entity == "room:room5" and s.map_xy == (1.2, 14.0)
+    assert s.entity == Entity.room("room5") and s.map_xy == (1.2, 14.0)
     assert math.dist(s.odom_xy, s.map_xy) > VERIFY_TOLERANCE
     assert rig.failure.code == FailureCode.TARGET_NOT_FOUND
     assert "not it" in rig.failure.message
@@ -231,10 +240,10 @@ def test_a_sighting_of_the_wrong_place_fails_target_not_found(make_rig):
 def test_coarse_only_places_the_target_straight_ahead_at_the_map_distance(make_rig):
     rig = make_rig(NORTH_OF_ROOM4, overrides=("tree.variant=coarse_only",))
     search(rig, targets(rig)["room4"])
-    rig.tick(CoarseDirection("CoarseDirection", rig.ctx))
+    rig.run(CoarseDirection("CoarseDirection", rig.ctx))
     rig.expect(rig.run(Ground("Grounding", rig.ctx), max_ticks=100), Status.SUCCESS)
-    assert rig.tick(FineDirection("FineDirection", rig.ctx)) == Status.SUCCESS
-    view, _ = rig.get("choice")
+    assert rig.tick(FineDirection("FineDirection", rig.ctx, refine=False)) == Status.SUCCESS
+    view, _ = choice(rig)
     s, p = rig.get("sighting"), view.observation.pose
     assert rig.get("bearing") == 0.0
     assert math.dist(s.odom_xy, (p.x, p.y)) == pytest.approx(math.dist(ROOM4_DOOR, (p.x, p.y)))
@@ -248,7 +257,8 @@ def test_detector_coarse_direction_seam_grounds_plain_views(make_rig):
     rig = make_rig(NORTH_OF_ROOM4, width=320, height=240)
     captured = search(rig, targets(rig)["room4"])
     plain = [View(v.relative_yaw, v.observation) for v in captured]  # no detections
-    yaw = rig.ctx.coarse.choose(plain, "104 Laboratory")
+    picked = rig.ctx.coarse.choose(plain, Entity.room("room4"))
     best = max(((v, d) for v in captured for d in v.detections), key=lambda vd: vd[1].score)
-    assert yaw == pytest.approx(best[0].relative_yaw)
-    assert rig.ctx.coarse.choose(plain, "103 Radiology") is None  # 16 m away: unreadable
+    assert picked.view.relative_yaw == pytest.approx(best[0].relative_yaw)
+    assert picked.detection.entity == Entity.room("room4")
+    assert rig.ctx.coarse.choose(plain, Entity.room("room3")) is None  # 16 m: unreadable

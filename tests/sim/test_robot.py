@@ -16,10 +16,11 @@ from pmnav_bt.seams import (
     DiscreteAction,
     MotionStatus,
     Pose2D,
+    sign_label,
 )
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.robot import MAX_ANGULAR, MAX_LINEAR, RADIUS, SimBase
-from pmnav_bt.sim.world import SimWorld, sign_label
+from pmnav_bt.sim.world import SimWorld
 
 A = DiscreteAction
 # fig2_hospital: the corridor start-turn1 runs along x = 0 (walls at x = +-1.2); y = 8 is clear.

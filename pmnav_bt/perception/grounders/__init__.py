@@ -1,0 +1,1 @@
+"""Grounder back ends (the ``Grounder`` seam): ``sim_gt`` reads the simulator's labels."""

@@ -1,0 +1,1 @@
+"""Refiner back ends (the ``Refiner`` seam): ``geometric`` measures bearing and range."""

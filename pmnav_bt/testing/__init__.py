@@ -1,0 +1,1 @@
+"""Test doubles for the seams: run behaviours and trees without a simulator or a robot."""
