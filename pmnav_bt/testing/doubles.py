@@ -149,7 +149,8 @@ class FakeBase:
         v, w = self._cmd
         if self.blocked or self.faulted:
             v = 0.0
-        p = self.pose()
+        with self._lock:
+            p = self._pose
         if abs(w) < 1e-9:
             x, y = p.x + v * dt * math.cos(p.yaw), p.y + v * dt * math.sin(p.yaw)
         else:  # an exact arc
