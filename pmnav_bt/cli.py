@@ -53,6 +53,26 @@ def buildings() -> None:
 
 
 @app.command()
+def backends() -> None:
+    """List every registered back end of each seam (choose with --set SEAM.backend=NAME)."""
+    from pmnav_bt.config import Config
+    from pmnav_bt.registry import REGISTRIES
+
+    defaults = Config()
+    for seam, registry in REGISTRIES.items():
+        default = getattr(defaults, seam).backend
+        for name in registry.names():
+            spec = registry.spec(name)
+            tags = [
+                t
+                for t, on in (("default", name == default), ("sim only", spec.needs_sim_labels))
+                if on
+            ]
+            tag = f" [{', '.join(tags)}]" if tags else ""
+            typer.echo(f"{seam + '.backend':<17} {name:<12} {spec.summary}{tag}")
+
+
+@app.command()
 def validate(
     file: str = typer.Argument(..., help=FILE_HELP),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as problems (exit 1)."),
