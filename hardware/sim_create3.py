@@ -68,9 +68,9 @@ class SimCreate3:
 
         from pmnav_bt.hardware import qos
         from pmnav_bt.hardware.node import declare_parameters
-        from pmnav_bt.sim.cli import parse_pose
         from pmnav_bt.sim.clock import SimClock
         from pmnav_bt.sim.odometry import NoisyOdometry
+        from pmnav_bt.sim.poses import parse_pose
         from pmnav_bt.sim.robot import SimBase
         from pmnav_bt.sim.world import SimWorld
 

@@ -37,29 +37,25 @@ def _formats(text: str) -> list[str]:
 
 
 def _build_tree(variant: str):
-    """The real tree for ``variant``, built on the built-in fig2_hospital with a sim body.
+    """The real tree for ``variant`` on the built-in fig2_hospital, on a test-double body
+    (drawing a tree ticks nothing: no simulator needed).
 
-    Returns (tree, close) where close() releases the worker and the physics client."""
+    Returns (tree, close) where close() releases the worker."""
     import py_trees
 
     from pmnav_bt.config import load_config
     from pmnav_bt.map.building import load_building
     from pmnav_bt.map.priori_map import parse_building
-    from pmnav_bt.sim.robot import SimBase
-    from pmnav_bt.sim.world import SimWorld
+    from pmnav_bt.testing.doubles import FakeBase
     from pmnav_bt.trees.pmnav import build_pmnav_tree
     from pmnav_bt.trees.runner import make_context
 
     building = load_building(RENDER_BUILDING)
     config = load_config(overrides=[f"tree.variant={variant}"])
-    world = SimWorld(building)
-    base = SimBase(world)
-    ctx = make_context(base, parse_building(building), config)
+    ctx = make_context(FakeBase(), parse_building(building), config)
 
     def close() -> None:
         ctx.worker.shutdown()
-        base.close()
-        world.close()
 
     try:
         py_trees.blackboard.Blackboard.clear()
