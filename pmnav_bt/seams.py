@@ -275,6 +275,11 @@ class CoarseChoice:
     view: View
     detection: Detection
 
+    def __str__(self) -> str:  # logs and tree snapshots (no image arrays)
+        d = self.detection
+        yaw = math.degrees(self.view.relative_yaw)
+        return f"{d.entity or d.label} at {yaw:+.0f} deg (score {d.score:.2f})"
+
 
 @runtime_checkable
 class CoarseDirection(Protocol):
