@@ -12,7 +12,7 @@ import typer
 from pmnav_bt import cli_values
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.loading import check_output_dir, check_output_file, safe_filename
-from pmnav_bt.seams import Pose2D
+from pmnav_bt.sim.poses import PoseError, parse_pose  # noqa: F401 - PoseError: part of this CLI
 
 app = typer.Typer(
     add_completion=False,
@@ -25,21 +25,6 @@ app = typer.Typer(
 @app.callback()
 def _group() -> None:
     """The pybullet simulator: build a world from a building file and look at it."""
-
-
-class PoseError(PmNavError):
-    """A --pose value that is not x,y,yaw_deg."""
-
-
-def parse_pose(text: str) -> Pose2D:
-    """'x,y,yaw_deg' (metres, degrees) -> Pose2D (radians); finite and in range."""
-    from pmnav_bt.cli_values import CliValueError, parse_pose_text
-
-    try:
-        x, y, yaw_deg = parse_pose_text(text, "--pose")
-    except CliValueError as err:
-        raise PoseError(str(err)) from None
-    return Pose2D(x, y, math.radians(yaw_deg))
 
 
 @app.command()
