@@ -1,4 +1,7 @@
-"""The ``pmnav`` command line.
+"""The core commands of ``pmnav`` (buildings, backends, validate, map, plan, ...).
+
+``pmnav_bt.experiments.cli`` mounts ``pmnav sim`` and ``pmnav tree`` on this app and is
+the program's entry point: the core knows neither the simulator nor the tree.
 
 A user error (bad file, unknown room, ...) prints one line on stderr and exits
 with status 2; ``pmnav validate`` exits 1 when the file has problems.
@@ -202,18 +205,6 @@ def annotate(file: Path = typer.Argument(..., help="The building file to edit (Y
     from pmnav_bt.render.tk_annotate import run
 
     run(file)
-
-
-def _mount_subcommands() -> None:
-    # Both import only typer at module level: pybullet and py_trees load inside commands.
-    from pmnav_bt.sim.cli import app as sim_app
-    from pmnav_bt.trees.cli import app as tree_app
-
-    app.add_typer(sim_app, name="sim")
-    app.add_typer(tree_app, name="tree")
-
-
-_mount_subcommands()
 
 
 def _error_line(err: PmNavError) -> str:

@@ -1,7 +1,8 @@
 """``pmnav tree``: draw the behaviour tree, and step through a snapshot log.
 
-Mounted in ``pmnav_bt/cli.py`` with ``app.add_typer(tree_cli.app, name="tree")``. This module
-imports only typer at import time (the core CLI must not pull in py_trees or pybullet);
+Mounted by ``pmnav_bt/experiments/cli.py`` (``app.add_typer(tree_cli.app, name="tree")``).
+This module imports only typer at import time (``pmnav --help`` pulls in neither py_trees
+nor pybullet);
 each command imports what it needs. User errors raise PmNavError, which ``pmnav``'s main
 prints in one line.
 """

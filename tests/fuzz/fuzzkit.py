@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from pmnav_bt.cli import main
+from pmnav_bt.experiments.cli import main
 
 TRIED: Counter[str] = Counter()
 MEMORY_LIMIT = 3 << 30  # bytes of address space for a CLI child
@@ -55,7 +55,7 @@ def _limit_memory() -> None:  # pragma: no cover - runs in the child
 def pmnav_subprocess(*argv: str | Path, timeout: float = TIMEOUT_S, **kw):
     """``pmnav ARGV`` in a child process with a timeout and RLIMIT_AS."""
     return subprocess.run(
-        [sys.executable, "-m", "pmnav_bt.cli", *map(str, argv)],
+        [sys.executable, "-m", "pmnav_bt.experiments.cli", *map(str, argv)],
         capture_output=True,
         text=True,
         timeout=timeout,

@@ -50,7 +50,7 @@ def test_eval_interrupted_keeps_finished_episodes(tmp_path, signame, jobs):
         [
             sys.executable,
             "-m",
-            "pmnav_bt.cli",
+            "pmnav_bt.experiments.cli",
             "sim",
             "eval",
             "--building",

@@ -1,4 +1,6 @@
-"""``pmnav sim``: look at a simulated building (top-down plan and a first-person view)."""
+"""``pmnav sim``: look at a simulated building, generate episodes, run the tree in the
+simulator and evaluate it. It joins simulator, tree and metrics, so it lives in the
+experiments layer; ``pmnav_bt.experiments.cli`` mounts it."""
 
 from __future__ import annotations
 

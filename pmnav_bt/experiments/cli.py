@@ -1,0 +1,26 @@
+"""The ``pmnav`` program: the core commands (``pmnav_bt.cli``) with the simulator's
+(``pmnav sim``) and the tree's (``pmnav tree``) mounted on them.
+
+This is where the command line joins simulator, tree and metrics, so it lives in the
+experiments layer; the core CLI knows neither. Each sub-app imports only typer at module
+level: pybullet and py_trees load inside the commands that need them.
+"""
+
+from __future__ import annotations
+
+from pmnav_bt.cli import app
+from pmnav_bt.cli import main as _run
+from pmnav_bt.experiments.sim_cli import app as sim_app
+from pmnav_bt.trees.cli import app as tree_app
+
+app.add_typer(sim_app, name="sim")
+app.add_typer(tree_app, name="tree")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of ``pmnav``: user errors become one line on stderr and exit status 2."""
+    _run(argv)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

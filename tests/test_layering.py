@@ -1,0 +1,133 @@
+"""Layering, by import analysis of every module (imports inside functions included):
+the core imports none of the layers built on it; ``experiments`` is the one layer that
+joins simulator, tree and metrics. And every third-party import is a declared dependency."""
+
+from __future__ import annotations
+
+import ast
+import importlib.metadata
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+
+ROOT = Path(__file__).resolve().parents[1]
+PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
+
+# layer -> the layers it may import besides the core (which every layer may import)
+ALLOWED = {
+    "core": set(),
+    "behaviours": set(),
+    "trees": {"behaviours"},
+    "sim": set(),
+    "hardware": {"behaviours", "trees", "sim"},  # the node runs the tree; sim_create3 the sim
+    "experiments": {"behaviours", "trees", "sim"},
+}
+SUBLAYERS = ("behaviours", "trees", "sim", "hardware", "experiments")
+
+
+def layer_of_module(name: str) -> str | None:
+    """'pmnav_bt.sim.world' -> 'sim'; 'pmnav_bt.map.building' -> 'core'; numpy -> None."""
+    parts = name.split(".")
+    if parts[0] != "pmnav_bt":
+        return None
+    if len(parts) > 1 and parts[1] in SUBLAYERS:
+        return parts[1]
+    return "core"
+
+
+def shipped_modules() -> dict[str, Path]:
+    """Every module of the wheel: import name -> file."""
+    out = {}
+    for package, folder in PYPROJECT["tool"]["setuptools"]["package-dir"].items():
+        for path in (ROOT / folder).rglob("*.py"):
+            rel = path.relative_to(ROOT / folder).with_suffix("").parts
+            if package == "pmnav_bt" and rel and rel[0] in SUBLAYERS and rel[0] != "experiments":
+                continue  # installed from its own folder
+            name = ".".join([package, *(p for p in rel if p != "__init__")])
+            out[name] = path
+    return out
+
+
+def _fallbacks(tree: ast.AST) -> set[int]:
+    """ids of the import nodes in ``except ImportError:`` handlers (optional fallbacks)."""
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ExceptHandler) and "ImportError" in ast.unparse(node.type or ""):
+            out |= {id(n) for n in ast.walk(node) if isinstance(n, (ast.Import, ast.ImportFrom))}
+    return out
+
+
+def imports(path: Path, module: str, fallbacks: bool = True) -> list[tuple[int, str]]:
+    """(line, absolute module name) of every import in the file, at any depth (with or
+    without the fallbacks in ``except ImportError`` handlers)."""
+    out = []
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    skip = set() if fallbacks else _fallbacks(tree)
+    for node in ast.walk(tree):
+        if id(node) in skip:
+            continue
+        if isinstance(node, ast.Import):
+            out += [(node.lineno, a.name) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                up = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join([*up, base] if base else up)
+            out += [
+                (node.lineno, f"{base}.{a.name}" if a.name != "*" else base) for a in node.names
+            ]
+    return out
+
+
+MODULES = shipped_modules()
+
+
+def test_the_analysis_sees_every_layer():
+    layers = {layer_of_module(m) for m in MODULES}
+    assert layers == {"core", *SUBLAYERS}
+    assert "pmnav_bt.testing.doubles" in MODULES and "pmnav_bt.sim.world" in MODULES
+
+
+@pytest.mark.parametrize("layer", sorted(ALLOWED))
+def test_each_layer_imports_only_what_it_may(layer):
+    bad = []
+    for name, path in MODULES.items():
+        if layer_of_module(name) != layer:
+            continue
+        for line, target in imports(path, name):
+            other = layer_of_module(target)
+            if other not in (None, "core", layer) and other not in ALLOWED[layer]:
+                bad.append(f"{path.relative_to(ROOT)}:{line} imports {target}")
+    assert not bad, f"the {layer} layer may not import these:\n" + "\n".join(bad)
+
+
+def _declared() -> set[str]:
+    """Distribution names of the dependencies and of every extra (ROS: the [ros] extra)."""
+    reqs = list(PYPROJECT["project"]["dependencies"])
+    for extra in PYPROJECT["project"]["optional-dependencies"].values():
+        reqs += extra
+    return {re.split(r"[<>=!~\[ ;]", r, maxsplit=1)[0].lower().replace("_", "-") for r in reqs}
+
+
+def _is_ros(top: str) -> bool:  # rclpy and ROS 2 messages: the [ros] extra / apt
+    return top in {"rclpy", "launch", "launch_ros"} or top.endswith(("_msgs", "_interfaces"))
+
+
+def test_every_third_party_import_is_a_declared_dependency():
+    dists = importlib.metadata.packages_distributions()
+    declared = _declared()
+    missing = set()
+    for name, path in MODULES.items():
+        for _, target in imports(path, name, fallbacks=False):
+            top = target.split(".")[0]
+            if top in sys.stdlib_module_names or top == "pmnav_bt" or _is_ros(top):
+                continue
+            owners = {d.lower().replace("_", "-") for d in dists.get(top, [top])}
+            if not owners & declared:
+                missing.add(f"{top} (in {path.relative_to(ROOT)})")
+    assert not missing, f"imported but not in [project] dependencies: {sorted(missing)}"
