@@ -39,6 +39,7 @@ from pmnav_bt.eval.tiers import (
     tier_definition,
     within,
 )
+from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, relative_action, wrap_angle
 from pmnav_bt.loading import InputFileError, atomic_write_text, load_json
 from pmnav_bt.map.building import (
@@ -639,7 +640,7 @@ def score_episode(
     ok = failure is None and success(stop, door)
     reason = failure
     if failure is None and not ok:
-        reason = f"STOPPED_AWAY: stopped {dist:.2f} m from the door"
+        reason = f"{FailureCode.STOPPED_AWAY.value}: stopped {dist:.2f} m from the door"
     shortest = geodesic.distance((episode.start_x, episode.start_y))
     to_goal = 0.0 if ok else geodesic.distance(stop)
     return EpisodeResult(
