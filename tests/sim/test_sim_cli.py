@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from pmnav_bt.cli import main
+from pmnav_bt.experiments.cli import main
 from pmnav_bt.map.building import BUILTIN_DIR, load_building
 from pmnav_bt.map.floorplan import rasterize_building, save_ros_map
 
@@ -93,8 +93,8 @@ def test_eval_exits_non_zero_and_counts_errored_episodes(capsys, own_building, m
 
 
 def test_eval_all_means_every_builtin_building(monkeypatch):
+    from pmnav_bt.experiments.sim_cli import _buildings
     from pmnav_bt.map.building import builtin_buildings
-    from pmnav_bt.sim.cli import _buildings
 
     assert _buildings("all") == builtin_buildings()
     assert _buildings("a.yaml, t_school") == ["a.yaml", "t_school"]
