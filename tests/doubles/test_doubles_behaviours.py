@@ -27,8 +27,8 @@ EAST = Pose2D(4.0, 0.0, 0.0)  # straight_office: the corridor runs east along y 
 
 def search_views(rig, landmark: str):
     """A plan step for ``landmark`` as the target, and the search views taken for it."""
-    plan = rig.ctx.planner.plan(rig.pm, "start", "room13")
-    step = next(s for s in plan.steps if s.look_for == landmark)
+    step = rig.ctx.planner.plan(rig.pm, "start", landmark).steps[-1]  # {landmark: arrive}
+    assert step.look_for == landmark
     rig.set(target=step)
     cap = CaptureViews("SearchViews", rig.ctx, lambda b: [0.0, math.radians(30)], target_entity)
     assert rig.run(cap)[-1] == Status.SUCCESS
@@ -95,17 +95,19 @@ def test_fine_direction_takes_the_range_from_the_refinement_else_from_the_map(ri
 
 def test_make_plan_gives_the_planner_the_pose_and_the_constraints(rig, office):
     r = rig("straight_office", Pose2D(10.0, 0.2, math.pi))
+    first = r.ctx.planner.inner.plan(r.pm, Pose2D(11.0, 0.2, math.pi), "Kitchen").steps[0]
     r.set(
         goal="Kitchen",
         map_T_odom=(1.0, 0.0, 0.0),
-        avoid_landmarks=frozenset({"room4"}),
+        avoid_landmarks=frozenset({first.look_for}),
         blocked_segments=frozenset(),
     )
     assert r.run(MakePlan("Plan", r.ctx))[-1] == Status.SUCCESS
     (start,) = r.planner.starts
     assert start == Pose2D(11.0, 0.2, math.pi)  # map_T_odom applied; radians, not text
-    assert r.planner.constraints == [PlanConstraints(avoid_landmarks=frozenset({"room4"}))]
-    assert all(s.look_for != "room4" for s in r.get("plan").steps)
+    avoided = PlanConstraints(avoid_landmarks=frozenset({first.look_for}))
+    assert r.planner.constraints == [avoided]
+    assert all(s.look_for != first.look_for for s in r.get("plan").steps)
 
 
 def test_a_buggy_planner_fails_internal_error(rig, office):
