@@ -1,0 +1,1 @@
+"""Grounder back ends (the ``Grounder`` seam): ``ocr`` reads signs, ``gdino_sam`` grounds phrases."""
