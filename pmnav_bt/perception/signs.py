@@ -195,7 +195,7 @@ class SignReader:
         crops = [_quad_crop(bgr, q) for q in quads]
         results, _ = self._ocr.text_rec(crops)
         lines = []
-        for q, (text, score) in zip(quads, results):
+        for q, (text, score) in zip(quads, results, strict=True):
             text = _ascii(text)
             if not text or score < self.min_score:
                 continue

@@ -1,1 +1,1 @@
-"""Grounder back ends (the ``Grounder`` seam): ``ocr`` reads signs, ``gdino_sam`` grounds phrases."""
+"""Grounder back ends (the ``Grounder`` seam): ``ocr`` reads signs, ``gdino_sam`` grounds text."""

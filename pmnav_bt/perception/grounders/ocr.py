@@ -46,12 +46,12 @@ class OcrGrounder:
         self,
         building: Building,
         reader: SignReader | None = None,
-        layout: DoorLayout = DoorLayout(),
+        layout: DoorLayout | None = None,
     ):
         self.building = building
         self.reader = reader if reader is not None else SignReader()
         self.matcher = SignMatcher(building)
-        self.layout = layout
+        self.layout = layout if layout is not None else DoorLayout()
         self._lock = threading.Lock()
         self._cache: tuple[int, float, _Read] | None = None
 
@@ -63,7 +63,7 @@ class OcrGrounder:
     def detect(self, obs: Observation, target: Entity) -> list[Detection]:
         r = self._read(obs)
         out = []
-        for det, plate in zip(r.signs, r.plates):
+        for det, plate in zip(r.signs, r.plates, strict=True):
             if det.entity != target:
                 continue
             if target.kind == EntityKind.ROOM and plate is not None:
