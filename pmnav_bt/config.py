@@ -60,7 +60,7 @@ class GrounderConfig(_Section):
         default_factory=list, description="room/landmark IDs whose signs are never read"
     )
     # -- ocr and gdino_sam (real perception) --
-    ocr_threads: int = Field(2, ge=1, description="ocr: onnxruntime threads per model")
+    ocr_threads: int = Field(1, ge=1, description="ocr: onnxruntime threads per model")
     ocr_max_candidates: int = Field(4, ge=1, description="ocr: sign plates read per frame")
     ocr_min_score: float = Field(
         0.6, ge=0.0, le=1.0, description="ocr: text lines read with a lower score are dropped"

@@ -72,6 +72,7 @@ class SignMatcher:
 
     def __init__(self, building: Building):
         self.keys: list[tuple[str, Entity]] = []
+        self._numbers: dict[Entity, str] = {}
         for r in building.rooms:
             self._add(Entity.room(r.id), r.sign_text, r.name, *r.aliases)
         for lm in building.landmarks:
@@ -80,6 +81,8 @@ class SignMatcher:
     def _add(self, entity: Entity, sign: str, *names: str) -> None:
         texts = [sign, *names]
         num = sign_number(sign)
+        if num is not None:
+            self._numbers[entity] = digits(num)
         if num is not None:  # the number alone (the rest unread) and the rest alone
             texts += [num, sign.split(None, 1)[1] if " " in sign else ""]
         seen = set()
@@ -94,11 +97,28 @@ class SignMatcher:
         return next(k for k, e in self.keys if e == entity)
 
     def match(self, lines: Sequence[tuple[str, float]]) -> Match | None:
-        """The entity that the lines of one sign (text, recogniser score) name, or None."""
-        text = fix_numbers(" ".join(t for t, _ in lines))
+        """The entity that the lines of one sign (text, recogniser score) name, or None.
+
+        The lines are matched together; failing that (a number cut by the image border),
+        the lines without digits are, and the digits read must then be a part of the
+        matched sign's number.
+        """
         if any(digits(normalise(fix_numbers(t))) and s < MIN_DIGIT_SCORE for t, s in lines):
             return None  # digits we do not trust: never guess a number
-        key = normalise(text)
+        whole = self._match_key(normalise(fix_numbers(" ".join(t for t, _ in lines))))
+        if whole is not None or len(lines) < 2:
+            return whole
+        read_digits = [digits(normalise(fix_numbers(t))) for t, _ in lines]
+        words = [t for (t, _), d in zip(lines, read_digits, strict=True) if not d]
+        part = self._match_key(normalise(" ".join(words))) if words else None
+        if part is None:
+            return None
+        number = self._numbers.get(part.entity, "")
+        if all(d in number for d in read_digits if d):
+            return Match(part.entity, 0.9 * part.score, part.key)
+        return None
+
+    def _match_key(self, key: str) -> Match | None:
         if not key:
             return None
         best: dict[Entity, Match] = {}

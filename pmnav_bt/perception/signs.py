@@ -143,7 +143,7 @@ class SignReader:
     (the largest first); ``min_score``: recogniser score below which a line is dropped.
     """
 
-    def __init__(self, threads: int = 2, max_candidates: int = 4, min_score: float = 0.6):
+    def __init__(self, threads: int = 1, max_candidates: int = 4, min_score: float = 0.6):
         self.threads = threads
         self.max_candidates = max_candidates
         self.min_score = min_score
@@ -158,30 +158,45 @@ class SignReader:
         s = min(1.0, 320.0 / w)
         small = rgb if s == 1.0 else cv2.resize(rgb, (int(w * s), int(h * s)), cv2.INTER_AREA)
         gray = cv2.cvtColor(small, cv2.COLOR_RGB2GRAY)
-        min_h = max(3, int(round(MIN_LINE_PX * s)))
+        min_h = max(2, int(round(MIN_LINE_PX * s)))
         plates = group_lines(text_line_boxes(gray, min_h))
         plates = [((b[0] / s, b[1] / s, b[2] / s, b[3] / s), lh / s) for b, lh in plates]
         plates.sort(key=lambda p: -(p[0][2] - p[0][0]) * (p[0][3] - p[0][1]))
         return plates[: self.max_candidates]
 
     def read(self, rgb: np.ndarray) -> list[SignText]:
-        """Every candidate plate whose text could be read, with its lines."""
-        out = []
-        for box, lh in self.candidates(rgb):
-            sign = self.read_crop(rgb, box, lh)
-            if sign is not None:
-                out.append(sign)
+        """Every candidate plate whose text could be read, with its lines.
+
+        Lines are found per candidate, then recognised together in one batch.
+        """
+        found = [(box, self.find_lines(rgb, box, lh)) for box, lh in self.candidates(rgb)]
+        crops = [crop for _, lines in found for _, crop in lines]
+        if not crops:
+            return []
+        results, _ = self._ocr.text_rec(crops)
+        out, i = [], 0
+        for box, lines in found:
+            read = []
+            for line_box, _ in lines:
+                text, score = results[i]
+                i += 1
+                text = _ascii(text)
+                if text and score >= self.min_score:
+                    read.append(TextLine(text, float(score), line_box))
+            if read:
+                out.append(SignText(tuple(read), box))
         return out
 
-    def read_crop(self, rgb: np.ndarray, box: Box, line_h: float) -> SignText | None:
-        """Detect and recognise the text lines inside ``box`` (padded), or None."""
+    def find_lines(self, rgb: np.ndarray, box: Box, line_h: float) -> list[tuple[Box, np.ndarray]]:
+        """Text lines inside ``box`` (padded), top to bottom: (box in frame pixels, upright
+        BGR crop for the recogniser). Lines too low to be read are left out."""
         h, w = rgb.shape[:2]
         pad = PAD_LINES * line_h
         x0, y0 = int(max(0, box[0] - pad)), int(max(0, box[1] - pad))
         x1, y1 = int(min(w, box[2] + pad + 1)), int(min(h, box[3] + pad + 1))
         crop = rgb[y0:y1, x0:x1]
         if crop.size == 0:
-            return None
+            return []
         scale = float(np.clip(LINE_PX / max(line_h, 1.0), 0.5, 6.0))
         big = cv2.resize(crop, None, fx=scale, fy=scale, interpolation=cv2.INTER_CUBIC)
         bgr = np.ascontiguousarray(big[:, :, ::-1])
@@ -190,22 +205,16 @@ class SignReader:
             det.limit_type, det.limit_side_len = "max", max(bgr.shape[:2])
             quads, _ = det(bgr)
         if quads is None or len(quads) == 0:
-            return None
+            return []
         quads = sorted(quads, key=lambda q: (float(q[:, 1].mean()), float(q[:, 0].min())))
-        crops = [_quad_crop(bgr, q) for q in quads]
-        results, _ = self._ocr.text_rec(crops)
-        lines = []
-        for q, (text, score) in zip(quads, results, strict=True):
-            text = _ascii(text)
-            if not text or score < self.min_score:
-                continue
+        out = []
+        for q in quads:
             qb = (
                 x0 + float(q[:, 0].min()) / scale,
                 y0 + float(q[:, 1].min()) / scale,
                 x0 + float(q[:, 0].max()) / scale,
                 y0 + float(q[:, 1].max()) / scale,
             )
-            lines.append(TextLine(text, float(score), qb))
-        if not lines:
-            return None
-        return SignText(tuple(lines), tuple(float(v) for v in box))  # type: ignore[arg-type]
+            if qb[3] - qb[1] >= 0.8 * MIN_LINE_PX:
+                out.append((qb, _quad_crop(bgr, q)))
+        return out

@@ -53,7 +53,7 @@ class OcrGrounder:
         self.matcher = SignMatcher(building)
         self.layout = layout if layout is not None else DoorLayout()
         self._lock = threading.Lock()
-        self._cache: tuple[int, float, _Read] | None = None
+        self._cache: tuple[np.ndarray, float, _Read] | None = None
 
     # -- Grounder seam ------------------------------------------------------------------
 
@@ -78,10 +78,10 @@ class OcrGrounder:
     # -- internals ----------------------------------------------------------------------
 
     def _read(self, obs: Observation) -> _Read:
-        key = (id(obs.rgb), obs.stamp)
-        with self._lock:
-            if self._cache is not None and self._cache[:2] == key:
-                return self._cache[2]
+        with self._lock:  # the same frame object (kept alive here, so never a reused id)
+            c = self._cache
+            if c is not None and c[0] is obs.rgb and c[1] == obs.stamp:
+                return c[2]
         signs, plates = [], []
         for sign in self.reader.read(obs.rgb):
             m = self.matcher.match([(line.text, line.score) for line in sign.lines])
@@ -101,7 +101,7 @@ class OcrGrounder:
             plates.append(plate)
         result = _Read(signs, plates)
         with self._lock:
-            self._cache = (key[0], key[1], result)
+            self._cache = (obs.rgb, obs.stamp, result)
         return result
 
     def _door(self, obs: Observation, sign: Detection, plate: depth_geom.PlatePose) -> Detection:
