@@ -68,9 +68,10 @@ def surfaces(obs: Observation) -> SurfaceMasks:
     rng = pts[..., 0]
     ok = np.isfinite(height)
     tol = FLOOR_TOL + FLOOR_TOL_PER_M * np.nan_to_num(rng, nan=0.0)
-    floor = ok & (np.abs(np.nan_to_num(height, nan=1e9)) <= tol)
     nz = np.abs(normals(pts)[..., 2])
     vertical = np.isfinite(nz) & (nz <= MAX_VERTICAL_NZ)
+    # Floor: at floor height, and not the foot of a wall (unknown normals are allowed).
+    floor = ok & (np.abs(np.nan_to_num(height, nan=1e9)) <= tol) & ~vertical
     wall = ok & ~floor & vertical & (np.nan_to_num(height, nan=-1.0) > tol)
     # Fill the one-pixel gaps that depth edges leave between neighbouring estimates.
     kernel = np.ones((3, 3), np.uint8)

@@ -4,37 +4,11 @@ from __future__ import annotations
 
 import math
 
-import cv2
-import numpy as np
 import pytest
 
-from pmnav_bt.seams import CameraIntrinsics, Entity, Observation, Pose2D
-from pmnav_bt.sim.textures import make_sign
+from pmnav_bt.seams import Entity
 
 pytest.importorskip("rapidocr_onnxruntime")
-
-K = CameraIntrinsics.from_hfov(320, 240, math.radians(60.0))
-WALL_RGB = (200, 196, 180)
-RANGE = 1.8  # m to the wall
-
-
-def wall_frame(signs: list[tuple[str, float]], depth: bool = True) -> Observation:
-    """A camera facing a plain wall RANGE m away, with sign plates at lateral offsets
-    (m, left positive) centred at camera height."""
-    rgb = np.full((K.height, K.width, 3), WALL_RGB, np.uint8)
-    px_per_m = K.fx / RANGE
-    for text, y_left in signs:
-        tex = make_sign(text)
-        w = int(round(tex.width_m * px_per_m))
-        h = int(round(tex.height_m * px_per_m))
-        img = cv2.resize(tex.image, (w, h), interpolation=cv2.INTER_AREA)
-        u0 = int(round(K.cx - y_left * px_per_m - w / 2))
-        v0 = int(round(K.cy - h / 2))
-        su0, sv0 = max(u0, 0), max(v0, 0)
-        su1, sv1 = min(u0 + w, K.width), min(v0 + h, K.height)
-        rgb[sv0:sv1, su0:su1] = img[sv0 - v0 : sv1 - v0, su0 - u0 : su1 - u0]
-    d = np.full((K.height, K.width), RANGE, np.float32) if depth else None
-    return Observation(rgb, Pose2D(0.0, 0.0, 0.0), 0.0, K, depth=d, camera_height=1.6)
 
 
 @pytest.fixture(scope="module")
@@ -44,39 +18,39 @@ def grounder(fig2):
     return OcrGrounder(fig2)
 
 
-def test_reads_a_sign_and_places_it_with_depth(grounder):
-    obs = wall_frame([("102 Pharmacy", 0.0)])
+def test_reads_a_sign_and_places_it_with_depth(grounder, wall):
+    obs = wall.frame([("102 Pharmacy", 0.0)])
     signs = grounder.read_signs(obs)
     assert [d.entity for d in signs] == [Entity.room("room2")]
     x, y, z = signs[0].point
-    assert x == pytest.approx(RANGE, abs=0.05) and abs(y) < 0.1 and abs(z) < 0.15
+    assert x == pytest.approx(wall.RANGE, abs=0.05) and abs(y) < 0.1 and abs(z) < 0.15
 
 
-def test_two_similar_signs_the_query_gets_its_own(grounder):
+def test_two_similar_signs_the_query_gets_its_own(grounder, wall):
     """Signs 111 and 112 side by side: the query for room 12 is grounded at the 112 sign's
     door, not at 111's."""
-    obs = wall_frame([("111", 0.55), ("112", -0.55)])
+    obs = wall.frame([("111", 0.55), ("112", -0.55)])
     named = {d.entity for d in grounder.read_signs(obs)}
     assert named == {Entity.room("room11"), Entity.room("room12")}
     dets = grounder.detect(obs, Entity.room("room12"))
     assert len(dets) == 1
     door = dets[0]
     # The door is sign_to_door (1.14 m) beside the 112 sign (at y = -0.55), on the wall.
-    assert door.point[0] == pytest.approx(RANGE, abs=0.05)
+    assert door.point[0] == pytest.approx(wall.RANGE, abs=0.05)
     assert abs(door.point[1] - (-0.55)) == pytest.approx(1.14, abs=0.1)
 
 
-def test_a_sign_cut_by_the_image_border_is_still_named(grounder):
+def test_a_sign_cut_by_the_image_border_is_still_named(grounder, wall):
     # Centred at the left edge of the view: the plate's left part is out of the frame.
-    half_view = RANGE * math.tan(K.hfov / 2)
-    obs = wall_frame([("104 Laboratory", half_view - 0.1)])
+    half_view = wall.RANGE * math.tan(wall.K.hfov / 2)
+    obs = wall.frame([("104 Laboratory", half_view - 0.1)])
     signs = grounder.read_signs(obs)
     assert signs and signs[0].entity == Entity.room("room4")
     assert signs[0].box[0] <= 2  # it touches the border
 
 
-def test_without_depth_signs_are_named_but_not_placed(grounder):
-    obs = wall_frame([("102 Pharmacy", 0.0)], depth=False)
+def test_without_depth_signs_are_named_but_not_placed(grounder, wall):
+    obs = wall.frame([("102 Pharmacy", 0.0)], depth=False)
     signs = grounder.read_signs(obs)
     assert [d.entity for d in signs] == [Entity.room("room2")] and signs[0].point is None
     dets = grounder.detect(obs, Entity.room("room2"))
@@ -84,16 +58,16 @@ def test_without_depth_signs_are_named_but_not_placed(grounder):
     assert grounder.surfaces(obs).floor.sum() == 0
 
 
-def test_a_plain_wall_names_nothing(grounder):
-    assert grounder.read_signs(wall_frame([])) == []
-    assert grounder.detect(wall_frame([]), Entity.room("room2")) == []
+def test_a_plain_wall_names_nothing(grounder, wall):
+    assert grounder.read_signs(wall.frame([])) == []
+    assert grounder.detect(wall.frame([]), Entity.room("room2")) == []
 
 
-def test_the_door_side_follows_the_image(grounder):
+def test_the_door_side_follows_the_image(grounder, wall):
     """A brown door on the sign's right (viewer's) is found there, against the default."""
-    obs = wall_frame([("105", 0.0)])
-    px_per_m = K.fx / RANGE
-    u0 = int(round(K.cx + (1.14 - 0.5) * px_per_m))
-    obs.rgb[int(K.cy - 0.2 * px_per_m) :, u0 : u0 + int(px_per_m)] = (148, 97, 51)
+    obs = wall.frame([("105", 0.0)])
+    px_per_m = wall.K.fx / wall.RANGE
+    u0 = int(round(wall.K.cx + (1.14 - 0.5) * px_per_m))
+    obs.rgb[int(wall.K.cy - 0.2 * px_per_m) :, u0 : u0 + int(px_per_m)] = (148, 97, 51)
     (door,) = grounder.detect(obs, Entity.room("room5"))
     assert door.point[1] == pytest.approx(-1.14, abs=0.1)  # right of the sign
