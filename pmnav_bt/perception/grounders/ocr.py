@@ -1,8 +1,10 @@
 """The ``ocr`` grounder: reads door and landmark signs in RGB, floor and walls from depth.
 
 - ``read_signs``: every plate whose text names a room or landmark of the building
-  (``SignReader`` + ``SignMatcher``); the detection's box is the sign's text, its
-  ``point`` the plate's centre from depth (None without depth).
+  (``SignReader`` + ``SignMatcher``); the detection's box is the sign's, its ``point``
+  where the named entity is, the point the priori-map knows it by: for a room its door
+  (derived from the sign, as ``detect`` does), for a landmark its sign; None without
+  depth. Localization pairs these points with the map's.
 - ``detect(room)``: the room's *door*, derived from its sign (``doors.door_from_sign``):
   box and mask of the door rectangle projected into the image, ``point`` its centre.
   Without depth the door cannot be placed: the sign's detection stands in for it.
@@ -16,7 +18,7 @@ ask ``read_signs`` and ``detect`` of one frame at the cost of one reading.
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,10 +33,10 @@ from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMa
 
 @dataclass
 class _Read:
-    """One frame's signs, and the plate pose behind each detection."""
+    """One frame's signs, and the door derived from each room sign (None: not derived)."""
 
     signs: list[Detection]
-    plates: list[depth_geom.PlatePose | None]
+    doors: list[Detection | None]
 
 
 class OcrGrounder:
@@ -62,14 +64,11 @@ class OcrGrounder:
 
     def detect(self, obs: Observation, target: Entity) -> list[Detection]:
         r = self._read(obs)
-        out = []
-        for det, plate in zip(r.signs, r.plates, strict=True):
-            if det.entity != target:
-                continue
-            if target.kind == EntityKind.ROOM and plate is not None:
-                out.append(self._door(obs, det, plate))
-            else:
-                out.append(det)
+        out = [
+            door if door is not None else sign
+            for sign, door in zip(r.signs, r.doors, strict=True)
+            if sign.entity == target
+        ]
         return sorted(out, key=lambda d: -d.score)
 
     def surfaces(self, obs: Observation) -> SurfaceMasks:
@@ -82,24 +81,26 @@ class OcrGrounder:
             c = self._cache
             if c is not None and c[0] is obs.rgb and c[1] == obs.stamp:
                 return c[2]
-        signs, plates = [], []
+        signs, doors = [], []
         for sign in self.reader.read(obs.rgb):
             m = self.matcher.match([(line.text, line.score) for line in sign.lines])
             if m is None:
                 continue
             plate = depth_geom.plate_pose(obs, sign.box)
-            point = None if plate is None else tuple(float(v) for v in plate.centre)
-            signs.append(
-                Detection(
-                    label=sign.text,
-                    box=sign.box,
-                    score=float(m.score * sign.score),
-                    entity=m.entity,
-                    point=point,  # type: ignore[arg-type]
-                )
+            det = Detection(
+                label=sign.text,
+                box=sign.box,
+                score=float(m.score * sign.score),
+                entity=m.entity,
+                point=None if plate is None else tuple(float(v) for v in plate.centre),  # type: ignore[arg-type]
             )
-            plates.append(plate)
-        result = _Read(signs, plates)
+            door = None
+            if m.entity.kind == EntityKind.ROOM and plate is not None:
+                door = self._door(obs, det, plate)
+                det = replace(det, point=door.point)
+            signs.append(det)
+            doors.append(door)
+        result = _Read(signs, doors)
         with self._lock:
             self._cache = (obs.rgb, obs.stamp, result)
         return result
