@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pmnav_bt.errors import BackendError
+from pmnav_bt.errors import BackendError, PmNavError
+from pmnav_bt.loading import weights_file
 from pmnav_bt.map.building import Building
 from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.doors import DoorLayout
@@ -48,6 +49,11 @@ def _model_dir(path: str, field: str, what: str) -> Path:
             f"transformers' save_pretrained (config.json, model.safetensors"
             f"{', tokenizer and preprocessor_config.json' if field == 'gdino_path' else ''})"
         )
+    if not (p / "model.safetensors.index.json").is_file():  # sharded: transformers checks
+        try:
+            weights_file(p / "model.safetensors")
+        except PmNavError as err:
+            raise BackendError(f"grounder.{field}: {what} weights: {err}") from None
     return p
 
 
