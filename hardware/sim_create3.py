@@ -13,7 +13,9 @@ against a Create 3:
 - out ``camera/image_raw`` (rgb8), ``camera/camera_info``, ``camera/depth/image_raw``
   (32FC1 m), ``camera/segmentation`` (16UC1 label ids) at ``camera_rate_hz``, all
   with one stamp (the render time) and sensor-data QoS; ``camera/segmentation_labels``
-  (std_msgs/String JSON id -> label, latched);
+  (std_msgs/String JSON id -> label, latched). With ``publish_segmentation`` false no
+  segmentation is rendered or published: the real stack (``grounder.backend`` ``ocr``
+  or ``gdino_sam``) needs none;
 - out ``sim/true_pose`` (geometry_msgs/PoseStamped, frame ``map``: ground truth) and
   ``sim/stats`` (std_msgs/String JSON: collisions, path length, rotation).
 
@@ -49,6 +51,10 @@ PARAMETERS = {
     "odom_at_origin": (True, "odometry frame starts at the start pose"),
     "publish_odom": (True, "false: stop publishing odometry (fault injection)"),
     "publish_camera": (True, "false: stop publishing camera frames (fault injection)"),
+    "publish_segmentation": (
+        True,
+        "false: render and publish no segmentation (the real stack needs none; sim_gt does)",
+    ),
     "odom_frame": ("odom", ""),
     "base_frame": ("base_link", ""),
     "camera_frame": ("camera_optical_frame", ""),
@@ -97,6 +103,7 @@ class SimCreate3:
             height=int(p["height"]),
             hfov=math.radians(float(p["hfov_deg"])),
             camera_height=float(p["camera_height"]),
+            segmentation=bool(p["publish_segmentation"]),
         )
         self.base = NoisyOdometry(self.inner, float(p["odometry_noise"]), seed=int(p["seed"]))
         self._odom_T_map = (

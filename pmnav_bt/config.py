@@ -59,6 +59,26 @@ class GrounderConfig(_Section):
     hidden: list[str] = Field(
         default_factory=list, description="room/landmark IDs whose signs are never read"
     )
+    # -- ocr and gdino_sam (real perception) --
+    ocr_threads: int = Field(1, ge=1, description="ocr: onnxruntime threads per model")
+    ocr_max_candidates: int = Field(4, ge=1, description="ocr: sign plates read per frame")
+    ocr_min_score: float = Field(
+        0.6, ge=0.0, le=1.0, description="ocr: text lines read with a lower score are dropped"
+    )
+    sign_to_door: float = Field(
+        1.14, gt=0.0, description="m from a door sign's centre to its door's centre"
+    )
+    door_side: Literal["left", "right"] = Field(
+        "left", description="side of its sign a door is on when the image cannot tell"
+    )
+    door_width: float = Field(1.16, gt=0.0, description="m, with the frame")
+    door_height: float = Field(2.18, gt=0.0, description="m, with the frame")
+    gdino_path: str = Field(
+        "", description="gdino_sam: local folder of a GroundingDINO model (transformers)"
+    )
+    sam_path: str = Field("", description="gdino_sam: local folder of a SAM model (transformers)")
+    box_threshold: float = Field(0.35, ge=0.0, le=1.0, description="gdino_sam: box score")
+    text_threshold: float = Field(0.25, ge=0.0, le=1.0, description="gdino_sam: phrase score")
 
 
 class CoarseConfig(_Section):

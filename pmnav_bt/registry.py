@@ -104,6 +104,16 @@ GROUNDERS = Registry(
             "the simulator's segmentation (oracle; misses/noise configurable)",
             needs_sim_labels=True,
         ),
+        BackendSpec(
+            "ocr",
+            "pmnav_bt.perception.grounders.ocr:build",
+            "reads door and landmark signs (PP-OCR); floor and walls from depth",
+        ),
+        BackendSpec(
+            "gdino_sam",
+            "pmnav_bt.perception.grounders.gdino_sam:build",
+            "GroundingDINO + SAM (transformers, local weights); signs by OCR; depth surfaces",
+        ),
     ],
 )
 COARSE = Registry(

@@ -1,0 +1,104 @@
+"""Sign reading: does the ``ocr`` grounder name the right room, how far, how fast.
+
+Views of the sign plates of every built-in building are rendered from 1.5-6 m and 0-70
+deg off the plate's normal (``sim.sign_views``), at 320x240 and 640x480. For each view
+the grounder's ``read_signs`` names entities; a named entity is right when the frame
+shows that entity's sign (its simulator label covers pixels inside the detection's box).
+Recall: views whose target sign was named. Precision: named entities that were right.
+Latency: wall time and process CPU time of ``read_signs`` per frame (the models are
+loaded before timing; one onnxruntime thread). On a shared machine the wall time
+includes waiting for a core: the load average is printed with it.
+
+Run: python benchmarks/bench_signs.py [--views 160] [--seed 0]
+Target: read_signs p50 < 150 ms and p95 < 400 ms per 320x240 frame on 2 cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+from collections import defaultdict
+
+import numpy as np
+
+from pmnav_bt.map.building import builtin_buildings
+from pmnav_bt.perception.grounders.ocr import OcrGrounder
+from pmnav_bt.seams import EntityKind, landmark_label, sign_label
+from pmnav_bt.sim.sign_views import sample_views
+from pmnav_bt.sim.world import SimWorld
+
+BANDS = ((1.5, 2.5), (2.5, 3.5), (3.5, 4.5), (4.5, 6.0))
+
+
+def shows(obs, entity, box) -> bool:
+    """Whether the frame shows ``entity``'s sign inside ``box`` (simulator labels)."""
+    lab = sign_label(entity.id) if entity.kind == EntityKind.ROOM else landmark_label(entity.id)
+    ids = [i for i, name in obs.labels.items() if name == lab]
+    x0, y0, x1, y1 = (int(round(v)) for v in box)
+    return bool(np.isin(obs.segmentation[y0 : y1 + 1, x0 : x1 + 1], ids).any())
+
+
+def band_of(d: float) -> int:
+    return next(i for i, (a, b) in enumerate(BANDS) if a <= d < b or (i == len(BANDS) - 1))
+
+
+def run(width: int, height: int, views: int, seed: int) -> None:
+    names = builtin_buildings()
+    per = math.ceil(views / len(names))
+    stats = defaultdict(lambda: defaultdict(int))
+    times: list[float] = []
+    cpu: list[float] = []
+    total = 0
+    for k, name in enumerate(names):
+        world = SimWorld(name)
+        g = OcrGrounder(world.building)
+        for v in sample_views(world, per, width=width, height=height, seed=seed + k):
+            obs = v.observation
+            t0, c0 = time.perf_counter(), time.process_time()
+            dets = g.read_signs(obs)
+            times.append(time.perf_counter() - t0)
+            cpu.append(time.process_time() - c0)
+            s = stats[band_of(v.distance)]
+            s["views"] += 1
+            s["hit"] += any(d.entity == v.entity for d in dets)
+            for d in dets:
+                s["named"] += 1
+                s["right"] += shows(obs, d.entity, d.box)
+            total += 1
+        world.close()
+    ms = np.array(times) * 1000
+    cpu_ms = np.array(cpu) * 1000
+    print(f"\n{width}x{height}: {total} views, {len(names)} buildings, 0-70 deg off the plate")
+    print(f"{'distance':>10s} {'views':>6s} {'recall':>7s} {'named':>6s} {'precision':>9s}")
+    tot = defaultdict(int)
+    for i, (a, b) in enumerate(BANDS):
+        s = stats[i]
+        for key in ("views", "hit", "named", "right"):
+            tot[key] += s[key]
+        rec = 100 * s["hit"] / max(s["views"], 1)
+        prec = 100 * s["right"] / s["named"] if s["named"] else float("nan")
+        print(f"{a:4.1f}-{b:3.1f} m {s['views']:6d} {rec:6.1f}% {s['named']:6d} {prec:8.1f}%")
+    rec = 100 * tot["hit"] / max(tot["views"], 1)
+    prec = 100 * tot["right"] / tot["named"] if tot["named"] else float("nan")
+    print(f"{'all':>10s} {tot['views']:6d} {rec:6.1f}% {tot['named']:6d} {prec:8.1f}%")
+    for what, v in (("wall time", ms), ("CPU time", cpu_ms)):
+        print(
+            f"read_signs {what}: p50 {np.percentile(v, 50):.0f} ms, "
+            f"p95 {np.percentile(v, 95):.0f} ms, max {v.max():.0f} ms per frame"
+        )
+    print(f"(load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--views", type=int, default=160, help="views per resolution")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    for w, h in ((320, 240), (640, 480)):
+        run(w, h, args.views, args.seed)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,137 @@
+"""The ``ocr`` grounder: reads door and landmark signs in RGB, floor and walls from depth.
+
+- ``read_signs``: every plate whose text names a room or landmark of the building
+  (``SignReader`` + ``SignMatcher``); the detection's box is the sign's, its ``point``
+  where the named entity is, the point the priori-map knows it by: for a room its door
+  (derived from the sign, as ``detect`` does), for a landmark its sign; None without
+  depth. Localization pairs these points with the map's.
+- ``detect(room)``: the room's *door*, derived from its sign (``doors.door_from_sign``):
+  box and mask of the door rectangle projected into the image, ``point`` its centre.
+  Without depth the door cannot be placed: the sign's detection stands in for it.
+- ``detect(landmark)``: the landmark's sign.
+- ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
+
+No simulator labels are read. Results are cached for the last frame, so the tree can
+ask ``read_signs`` and ``detect`` of one frame at the cost of one reading.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from pmnav_bt.map.building import Building
+from pmnav_bt.perception import depth as depth_geom
+from pmnav_bt.perception.doors import DoorLayout, door_from_sign
+from pmnav_bt.perception.sign_match import SignMatcher
+from pmnav_bt.perception.signs import SignReader
+from pmnav_bt.registry import BackendDeps
+from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
+
+
+@dataclass
+class _Read:
+    """One frame's signs, and the door derived from each room sign (None: not derived)."""
+
+    signs: list[Detection]
+    doors: list[Detection | None]
+
+
+class OcrGrounder:
+    """Grounder by reading signs (see the module docstring)."""
+
+    needs_sim_labels = False
+
+    def __init__(
+        self,
+        building: Building,
+        reader: SignReader | None = None,
+        layout: DoorLayout | None = None,
+    ):
+        self.building = building
+        self.reader = reader if reader is not None else SignReader()
+        self.matcher = SignMatcher(building)
+        self.layout = layout if layout is not None else DoorLayout()
+        self._lock = threading.Lock()
+        self._cache: tuple[np.ndarray, float, _Read] | None = None
+
+    # -- Grounder seam ------------------------------------------------------------------
+
+    def read_signs(self, obs: Observation) -> list[Detection]:
+        return list(self._read(obs).signs)
+
+    def detect(self, obs: Observation, target: Entity) -> list[Detection]:
+        r = self._read(obs)
+        out = [
+            door if door is not None else sign
+            for sign, door in zip(r.signs, r.doors, strict=True)
+            if sign.entity == target
+        ]
+        return sorted(out, key=lambda d: -d.score)
+
+    def surfaces(self, obs: Observation) -> SurfaceMasks:
+        return depth_geom.surfaces(obs)
+
+    # -- internals ----------------------------------------------------------------------
+
+    def _read(self, obs: Observation) -> _Read:
+        with self._lock:  # the same frame object (kept alive here, so never a reused id)
+            c = self._cache
+            if c is not None and c[0] is obs.rgb and c[1] == obs.stamp:
+                return c[2]
+        signs, doors = [], []
+        for sign in self.reader.read(obs.rgb):
+            m = self.matcher.match([(line.text, line.score) for line in sign.lines])
+            if m is None:
+                continue
+            plate = depth_geom.plate_pose(obs, sign.box)
+            det = Detection(
+                label=sign.text,
+                box=sign.box,
+                score=float(m.score * sign.score),
+                entity=m.entity,
+                point=None if plate is None else tuple(float(v) for v in plate.centre),  # type: ignore[arg-type]
+            )
+            door = None
+            if m.entity.kind == EntityKind.ROOM and plate is not None:
+                door = self._door(obs, det, plate)
+                det = replace(det, point=door.point)
+            signs.append(det)
+            doors.append(door)
+        result = _Read(signs, doors)
+        with self._lock:
+            self._cache = (obs.rgb, obs.stamp, result)
+        return result
+
+    def _door(self, obs: Observation, sign: Detection, plate: depth_geom.PlatePose) -> Detection:
+        door = door_from_sign(obs, plate, self.layout)
+        if door.mask is not None:
+            ys, xs = np.nonzero(door.mask)
+            box = (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
+        else:
+            box = sign.box
+        return Detection(
+            label=sign.label,
+            box=box,
+            score=sign.score if door.seen else 0.9 * sign.score,
+            mask=door.mask,
+            entity=sign.entity,
+            point=tuple(float(v) for v in door.centre),  # type: ignore[arg-type]
+        )
+
+
+def build(deps: BackendDeps) -> OcrGrounder:
+    """The ``ocr`` back end from ``config.grounder`` (registry factory)."""
+    g = deps.config.grounder
+    reader = SignReader(
+        threads=g.ocr_threads, max_candidates=g.ocr_max_candidates, min_score=g.ocr_min_score
+    )
+    layout = DoorLayout(
+        sign_to_door=g.sign_to_door,
+        door_width=g.door_width,
+        door_height=g.door_height,
+        default_side=g.door_side,
+    )
+    return OcrGrounder(deps.pm.building, reader, layout)

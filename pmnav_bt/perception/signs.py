@@ -1,0 +1,220 @@
+"""Reading sign plates in RGB: cheap candidate regions, then PP-OCR on the crops.
+
+Full-frame text detection (PP-OCRv4 through ``rapidocr-onnxruntime``) upscales every
+frame to 736 px and costs about half a CPU-second. Signs are small, dense, high-contrast
+text on a plain plate, so a morphological gradient finds them for a few milliseconds:
+strong edges, closed horizontally into text lines, kept when the lines are dense, then
+grouped into plates. Only those crops go through the text detector (upscaled so a text
+line is about ``LINE_PX`` pixels high) and the recogniser. The models load once per
+process and are shared by every reader. Text is filtered to printable ASCII (the
+models also read Chinese).
+"""
+
+from __future__ import annotations
+
+import functools
+import threading
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from pmnav_bt.errors import BackendError
+
+Box = tuple[float, float, float, float]  # x0, y0, x1, y1 (pixels)
+
+LINE_PX = 32.0  # text-line height the detector sees after upscaling a crop
+MIN_LINE_PX = 5  # lines lower than this in the frame cannot be read: not candidates
+PAD_LINES = 0.8  # crop padding around a plate candidate, in line heights
+
+
+@dataclass(frozen=True)
+class TextLine:
+    """One line of text read in a frame: ASCII text, recogniser score, box in frame pixels."""
+
+    text: str
+    score: float
+    box: Box
+
+
+@dataclass(frozen=True)
+class SignText:
+    """The text lines read inside one sign candidate (top to bottom), and the plate's box."""
+
+    lines: tuple[TextLine, ...]
+    box: Box
+
+    @property
+    def text(self) -> str:
+        return " ".join(line.text for line in self.lines)
+
+    @property
+    def score(self) -> float:
+        return float(min(line.score for line in self.lines)) if self.lines else 0.0
+
+
+_ENGINE_LOCK = threading.Lock()
+
+
+@functools.lru_cache(maxsize=4)
+def _engine(threads: int):
+    """The rapidocr engine (models loaded once per process and thread count)."""
+    try:
+        from rapidocr_onnxruntime import RapidOCR
+    except ImportError as e:  # pragma: no cover - depends on the install
+        raise BackendError(
+            "grounder.backend 'ocr' needs rapidocr-onnxruntime: "
+            "pip install -e '.[ocr]' && pip install --no-deps rapidocr-onnxruntime==1.4.4 "
+            "(or `make setup`)"
+        ) from e
+    return RapidOCR(intra_op_num_threads=threads, inter_op_num_threads=1, print_verbose=False)
+
+
+def text_line_boxes(gray: np.ndarray, min_h: int = MIN_LINE_PX) -> list[tuple[Box, float]]:
+    """Dense, high-contrast regions: text lines, or whole plates where the text touches the
+    plate's border; each with its estimated text-line height (pixels)."""
+    h, w = gray.shape
+    grad = cv2.morphologyEx(gray, cv2.MORPH_GRADIENT, np.ones((3, 3), np.uint8))
+    edges = (grad >= 60).astype(np.uint8)
+    k = max(3, w // 80)
+    kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (k, max(1, k // 3)))
+    closed = cv2.morphologyEx(edges, cv2.MORPH_CLOSE, kernel)
+    n, _, stats, _ = cv2.connectedComponentsWithStats(closed, connectivity=8)
+    out: list[tuple[Box, float]] = []
+    for i in range(1, n):
+        x, y, bw, bh, _ = stats[i]
+        if bh < min_h or bw < min_h or bh > h // 4 or bw > w * 0.9:
+            continue
+        fill = float(edges[y : y + bh, x : x + bw].mean())
+        if fill >= 0.25 and bw >= 0.7 * bh:
+            line_h = bh if fill >= 0.45 else bh / 3.0  # sparse: a plate, about 3 lines high
+            out.append(((float(x), float(y), float(x + bw), float(y + bh)), float(line_h)))
+    return out
+
+
+def group_lines(lines: list[tuple[Box, float]]) -> list[tuple[Box, float]]:
+    """Group regions stacked close together into plates: (plate box, text-line height)."""
+    groups: list[list[tuple[Box, float]]] = []
+    for b, lh in sorted(lines, key=lambda r: r[0][1]):
+        for g in groups:
+            gx0, gx1 = min(q[0] for q, _ in g), max(q[2] for q, _ in g)
+            gy1 = max(q[3] for q, _ in g)
+            gap = b[1] - gy1
+            overlap = min(b[2], gx1) - max(b[0], gx0)
+            if gap <= 1.5 * max(lh, g[-1][1]) and overlap > -lh:
+                g.append((b, lh))
+                break
+        else:
+            groups.append([(b, lh)])
+    out = []
+    for g in groups:
+        qs = [q for q, _ in g]
+        box = (
+            min(q[0] for q in qs),
+            min(q[1] for q in qs),
+            max(q[2] for q in qs),
+            max(q[3] for q in qs),
+        )
+        out.append((box, float(min(lh for _, lh in g))))
+    return out
+
+
+def _ascii(text: str) -> str:
+    return "".join(c for c in text if 32 <= ord(c) < 127).strip()
+
+
+def _quad_crop(img: np.ndarray, quad: np.ndarray) -> np.ndarray:
+    """The text line inside ``quad`` (4x2, clockwise from top-left), warped upright."""
+    q = quad.astype(np.float32)
+    w = int(max(np.linalg.norm(q[0] - q[1]), np.linalg.norm(q[2] - q[3])))
+    h = int(max(np.linalg.norm(q[0] - q[3]), np.linalg.norm(q[1] - q[2])))
+    w, h = max(w, 1), max(h, 1)
+    dst = np.float32([[0, 0], [w, 0], [w, h], [0, h]])
+    m = cv2.getPerspectiveTransform(q, dst)
+    return cv2.warpPerspective(
+        img, m, (w, h), flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE
+    )
+
+
+class SignReader:
+    """Reads the sign plates of an RGB frame (see the module docstring).
+
+    ``threads``: onnxruntime threads per model; ``max_candidates``: plates read per frame
+    (the largest first); ``min_score``: recogniser score below which a line is dropped.
+    """
+
+    def __init__(self, threads: int = 1, max_candidates: int = 4, min_score: float = 0.6):
+        self.threads = threads
+        self.max_candidates = max_candidates
+        self.min_score = min_score
+        self._ocr = _engine(threads)
+
+    def candidates(self, rgb: np.ndarray) -> list[tuple[Box, float]]:
+        """Plate candidates: (box in frame pixels, text-line height), largest first.
+
+        Frames wider than 320 px are searched at 320 px (the cue needs no detail).
+        """
+        h, w = rgb.shape[:2]
+        s = min(1.0, 320.0 / w)
+        small = rgb if s == 1.0 else cv2.resize(rgb, (int(w * s), int(h * s)), cv2.INTER_AREA)
+        gray = cv2.cvtColor(small, cv2.COLOR_RGB2GRAY)
+        min_h = max(2, int(round(MIN_LINE_PX * s)))
+        plates = group_lines(text_line_boxes(gray, min_h))
+        plates = [((b[0] / s, b[1] / s, b[2] / s, b[3] / s), lh / s) for b, lh in plates]
+        plates.sort(key=lambda p: -(p[0][2] - p[0][0]) * (p[0][3] - p[0][1]))
+        return plates[: self.max_candidates]
+
+    def read(self, rgb: np.ndarray) -> list[SignText]:
+        """Every candidate plate whose text could be read, with its lines.
+
+        Lines are found per candidate, then recognised together in one batch.
+        """
+        found = [(box, self.find_lines(rgb, box, lh)) for box, lh in self.candidates(rgb)]
+        crops = [crop for _, lines in found for _, crop in lines]
+        if not crops:
+            return []
+        results, _ = self._ocr.text_rec(crops)
+        out, i = [], 0
+        for box, lines in found:
+            read = []
+            for line_box, _ in lines:
+                text, score = results[i]
+                i += 1
+                text = _ascii(text)
+                if text and score >= self.min_score:
+                    read.append(TextLine(text, float(score), line_box))
+            if read:
+                out.append(SignText(tuple(read), box))
+        return out
+
+    def find_lines(self, rgb: np.ndarray, box: Box, line_h: float) -> list[tuple[Box, np.ndarray]]:
+        """Text lines inside ``box`` (padded), top to bottom: (box in frame pixels, upright
+        BGR crop for the recogniser). Lines too low to be read are left out."""
+        h, w = rgb.shape[:2]
+        pad = PAD_LINES * line_h
+        x0, y0 = int(max(0, box[0] - pad)), int(max(0, box[1] - pad))
+        x1, y1 = int(min(w, box[2] + pad + 1)), int(min(h, box[3] + pad + 1))
+        crop = rgb[y0:y1, x0:x1]
+        if crop.size == 0:
+            return []
+        scale = float(np.clip(LINE_PX / max(line_h, 1.0), 0.5, 6.0))
+        big = cv2.resize(crop, None, fx=scale, fy=scale, interpolation=cv2.INTER_CUBIC)
+        bgr = np.ascontiguousarray(big[:, :, ::-1])
+        det = self._ocr.text_det
+        with _ENGINE_LOCK:  # the detector's limits are per-call state
+            det.limit_type, det.limit_side_len = "max", max(bgr.shape[:2])
+            quads, _ = det(bgr)
+        if quads is None or len(quads) == 0:
+            return []
+        quads = sorted(quads, key=lambda q: (float(q[:, 1].mean()), float(q[:, 0].min())))
+        out = []
+        for q in quads:
+            qb = (
+                x0 + float(q[:, 0].min()) / scale,
+                y0 + float(q[:, 1].min()) / scale,
+                x0 + float(q[:, 0].max()) / scale,
+                y0 + float(q[:, 1].max()) / scale,
+            )
+            if qb[3] - qb[1] >= 0.8 * MIN_LINE_PX:
+                out.append((qb, _quad_crop(bgr, q)))
+        return out
