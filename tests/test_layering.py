@@ -111,6 +111,8 @@ def _declared() -> set[str]:
     reqs = list(PYPROJECT["project"]["dependencies"])
     for extra in PYPROJECT["project"]["optional-dependencies"].values():
         reqs += extra
+    # Installed by the Makefile with --no-deps (their metadata names opencv-python).
+    reqs += re.findall(r"--no-deps (\S+)", (ROOT / "Makefile").read_text())
     return {re.split(r"[<>=!~\[ ;]", r, maxsplit=1)[0].lower().replace("_", "-") for r in reqs}
 
 

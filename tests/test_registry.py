@@ -37,8 +37,8 @@ def test_a_simulator_only_grounder_is_refused_on_a_robot_in_one_line(fig2_map):
 
 
 def test_an_unknown_back_end_lists_the_registered_ones():
-    with pytest.raises(ConfigError, match="unknown back end 'ocr'.*registered: sim_gt"):
-        load_config(overrides=["grounder.backend=ocr"])
+    with pytest.raises(ConfigError, match="unknown back end 'orc'.*registered: sim_gt, ocr"):
+        load_config(overrides=["grounder.backend=orc"])
 
 
 def _scripted(deps):
