@@ -147,8 +147,6 @@ def test_easy_episode_with_the_real_stack_over_dds(probe, domain_id, tmp_path):
     from episode 0's start no sign is within the reader's 2.5 m (LOCALIZATION_FAILED, in
     the simulator too)."""
     pytest.importorskip("rapidocr_onnxruntime")
-    # The tree passes typed entities to the grounder only once it is on the seams contract.
-    pytest.importorskip("pmnav_bt.perception.grounders.ground_truth")
     ep = _episode("easy", 1)
     _run_episode(
         probe,
