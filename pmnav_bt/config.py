@@ -100,6 +100,34 @@ class PlannerConfig(_Section):
     )
 
 
+class VlmConfig(_Section):
+    """An OpenAI-compatible chat-completions server (vLLM, Ollama, llama.cpp, OpenAI)."""
+
+    base_url: str = Field(
+        "http://127.0.0.1:8000/v1", description="server URL up to /v1 (chat/completions is added)"
+    )
+    model: str = Field("", description="model name the server serves (required for vlm back ends)")
+    api_key_env: str = Field(
+        "PMNAV_VLM_API_KEY", description="environment variable holding the API key (never logged)"
+    )
+    timeout_s: float = Field(60.0, gt=0.0, description="seconds per HTTP request")
+    retries: int = Field(3, ge=0, description="retries after a 429, a 5xx or a dropped connection")
+    backoff_s: float = Field(1.0, ge=0.0, description="first retry delay, doubled each retry")
+    max_tokens: int = Field(1024, ge=1, description="most tokens an answer may have")
+    temperature: float = Field(0.0, ge=0.0, le=2.0, description="sampling temperature")
+    prompt: Literal["h-pm", "h-em", "o-em"] = Field(
+        "h-pm", description="planning prompt: H-CoT + annotated map, H-CoT + raw map, ordinary"
+    )
+    plan_tries: int = Field(
+        3, ge=1, description="VLM answers per plan (the first, then re-prompts quoting errors)"
+    )
+    fallback: bool = Field(
+        True, description="plan with the graph planner when no VLM answer is valid or it fails"
+    )
+    image_px: int = Field(1280, ge=64, description="long side of the map image sent, pixels")
+    usage_log: str = Field("", description="append one JSON line per call here (tokens, latency)")
+
+
 class TreeConfig(_Section):
     variant: Literal["pmnav", "coarse_only"] = Field(
         "pmnav", description="coarse_only: no grounding or refinement (paper Table 4)"
@@ -160,6 +188,7 @@ class Config(_Section):
     refiner: RefinerConfig = RefinerConfig()
     planner: PlannerConfig = PlannerConfig()
     tree: TreeConfig = TreeConfig()
+    vlm: VlmConfig = VlmConfig()
     sim: SimConfig = SimConfig()
 
 

@@ -124,6 +124,11 @@ COARSE = Registry(
             "pmnav_bt.perception.coarse:build_detector",
             "ground the target in every view, take the best score",
         ),
+        BackendSpec(
+            "vlm",
+            "pmnav_bt.vlm.coarse:build",
+            "a VLM picks the view from the stitched panorama (OpenAI-compatible server)",
+        ),
     ],
 )
 REFINERS = Registry(
@@ -143,6 +148,11 @@ PLANNERS = Registry(
             "graph",
             "pmnav_bt.planning.graph_planner:build",
             "shortest path on the priori-map graph",
+        ),
+        BackendSpec(
+            "vlm",
+            "pmnav_bt.vlm.planner:build",
+            "a VLM plans with the H-CoT prompt; checked against the map, graph fallback",
         ),
     ],
 )

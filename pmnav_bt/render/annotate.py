@@ -456,6 +456,37 @@ def render_annotated_map(
     return img
 
 
+def render_environment_map(
+    pm: PrioriMap,
+    *,
+    scale_px_per_m: float | None = None,
+    floor_plan: FloorPlanImage | None = None,
+    base_dir: str | Path = ".",
+) -> np.ndarray:
+    """The raw environmental map (BGR), as the paper's O-EM/H-EM baselines see it: the floor
+    plan (or the clean drawing) with only what a printed plan shows, room numbers at their
+    rooms, a north arrow and a scale bar; no waypoints, segments or landmark tags."""
+    canvas = make_canvas(pm, scale_px_per_m)
+    if floor_plan is None:
+        floor_plan = load_floor_plan(pm.building, base_dir)
+    img = np.full((canvas.height, canvas.width, 3), 255, dtype=np.uint8)
+    if floor_plan is not None:
+        _draw_plan_background(img, floor_plan, canvas)
+    else:
+        _draw_building(img, pm, canvas)
+    for f, w in _room_widths(pm):
+        centre = canvas.to_px([_room_box(f, w).mean(axis=0)])[0]
+        (tw, th), _ = cv2.getTextSize(f.room, FONT, 0.45, 1)
+        org = (int(centre[0] - tw / 2), int(centre[1] + th / 2))
+        put_text(img, f.room, org, 0.45, (20, 20, 20))
+    top = canvas.map_top + canvas.map_height
+    img[top:] = 255
+    _draw_north_arrow(img, (28, top + 56))
+    _draw_scale_bar(img, canvas, (60, top + 50))
+    put_text(img, f"Floor plan: {pm.building.name}", (10, 30), TITLE_SCALE, (30, 30, 30), 2)
+    return img
+
+
 def _draw_plan_background(img: np.ndarray, plan: FloorPlanImage, canvas: Canvas) -> None:
     """Warp the plan image into the map area of the canvas."""
     to_canvas = np.vstack([canvas.affine(), [0.0, 0.0, 1.0]])
