@@ -92,9 +92,11 @@ def test_client_errors_are_not_retried_and_say_what_to_check():
 
 
 def test_a_body_that_is_not_json_is_a_vlm_error():
-    with ChatServer(Script([Reply(body="<html>proxy error</html>")])) as s:
-        with pytest.raises(VlmError, match="not JSON"):
-            client(s)[0].chat([user_message("x")])
+    with (
+        ChatServer(Script([Reply(body="<html>proxy error</html>")])) as s,
+        pytest.raises(VlmError, match="not JSON"),
+    ):
+        client(s)[0].chat([user_message("x")])
 
 
 def test_no_server_is_a_vlm_error_after_the_retries():

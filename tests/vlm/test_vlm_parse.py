@@ -6,7 +6,11 @@ import pytest
 
 from pmnav_bt.vlm.parse import ParseFailure, RawStep, parse_plan
 
-STEPS = [RawStep("room8", "go straight"), RawStep("turn2", "turn left"), RawStep("room17", "arrive")]
+STEPS = [
+    RawStep("room8", "go straight"),
+    RawStep("turn2", "turn left"),
+    RawStep("room17", "arrive"),
+]
 JSON = (
     '{"plan": [{"landmark": "room8", "action": "go straight"}, '
     '{"landmark": "turn2", "action": "turn left"}, {"landmark": "room17", "action": "arrive"}]}'

@@ -105,7 +105,8 @@ def test_the_validator_names_the_problem(fig2_map):
 
 
 def test_the_paper_notation_is_accepted(fig2_map):
-    text = "{room8: go straight} -> {turn2: turn left}\n{turn2: turn left} -> {elevator1: go straight}"
+    text = "{room8: go straight} -> {turn2: turn left}\n"
+    text += "{turn2: turn left} -> {elevator1: go straight}"
     text += " -> {branch1: turn right} -> {room17: arrive}"
     with ChatServer(Script([Reply(text)])) as s:
         p = planner(s, fallback=False).plan(fig2_map, START, "room17")
