@@ -126,6 +126,9 @@ class VlmConfig(_Section):
     )
     image_px: int = Field(1280, ge=64, description="long side of the map image sent, pixels")
     usage_log: str = Field("", description="append one JSON line per call here (tokens, latency)")
+    plan_log: str = Field(
+        "", description="append one JSON line per plan here (outcome, answers, issues)"
+    )
 
 
 class TreeConfig(_Section):

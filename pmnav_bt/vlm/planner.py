@@ -13,10 +13,12 @@ conversations (texts and image digests, never the API key).
 from __future__ import annotations
 
 import hashlib
+import json
 import logging
 import threading
 from collections import Counter, deque
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import networkx as nx
@@ -186,6 +188,7 @@ class VlmPlanner:
         max_gap: float = 8.0,
         image_px: int = 1280,
         keep_transcripts: int = 20,
+        plan_log: str | Path | None = None,
     ):
         if inputs not in PLAN_INPUTS:
             raise ValueError(f"inputs must be one of {PLAN_INPUTS}, got {inputs!r}")
@@ -197,6 +200,7 @@ class VlmPlanner:
         self.image_px = image_px
         self.stats = PlanStats()
         self.transcripts: deque[dict[str, Any]] = deque(maxlen=keep_transcripts)
+        self.plan_log = Path(plan_log) if plan_log else None
         self._lock = threading.Lock()
 
     def plan(
@@ -238,7 +242,22 @@ class VlmPlanner:
         return replace(plan, notes=(*plan.notes, f"fallback to the graph planner: {what}: {why}"))
 
     def _count(self, conv: Conversation) -> None:
+        outcome = (
+            "fallback" if conv.route is None and self.fallback
+            else "failed" if conv.route is None
+            else "valid_first" if len(conv.answers) == 1
+            else "repaired"
+        )  # fmt: skip
         with self._lock:
+            if self.plan_log is not None:
+                line = {
+                    "outcome": outcome,
+                    "answers": len(conv.answers),
+                    "issues": [i.kind.value for a in conv.issues for i in a],
+                    "server_error": conv.error,
+                }
+                with open(self.plan_log, "a", encoding="utf-8") as f:
+                    f.write(json.dumps(line) + "\n")
             s = self.stats
             s.plans += 1
             s.reprompts += max(0, len(conv.answers) - 1)
@@ -286,4 +305,17 @@ def build(deps) -> VlmPlanner:
         fallback=cfg.fallback,
         max_gap=deps.config.planner.max_gap,
         image_px=cfg.image_px,
+        plan_log=cfg.plan_log or None,
     )
+
+
+def summarise_plan_log(path: str | Path) -> dict[str, Any]:
+    """Counts of a plan log (written by planners in any number of processes)."""
+    out: dict[str, Any] = {"plans": 0, "issues": Counter()}
+    for line in Path(path).read_text(encoding="utf-8").splitlines():
+        d = json.loads(line)
+        out["plans"] += 1
+        out[d["outcome"]] = out.get(d["outcome"], 0) + 1
+        out["issues"].update(d["issues"])
+    out["issues"] = dict(sorted(out["issues"].items()))
+    return out

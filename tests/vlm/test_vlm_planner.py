@@ -192,3 +192,17 @@ def test_every_corruption_of_the_scripted_server_is_caught(fig2_map):
                 assert pl.plan(fig2_map, seg, room).planner == "vlm->graph"
     assert pl.stats.valid_first == 0 and pl.stats.fallbacks == pl.stats.plans == 80
     assert all(resp.counts[k] > 0 for k in resp.counts if k != "correct")
+
+
+def test_the_plan_log_counts_outcomes_across_planners(fig2_map, tmp_path):
+    from pmnav_bt.vlm.planner import summarise_plan_log
+
+    log = tmp_path / "plans.jsonl"
+    replies = [Reply("prose"), Reply(answer(GOOD)), Reply(answer(GOOD)), Reply("no")]
+    with ChatServer(Script(replies)) as s:
+        planner(s, tries=2, plan_log=log).plan(fig2_map, START, "room17")  # repaired
+        planner(s, tries=1, plan_log=log).plan(fig2_map, START, "room17")  # valid first
+        planner(s, tries=1, plan_log=log).plan(fig2_map, START, "room17")  # fallback
+    assert summarise_plan_log(log) == {
+        "plans": 3, "repaired": 1, "valid_first": 1, "fallback": 1, "issues": {"no_plan": 2},
+    }  # fmt: skip
