@@ -86,3 +86,23 @@ def test_a_hanging_server_is_a_vlm_error_after_the_timeout():
         pytest.raises(VlmError, match="no answer within 0.2 s"),
     ):
         coarse(s, timeout_s=0.2).choose(views(), Entity.room("room17"))
+
+
+def test_both_vlm_back_ends_are_registered_and_built_from_the_config(fig2_map):
+    from pmnav_bt.config import load_config
+    from pmnav_bt.registry import COARSE, PLANNERS, BackendDeps
+    from pmnav_bt.vlm.planner import VlmPlanner
+
+    cfg = load_config(
+        None,
+        [
+            "planner.backend=vlm", "coarse.backend=vlm", "vlm.model=m", "vlm.prompt=h-em",
+            "vlm.plan_tries=2", "vlm.fallback=false", "vlm.timeout_s=7",
+        ],
+    )  # fmt: skip
+    deps = BackendDeps(config=cfg, pm=fig2_map)
+    p = PLANNERS.build("vlm", deps)
+    assert isinstance(p, VlmPlanner)
+    assert (p.inputs, p.tries, p.fallback, p.client.timeout_s) == ("h-em", 2, False, 7.0)
+    c = COARSE.build("vlm", deps)
+    assert isinstance(c, VlmCoarseDirection) and c.client.model == "m"
