@@ -222,6 +222,11 @@ class VlmClient:
             ok=not error,
             error=error,
         )
+        log.info(
+            "VLM %s %s: %s prompt + %s completion tokens, %.2f s, %d tries%s",
+            self.model, purpose, u.prompt_tokens, u.completion_tokens, u.latency_s, attempts,
+            f", failed: {error}" if error else "",
+        )  # fmt: skip
         with self._lock:
             self.usage.append(u)
             if self.usage_log is not None:
