@@ -121,6 +121,9 @@ class VlmConfig(_Section):
     plan_tries: int = Field(
         3, ge=1, description="VLM answers per plan (the first, then re-prompts quoting errors)"
     )
+    max_detour: float = Field(
+        0.5, ge=0.0, description="a plan longer than the shortest by more than this is an error"
+    )
     fallback: bool = Field(
         True, description="plan with the graph planner when no VLM answer is valid or it fails"
     )

@@ -121,15 +121,11 @@ def score_transcript(pm: PrioriMap, t: dict[str, Any], margin: float) -> TaskRes
     issues: list[str] = []
     route_m = None
     for text in answers:
-        route, found = score_answer(pm, sp, t["goal"], text)
+        route, found = score_answer(pm, sp, t["goal"], text, max_detour=margin)
         issues += [i.kind.value for i in found]
-        good = route is not None and route.length <= shortest * (1.0 + margin) + 1e-6
-        if route is not None and not good:
-            issues.append("detour")
-        ok.append(good)
-        if route is not None and route_m is None:
-            route_m = round(route.length, 2)
+        ok.append(route is not None)
         if route is not None:
+            route_m = round(route.length, 2)
             break  # the conversation ended at its first valid answer
     first_ok = next((i + 1 for i, g in enumerate(ok) if g), None)
     return TaskResult(
@@ -174,7 +170,9 @@ def run_plan_eval(
             if not img_path.exists():
                 cv2.imwrite(str(img_path), map_image(pm, inp, image_px))
             sp = _start(pm, task.start)
-            conv = converse(client, pm, sp, task.goal, inp, tries, image_px=image_px)
+            conv = converse(
+                client, pm, sp, task.goal, inp, tries, image_px=image_px, max_detour=margin
+            )
             t = {
                 "version": TRANSCRIPT_VERSION,
                 "task": task.id,

@@ -82,8 +82,12 @@ def converse(
     constraints: PlanConstraints = NO_CONSTRAINTS,
     image_px: int = 1280,
     cancelled: threading.Event | None = None,
+    max_detour: float | None = None,
 ) -> Conversation:
-    """Ask for a plan; re-prompt with the issues up to ``tries`` answers in all."""
+    """Ask for a plan; re-prompt with the issues up to ``tries`` answers in all.
+
+    ``max_detour``: a valid route longer than the shortest by more than this fraction is
+    an issue too (None: any length)."""
     conv = Conversation(inputs)
     messages = plan_messages(pm, sp, goal_id, inputs, image_px)
     conv.turns.append(_turn_record(messages[0]))
@@ -108,7 +112,7 @@ def converse(
                 },
             }
         )
-        route, issues = score_answer(pm, sp, goal_id, reply.text, constraints)
+        route, issues = score_answer(pm, sp, goal_id, reply.text, constraints, max_detour)
         conv.issues.append(issues)
         if route is not None:
             conv.route = route
@@ -127,13 +131,27 @@ def score_answer(
     goal_id: str,
     text: str,
     constraints: PlanConstraints = NO_CONSTRAINTS,
+    max_detour: float | None = None,
 ) -> tuple[CheckedRoute | None, list[PlanIssue]]:
-    """Parse and check one answer: its route, or the issues."""
+    """Parse and check one answer: its route, or the issues (``max_detour``: see converse)."""
     try:
         raw = parse_plan(text)
     except ParseFailure as err:
         return None, [PlanIssue(IssueKind(err.kind), err.message)]
-    return check_plan(pm, sp, goal_id, raw, constraints)
+    route, issues = check_plan(pm, sp, goal_id, raw, constraints)
+    if route is None or max_detour is None:
+        return route, issues
+    best = graph_plan(pm, sp, goal_id, constraints, max_gap=1e9)
+    if route.length > best.length * (1.0 + max_detour) + 1e-6:
+        way = ", ".join(s.landmark for s in best.steps)
+        return None, [
+            PlanIssue(
+                IssueKind.DETOUR,
+                f"the route is {route.length:.1f} m long, more than {max_detour:.0%} longer "
+                f"than the shortest ({best.length:.1f} m, by {way}); take a shorter way",
+            )
+        ]
+    return route, []
 
 
 def _turn_record(message: dict[str, Any]) -> dict[str, Any]:
@@ -186,6 +204,7 @@ class VlmPlanner:
         tries: int = 3,
         fallback: bool = True,
         max_gap: float = 8.0,
+        max_detour: float | None = 0.5,
         image_px: int = 1280,
         keep_transcripts: int = 20,
         plan_log: str | Path | None = None,
@@ -196,6 +215,7 @@ class VlmPlanner:
         self.inputs = inputs
         self.tries = tries
         self.fallback = fallback
+        self.max_detour = max_detour
         self.max_gap = max_gap
         self.image_px = image_px
         self.stats = PlanStats()
@@ -213,7 +233,15 @@ class VlmPlanner:
         goal_id = resolve_room(pm, goal)
         sp = start_point(pm, start)
         conv = converse(
-            self.client, pm, sp, goal_id, self.inputs, self.tries, constraints, self.image_px
+            self.client,
+            pm,
+            sp,
+            goal_id,
+            self.inputs,
+            self.tries,
+            constraints,
+            self.image_px,
+            max_detour=self.max_detour,
         )
         self._count(conv)
         self.transcripts.append({"goal": goal_id, "start": sp.description, **conv.to_dict()})
@@ -304,6 +332,7 @@ def build(deps) -> VlmPlanner:
         tries=cfg.plan_tries,
         fallback=cfg.fallback,
         max_gap=deps.config.planner.max_gap,
+        max_detour=cfg.max_detour,
         image_px=cfg.image_px,
         plan_log=cfg.plan_log or None,
     )

@@ -48,6 +48,7 @@ class IssueKind(str, Enum):
     WRONG_GOAL = "wrong_goal"  # the plan does not end at the goal (with arrive)
     AVOIDED_LANDMARK = "avoided_landmark"  # a landmark the replan must avoid
     BLOCKED_SEGMENT = "blocked_segment"  # the way uses a segment found blocked
+    DETOUR = "detour"  # valid, but much longer than the shortest route
     SERVER_ERROR = "server_error"  # no answer at all (timeout, HTTP errors)
 
 

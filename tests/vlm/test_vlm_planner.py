@@ -206,3 +206,15 @@ def test_the_plan_log_counts_outcomes_across_planners(fig2_map, tmp_path):
     assert summarise_plan_log(log) == {
         "plans": 3, "repaired": 1, "valid_first": 1, "fallback": 1, "issues": {"no_plan": 2},
     }  # fmt: skip
+
+
+def test_a_detour_is_an_issue_when_a_limit_is_set(fig2_map):
+    from pmnav_bt.vlm.planner import score_answer
+
+    sp = resolve_start(fig2_map, "22,0,180")  # facing west, away from room17
+    back = [("room14", "turn around")] + GOOD  # via room14, then back east: 4 m more
+    route, issues = score_answer(fig2_map, sp, "room17", answer(back))
+    assert route is not None and not issues
+    route, issues = score_answer(fig2_map, sp, "room17", answer(back), max_detour=0.05)
+    assert route is None and [i.kind for i in issues] == [IssueKind.DETOUR]
+    assert "shorter way" in str(issues[0])
