@@ -15,7 +15,7 @@ from pathlib import Path
 
 import typer
 
-from pmnav_bt.cli_values import finite, run_cli
+from pmnav_bt.cli_values import run_cli
 from pmnav_bt.errors import BuildingFileError, PmNavError
 from pmnav_bt.loading import check_output_file
 

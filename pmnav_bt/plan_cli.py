@@ -101,6 +101,7 @@ def eval_(
     overrides: list[str] | None = typer.Option(None, "--set", help="section.key=value"),
 ) -> None:
     """Planning SR per input and tier (paper Table 2), against an OpenAI-compatible server."""
+    from pmnav_bt import cli_values
     from pmnav_bt.experiments.plan_eval import (
         correct_rule,
         plan_tasks,
@@ -109,7 +110,6 @@ def eval_(
         save_results,
         table_markdown,
     )
-    from pmnav_bt import cli_values
     from pmnav_bt.loading import check_output_dir
     from pmnav_bt.sim.cli import _buildings, _tiers
     from pmnav_bt.sim.episodes import tier_definition
