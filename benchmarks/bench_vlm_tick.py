@@ -1,13 +1,18 @@
 """Tick latency of the PM-Nav tree while a VLM call hangs.
 
-A local chat server accepts the planning request and never answers. The tree runs in
-the simulator at 10 Hz of real time with the robot's worker mode (``immediate``: jobs
-run in a worker thread during ticks), the ``vlm`` planner pointing at that server.
-Target (DESIGN.md, a tick never blocks): p99 tick < 5 ms while the call hangs; the
-call ends after ``vlm.timeout_s`` with the graph fallback (default) or, with
-``--no-fallback``, the tree fails with VLM_ERROR.
+A local chat server accepts every request and never answers. The tree runs in the
+simulator at 10 Hz of real time with the robot's worker mode (``immediate``: jobs run in
+a worker thread during ticks), with a ``vlm`` back end pointing at that server:
 
-    python benchmarks/bench_vlm_tick.py [--timeout 3] [--no-fallback]
+- ``--stage plan`` (default): the planner. The call ends after ``vlm.timeout_s`` with the
+  graph fallback, or, with ``--no-fallback``, VLM_ERROR (the tree replans, then fails);
+- ``--stage coarse``: the coarse direction (graph planner); each call ends with
+  VLM_ERROR after the timeout. Needs the CoarseDirection behaviour that calls the back
+  end in the worker (the seams migration).
+
+Target (DESIGN.md, a tick never blocks): p99 tick < 5 ms while a call hangs.
+
+    python benchmarks/bench_vlm_tick.py [--stage plan|coarse] [--timeout 3] [--no-fallback]
 """
 
 from __future__ import annotations
@@ -43,6 +48,7 @@ def pct(xs: list[float], q: float) -> float:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--stage", choices=("plan", "coarse"), default="plan")
     ap.add_argument("--timeout", type=float, default=3.0, help="vlm.timeout_s, seconds")
     ap.add_argument("--no-fallback", action="store_true", help="fail with VLM_ERROR")
     ap.add_argument("--max-seconds", type=float, default=60.0, help="wall time to run at most")
@@ -76,7 +82,14 @@ def main() -> None:
     with SimWorld(b) as world:
         base = SimBase(world, pose=ep.start_pose, width=cfg.sim.width, height=cfg.sim.height)
         ctx = make_context(base, pm, cfg, seed=0, budget=2000, deferred_work=False)
-        ctx.planner = _Planner(planner)
+        coarse = None
+        if args.stage == "plan":
+            ctx.planner = _Planner(planner)
+        else:
+            from pmnav_bt.vlm.coarse import VlmCoarseDirection
+
+            coarse = VlmCoarseDirection(client, pm.building, ctx.grounder)
+            ctx.coarse = coarse
         py_trees.blackboard.Blackboard.clear()
         tree = build_pmnav_tree(ctx, ep.goal)
         tree.setup()
@@ -87,8 +100,8 @@ def main() -> None:
             tree.tick()
             ticks.append((t0, time.perf_counter() - t0))
             status = tree.root.status
-            hang_over = requested and planner.stats.plans and t0 > requested[0] + args.timeout + 1
-            if hang_over and not args.no_fallback:
+            hang_over = requested and t0 > requested[0] + args.timeout + 1
+            if hang_over and args.stage == "plan" and planner.stats.plans and not args.no_fallback:
                 break  # the graph's plan took over: the tree drives on
             base.clock.wait(0.1)
             time.sleep(max(0.0, 0.1 - (time.perf_counter() - t0)))
@@ -97,13 +110,13 @@ def main() -> None:
         failure = py_trees.blackboard.Blackboard.storage.get("/pmnav/failure")
     hang.stop()
     if not requested:
-        raise SystemExit("the planner never called the server")
+        raise SystemExit(f"the {args.stage} back end never called the server")
     t_req = requested[0]
     during = [1e3 * d for t, d in ticks if any(r <= t <= r + args.timeout for r in requested)]
     allms = [1e3 * d for _, d in ticks]
     plan = py_trees.blackboard.Blackboard.storage.get("/pmnav/plan")
     print(
-        f"{len(requested)} VLM planning call(s), each hanging for {args.timeout:g} s "
+        f"{len(requested)} VLM {args.stage} call(s), each hanging for {args.timeout:g} s "
         "(vlm.timeout_s); tree at 10 Hz real time, immediate worker (the robot's mode), "
         "fig2_hospital, goal room17"
     )
@@ -118,7 +131,8 @@ def main() -> None:
         f"slowest tick: #{k + 1} of {len(ticks)}, {ticks[k][0] - t_req:+.2f} s from the request "
         f"(the first call hangs from 0 to {args.timeout:g} s)"
     )
-    print(f"planner: {planner.stats.to_dict()}")
+    if args.stage == "plan":
+        print(f"planner: {planner.stats.to_dict()}")
     if plan is not None:
         print(f"plan: {plan.planner}; {plan.notes[-1]}")
     print(f"tree status: {status.value}; failure: {failure}")
