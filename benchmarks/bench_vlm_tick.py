@@ -133,7 +133,7 @@ def main() -> None:
     )
     if args.stage == "plan":
         print(f"planner: {planner.stats.to_dict()}")
-    if plan is not None:
+    if plan is not None and args.stage == "plan":
         print(f"plan: {plan.planner}; {plan.notes[-1]}")
     print(f"tree status: {status.value}; failure: {failure}")
     print("target: p99 tick < 5 ms while the call hangs")
