@@ -47,7 +47,9 @@ def route(
     goal: str = typer.Option(..., "--to", help="Goal room: ID, name or alias."),
     as_json: bool = typer.Option(False, "--json", help="Print the plan as JSON."),
     image: Path | None = typer.Option(None, "--image", help="Draw the plan on the annotated map."),
-    max_gap: float = typer.Option(10.0, help="Most metres between consecutive plan steps."),
+    max_gap: float | None = typer.Option(
+        None, help="Most metres between consecutive plan steps (default: the planner's, 8)."
+    ),
     planner: str = typer.Option("graph", "--planner", help="graph or vlm (see docs/vlm.md)."),
     config: Path | None = typer.Option(None, "--config", help="A run config YAML."),
     overrides: list[str] | None = typer.Option(
@@ -61,16 +63,20 @@ def route(
     from pmnav_bt.loading import check_output_file
     from pmnav_bt.planning.graph_planner import GraphPlanner
 
-    finite(max_gap, "--max-gap", 0.1, 1000.0)
+    if max_gap is not None:
+        finite(max_gap, "--max-gap", 0.1, 1000.0)
     if image is not None:
         check_output_file(image, "--image", IMAGE_SUFFIXES)
     pm = _priori_map(file)
     if planner == "graph":
-        p = GraphPlanner(max_gap=max_gap).plan(pm, start, goal)
+        p = (GraphPlanner() if max_gap is None else GraphPlanner(max_gap=max_gap)).plan(
+            pm, start, goal
+        )
     else:
         from pmnav_bt.registry import PLANNERS, BackendDeps
 
-        cfg = load_config(config, [*(overrides or []), f"planner.max_gap={max_gap}"])
+        gap = [] if max_gap is None else [f"planner.max_gap={max_gap}"]
+        cfg = load_config(config, [*(overrides or []), *gap])
         p = PLANNERS.build(planner, BackendDeps(config=cfg, pm=pm)).plan(pm, start, goal)
     typer.echo(p.to_json() if as_json else p.text())
     if image is not None:
