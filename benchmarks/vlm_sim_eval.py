@@ -14,6 +14,7 @@ model. Without ``--endpoint`` it runs in this process.
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 import time
 from pathlib import Path
@@ -34,42 +35,28 @@ class _Planner:
 
     def plan(self, pm, start, goal, constraints=None, avoid_landmarks=(), blocked_segments=()):
         c = constraints or PlanConstraints(frozenset(avoid_landmarks), frozenset(blocked_segments))
-        if isinstance(self.inner, VlmPlanner):
+        if "constraints" in inspect.signature(self.inner.plan).parameters:
             return self.inner.plan(pm, start, goal, c)
         return self.inner.plan(pm, start, goal, c.avoid_landmarks, c.blocked_segments)
 
 
 def run_episode(ep, cfg, planner):
-    from pmnav_bt.map.building import load_building
-    from pmnav_bt.map.priori_map import parse_building
-    from pmnav_bt.sim.episodes import score_episode
-    from pmnav_bt.sim.odometry import NoisyOdometry
-    from pmnav_bt.sim.robot import SimBase
-    from pmnav_bt.sim.world import SimWorld
-    from pmnav_bt.trees.runner import action_budget, make_context, run_tree
+    """The evaluation's own episode runner, with ``planner`` put into the tree's context at
+    the first tick (localization runs first, so no plan has been asked for yet). Until the
+    runner builds the planner from ``planner.backend`` (the seams migration), this is how
+    the ``vlm`` planner gets into an episode."""
+    from pmnav_bt.experiments.evaluation import run_episode as run
 
-    b = load_building(ep.building)
-    pm = parse_building(b)
-    t0 = time.perf_counter()
-    with SimWorld(b) as world:
-        inner = SimBase(world, pose=ep.start_pose, width=cfg.sim.width, height=cfg.sim.height)
-        base = NoisyOdometry(inner, cfg.sim.odometry_noise, seed=ep.seed)
-        budget = max(ep.step_budget, action_budget(cfg, ep.geodesic_length))
-        ctx = make_context(base, pm, cfg, seed=ep.seed, budget=budget, deferred_work=True)
-        ctx.planner = _Planner(planner)
-        out = run_tree(ctx, ep.goal)
-        final, stats = inner.pose(), inner.stats
-        plans = [e for e in ctx.trace if e.kind == "plan"]
-    return score_episode(
-        pm,
-        ep,
-        (final.x, final.y),
-        path_length=stats.path_length,
-        steps=out.actions,
-        collisions=stats.collisions,
-        wall_time=time.perf_counter() - t0,
-        failure=None if out.success else str(out.failure),
-    ), len(plans)
+    wrapped = _Planner(planner)
+
+    def swap(tree) -> None:
+        for b in tree.root.iterate():
+            ctx = getattr(b, "ctx", None)
+            if ctx is not None and ctx.planner is not wrapped:
+                ctx.planner = wrapped
+                return
+
+    return run(ep, cfg, out_dir=None, on_tick=swap, plot=False).result
 
 
 def main() -> None:
@@ -105,10 +92,9 @@ def main() -> None:
         for ep in eps:
             row = {"episode": ep.id, "tier": ep.tier}
             for name, planner in (("graph", graph), ("vlm", vlm)):
-                res, plans = run_episode(ep, cfg, planner)
+                res = run_episode(ep, cfg, planner)
                 row[name] = res.success
                 row[f"{name}_failure"] = res.failure_reason
-                row[f"{name}_plans"] = plans
             rows.append(row)
             print(
                 f"{ep.id:<28} graph {'ok' if row['graph'] else 'FAIL':<4} "
