@@ -71,8 +71,8 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("out/vlm_sim_eval"))
     args = ap.parse_args()
 
+    from pmnav_bt.experiments.sim_cli import _buildings, _tiers
     from pmnav_bt.planning.graph_planner import GraphPlanner
-    from pmnav_bt.sim.cli import _buildings, _tiers
     from pmnav_bt.sim.episodes import tier_definition
 
     cfg = load_config()

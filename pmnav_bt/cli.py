@@ -143,39 +143,6 @@ def map_(
         typer.echo(f"wrote {image}", err=True)
 
 
-@app.command()
-def plan(
-    file: str = typer.Argument(..., help=FILE_HELP),
-    start: str = typer.Option(
-        ...,
-        "--from",
-        help="Start: a segment (seg13), a waypoint or room ID, or a pose 'x,y[,yaw_deg]'.",
-    ),
-    goal: str = typer.Option(..., "--to", help="Goal room: ID, name or alias."),
-    as_json: bool = typer.Option(False, "--json", help="Print the plan as JSON."),
-    image: Path | None = typer.Option(None, "--image", help="Draw the plan on the annotated map."),
-    max_gap: float | None = typer.Option(
-        None, help="Most metres between consecutive plan steps (default: the planner's, 8)."
-    ),
-) -> None:
-    """Plan from a start to a goal room: ordered {landmark: action} steps."""
-    from pmnav_bt.planning.graph_planner import GraphPlanner
-
-    if max_gap is not None:
-        finite(max_gap, "--max-gap", 0.1, 1000.0)
-    if image is not None:
-        check_output_file(image, "--image", IMAGE_SUFFIXES)
-    pm = _priori_map(file)
-    planner = GraphPlanner() if max_gap is None else GraphPlanner(max_gap=max_gap)
-    p = planner.plan(pm, start, goal)
-    typer.echo(p.to_json() if as_json else p.text())
-    if image is not None:
-        from pmnav_bt.render.annotate import render_annotated_map
-
-        render_annotated_map(pm, path=image, path_xy=list(p.path), base_dir=_folder(file))
-        typer.echo(f"wrote {image}", err=True)
-
-
 @app.command("map-draft")
 def map_draft(
     grid: Path = typer.Argument(..., help="A ROS map_server YAML (its PGM beside it)."),

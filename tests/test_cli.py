@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from pmnav_bt.cli import main
+from pmnav_bt.experiments.cli import main  # the pmnav program (with pmnav plan)
 
 
 def run(capsys, *argv) -> tuple[int, str, str]:

@@ -1,5 +1,6 @@
 """The ``pmnav`` program: the core commands (``pmnav_bt.cli``) with the simulator's
-(``pmnav sim``) and the tree's (``pmnav tree``) mounted on them.
+(``pmnav sim``), the tree's (``pmnav tree``) and planning's (``pmnav plan``: a route, and
+the Table 2 evaluation over the simulator's episodes) mounted on them.
 
 This is where the command line joins simulator, tree and metrics, so it lives in the
 experiments layer; the core CLI knows neither. Each sub-app imports only typer at module
@@ -10,9 +11,11 @@ from __future__ import annotations
 
 from pmnav_bt.cli import app
 from pmnav_bt.cli import main as _run
+from pmnav_bt.experiments.plan_cli import app as plan_app
 from pmnav_bt.experiments.sim_cli import app as sim_app
 from pmnav_bt.trees.cli import app as tree_app
 
+app.add_typer(plan_app, name="plan")
 app.add_typer(sim_app, name="sim")
 app.add_typer(tree_app, name="tree")
 

@@ -116,8 +116,8 @@ def eval_(
         save_results,
         table_markdown,
     )
+    from pmnav_bt.experiments.sim_cli import _buildings, _tiers
     from pmnav_bt.loading import check_output_dir
-    from pmnav_bt.sim.cli import _buildings, _tiers
     from pmnav_bt.sim.episodes import tier_definition
 
     cli_values.finite(margin, "--margin", 0.0, 10.0)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from pmnav_bt.cli import main
+from pmnav_bt.experiments.cli import main
 from pmnav_bt.vlm.prompts import template
 from pmnav_bt.vlm.scripted_server import ChatServer, PlanningResponder
 
