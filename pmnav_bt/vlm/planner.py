@@ -21,12 +21,11 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-import networkx as nx
 import numpy as np
 
 from pmnav_bt.errors import VlmError
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.planning.graph_planner import build_plan, graph_segment, shortest_route
+from pmnav_bt.planning.graph_planner import MAX_GAP_M, GraphPlanner, build_plan
 from pmnav_bt.planning.plan import Plan
 from pmnav_bt.planning.resolve import StartPoint, resolve_room, resolve_start
 from pmnav_bt.seams import PlanConstraints, Pose2D
@@ -203,7 +202,7 @@ class VlmPlanner:
         inputs: str = "h-pm",
         tries: int = 3,
         fallback: bool = True,
-        max_gap: float = 8.0,
+        max_gap: float = MAX_GAP_M,
         max_detour: float | None = 0.5,
         image_px: int = 1280,
         keep_transcripts: int = 20,
@@ -310,17 +309,8 @@ def graph_plan(
     max_gap: float,
     name: str = "graph",
 ) -> Plan:
-    """The graph planner's plan (shortest route, blocked segments left out)."""
-    graph = pm.graph
-    if constraints.blocked_segments:
-        graph = nx.subgraph_view(
-            pm.graph,
-            filter_edge=lambda u, v: graph_segment(pm, u, v) not in constraints.blocked_segments,
-        )
-    nodes, length, start_xy = shortest_route(pm, sp, pm.places[goal_id].node, graph)
-    return build_plan(
-        pm, sp, goal_id, nodes, length, start_xy, max_gap, name, constraints.avoid_landmarks
-    )
+    """The graph planner's plan (shortest route, constraints kept), named ``name``."""
+    return replace(GraphPlanner(max_gap=max_gap).plan(pm, sp, goal_id, constraints), planner=name)
 
 
 def build(deps) -> VlmPlanner:
