@@ -402,7 +402,14 @@ def building_from_data(data: Any, source: str = "<data>", base_dir: Path | None 
 
 
 def load_building(path: str | Path) -> Building:
-    """Read and validate a building file (or a built-in building's name)."""
+    """Read and validate a building file (or a built-in building's name, or a generated
+    family's: "sign_sparse_<seed>")."""
+    if isinstance(path, str) and not Path(path).exists():
+        from pmnav_bt.map.generate import generated_family  # generate imports this module
+
+        generated = generated_family(path)
+        if generated is not None:
+            return generated
     path = resolve_building_path(path)
     try:
         data = load_yaml(path, "building")

@@ -27,14 +27,26 @@ def generate_building(
     loop_fraction: float = 0.15,
     corridor_width: float = 2.4,
     name: str | None = None,
+    doors_per_corridor: int | None = None,
+    bare_fraction: float = 0.0,
+    n_landmarks: int = 4,
+    min_side: int = 2,
+    wing_signs: bool = False,
 ) -> Building:
-    """A valid building with exactly ``n_rooms`` rooms; the same seed gives the same building."""
+    """A valid building with exactly ``n_rooms`` rooms; the same seed gives the same building.
+
+    ``doors_per_corridor`` caps the doors on one corridor (placed from its first end, so
+    the rest of it stays bare); ``bare_fraction`` of the corridors get no door at all (the
+    sign-sparse family); ``n_landmarks`` elevators and stairs are spread over junctions;
+    ``min_side`` junctions per side of the grid at least; ``wing_signs``: signs numbered
+    per corridor with a wing letter ("A101", "B101", ...), near-identical across wings.
+    """
     if n_rooms < 1:
         raise ValueError("n_rooms must be at least 1")
     rng = random.Random(seed)
     per_edge = max(1, int((spacing - 2 * JUNCTION_CLEARANCE) / ROOM_PITCH) + 1)
     # Grid big enough that a spanning tree (n-1 edges) holds all rooms.
-    side = 2
+    side = max(2, min_side)
     while side * side - 1 < math.ceil(n_rooms / per_edge) + 1:
         side += 1
     grid = nx.grid_2d_graph(side, side)
@@ -70,30 +82,37 @@ def generate_building(
         waypoints.append({"id": ids[n], "kind": kind, "pos": list(pos[n])})
 
     edges, rooms = [], []
-    for u, v in sorted(g.edges, key=lambda e: (str(e[0]), str(e[1]))):
+    corridors = sorted(g.edges, key=lambda e: (str(e[0]), str(e[1])))
+    n_bare = int(bare_fraction * len(corridors))
+    bare = set(rng.sample(range(len(corridors)), n_bare)) if n_bare else set()
+    for ci, (u, v) in enumerate(corridors):
         edges.append([ids[u], ids[v]])
-        if len(rooms) >= n_rooms:
+        if len(rooms) >= n_rooms or ci in bare:
             continue
+        placed = 0
         (x0, y0), (x1, y1) = pos[u], pos[v]
         length = math.hypot(x1 - x0, y1 - y0)
         ux, uy = (x1 - x0) / length, (y1 - y0) / length
         s = JUNCTION_CLEARANCE
         side_sign = 1.0
         while s <= length - JUNCTION_CLEARANCE and len(rooms) < n_rooms:
+            if doors_per_corridor is not None and placed >= doors_per_corridor:
+                break
+            placed += 1
             k = len(rooms) + 1
             off = side_sign * corridor_width / 2.0
             door = [round(x0 + ux * s - uy * off, 3), round(y0 + uy * s + ux * off, 3)]
-            rooms.append(
-                {"id": f"room{k}", "name": f"Room {k}", "door": door, "sign": str(100 + k)}
-            )
+            sign = f"{chr(ord('A') + ci % 26)}{100 + placed}" if wing_signs else str(100 + k)
+            rooms.append({"id": f"room{k}", "name": f"Room {k}", "door": door, "sign": sign})
             s += ROOM_PITCH
             side_sign = -side_sign
-    if len(rooms) < n_rooms:  # cannot happen with the sizing above; keep it loud if it does
+    if len(rooms) < n_rooms and doors_per_corridor is None and not bare:
+        # cannot happen with the sizing above; keep it loud if it does
         raise RuntimeError(f"generator placed {len(rooms)} of {n_rooms} rooms")
 
     landmarks = []
     junctions = [n for n in sorted(g, key=str) if g.degree(n) >= 2]
-    for i, n in enumerate(junctions[:: max(1, len(junctions) // 4)][:4]):
+    for i, n in enumerate(junctions[:: max(1, len(junctions) // 4)][:n_landmarks]):
         kind = ("elevator", "stairs")[i % 2]
         x, y = pos[n]
         landmarks.append(
@@ -116,6 +135,35 @@ def generate_building(
         "landmarks": landmarks,
     }
     return building_from_data(data, source=data["name"])
+
+
+SIGN_SPARSE_FAMILY = "sign_sparse"
+
+
+def generate_sign_sparse(seed: int = 0) -> Building:
+    """The sign-sparse family (issue 15, paper Table 3): 30 m grid corridors, about 40 %
+    of them without a single door, at most three doors on the others (all near one end),
+    one elevator, and wing-numbered near-identical signs (A101, B101, ...)."""
+    return generate_building(
+        n_rooms=14,
+        seed=seed,
+        spacing=30.0,
+        loop_fraction=0.2,
+        name=f"{SIGN_SPARSE_FAMILY}_{seed}",
+        doors_per_corridor=3,
+        bare_fraction=0.4,
+        n_landmarks=1,
+        min_side=3,
+        wing_signs=True,
+    )
+
+
+def generated_family(name: str) -> Building | None:
+    """The generated building a name such as "sign_sparse_3" denotes, or None."""
+    stem, _, seed = name.rpartition("_")
+    if stem == SIGN_SPARSE_FAMILY and seed.isdigit():
+        return generate_sign_sparse(int(seed))
+    return None
 
 
 def _merge_straight_runs(g: nx.Graph) -> nx.Graph:

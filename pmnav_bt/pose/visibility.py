@@ -1,0 +1,191 @@
+"""Which landmarks the priori-map says are readable from a point of the corridors.
+
+A sign is readable from a point when the straight line to it stays inside the corridors
+(walls block the view) and it is no farther than ``READ_RANGE_M``. Every sign is on a
+corridor wall, so the check uses a point just in front of the wall. The counts along the
+corridor centre lines, on a ``LATTICE_M`` lattice, tell active localization where signs
+are and class start poses by landmark density (paper, Table 3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+from functools import cached_property
+
+import networkx as nx
+import numpy as np
+import shapely
+
+from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.planning.resolve import entity_position
+from pmnav_bt.seams import Entity
+
+READ_RANGE_M = 9.5  # a sign is read up to about this far (checked against the sim grounder)
+WALL_INSET_M = 0.3  # the sight line ends this far in front of the wall
+LATTICE_M = 0.5  # spacing of the lattice points along the corridor centre lines
+
+
+def entity_xy(pm: PrioriMap, entity: Entity) -> tuple[float, float]:
+    """Where the map puts a room's door or a landmark's face on the wall."""
+    return entity_position(pm, f"{entity.kind.value}:{entity.id}")
+
+
+def map_entities(pm: PrioriMap) -> list[Entity]:
+    """Every room and landmark of the building (each has a sign)."""
+    b = pm.building
+    return [Entity.room(r.id) for r in b.rooms] + [Entity.landmark(lm.id) for lm in b.landmarks]
+
+
+class LandmarkDensity(str, Enum):
+    """Start poses by the landmarks readable from them (paper, Table 3)."""
+
+    REDUNDANT = "redundant"  # more than 2
+    MINIMAL = "minimal"  # exactly 2
+    SCARCE = "scarce"  # 0 or 1
+
+
+def density_class(n_readable: int) -> LandmarkDensity:
+    if n_readable > 2:
+        return LandmarkDensity.REDUNDANT
+    return LandmarkDensity.MINIMAL if n_readable == 2 else LandmarkDensity.SCARCE
+
+
+@dataclass(frozen=True)
+class LatticePoint:
+    """A point on a corridor centre line: its segment, position and the signs readable there."""
+
+    index: int
+    segment: int  # 1-based, as in the priori-map
+    xy: tuple[float, float]
+    readable: frozenset[Entity]
+
+
+class Visibility:
+    """The map's prediction of what is readable where (built once per priori-map)."""
+
+    def __init__(self, pm: PrioriMap, read_range: float = READ_RANGE_M, lattice: float = LATTICE_M):
+        self.pm = pm
+        self.read_range = read_range
+        self.lattice = lattice
+        self.entities = map_entities(pm)
+        self._xy = np.array([entity_xy(pm, e) for e in self.entities], dtype=float).reshape(-1, 2)
+        self._eye = np.array([self._inset(p) for p in self._xy]).reshape(-1, 2)
+
+    @classmethod
+    def of(cls, pm: PrioriMap) -> Visibility:
+        """The cached Visibility of ``pm``."""
+        v = pm.__dict__.get("_visibility")
+        if v is None:
+            v = pm.__dict__["_visibility"] = cls(pm)
+        return v
+
+    @cached_property
+    def corridors(self):
+        """The corridor floor as one polygon (each segment buffered by half its width)."""
+        pm = self.pm
+        parts = [
+            shapely.buffer(
+                shapely.LineString([pm.nodes[s.a].pos, pm.nodes[s.b].pos]),
+                s.width / 2.0,
+                cap_style="square",
+            )
+            for s in pm.segments
+        ]
+        poly = shapely.union_all(parts)
+        shapely.prepare(poly)
+        return poly
+
+    def _inset(self, p: np.ndarray) -> np.ndarray:
+        loc = self.pm.locate(float(p[0]), float(p[1]))
+        c = loc.point(self.pm)
+        d = c - p
+        n = float(np.linalg.norm(d))
+        return c if n < 1e-6 else p + d * min(1.0, WALL_INSET_M / n)
+
+    def readable_from(self, xy) -> frozenset[Entity]:
+        """The entities whose signs can be read from ``xy`` (a full turn on the spot)."""
+        p = np.asarray(xy, dtype=float)
+        if not len(self.entities):
+            return frozenset()
+        near = np.nonzero(np.linalg.norm(self._xy - p, axis=1) <= self.read_range)[0]
+        if not len(near):
+            return frozenset()
+        lines = shapely.linestrings(
+            np.stack([np.broadcast_to(p, (len(near), 2)), self._eye[near]], 1)
+        )
+        ok = shapely.covers(self.corridors, lines)
+        return frozenset(self.entities[i] for i, k in zip(near, ok, strict=True) if k)
+
+    def n_readable(self, xy) -> int:
+        return len(self.readable_from(xy))
+
+    def density(self, xy) -> LandmarkDensity:
+        return density_class(self.n_readable(xy))
+
+    @cached_property
+    def lattice_points(self) -> list[LatticePoint]:
+        """Points every ``lattice`` metres along each segment, ends included."""
+        pts: list[LatticePoint] = []
+        for s in self.pm.segments:
+            a, b = self.pm.node_xy(s.a), self.pm.node_xy(s.b)
+            n = max(1, int(np.ceil(s.length / self.lattice)))
+            for k in range(n + 1):
+                xy = a + (b - a) * (k / n)
+                pts.append(
+                    LatticePoint(
+                        len(pts), s.index, (float(xy[0]), float(xy[1])), self.readable_from(xy)
+                    )
+                )
+        return pts
+
+    @cached_property
+    def lattice_xy(self) -> np.ndarray:
+        return np.array([p.xy for p in self.lattice_points], dtype=float)
+
+    @cached_property
+    def lattice_graph(self) -> nx.Graph:
+        """Lattice points joined along each segment, and wherever two lie on one spot (nodes)."""
+        g = nx.Graph()
+        pts = self.lattice_points
+        for p in pts:
+            g.add_node(p.index)
+        for p, q in zip(pts, pts[1:], strict=False):
+            if p.segment == q.segment:
+                g.add_edge(p.index, q.index, length=float(np.hypot(*np.subtract(p.xy, q.xy))))
+        xy = self.lattice_xy
+        tree = shapely.STRtree(shapely.points(xy))
+        for i, j in tree.query(shapely.points(xy), predicate="dwithin", distance=1e-3).T:
+            if i < j:
+                g.add_edge(int(i), int(j), length=0.0)
+        return g
+
+    def nearest_lattice(self, xy) -> int:
+        return int(self.nearest_many(np.asarray(xy, dtype=float).reshape(1, 2))[0][0])
+
+    @cached_property
+    def _lattice_tree(self):
+        return shapely.STRtree(shapely.points(self.lattice_xy))
+
+    def nearest_many(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """For (N, 2) points: the nearest lattice point of each and the distance to it."""
+        pairs, dist = self._lattice_tree.query_nearest(
+            shapely.points(xy), all_matches=False, return_distance=True
+        )
+        idx = np.empty(len(xy), dtype=int)
+        out = np.empty(len(xy))
+        idx[pairs[0]] = pairs[1]
+        out[pairs[0]] = dist
+        return idx, out
+
+    @cached_property
+    def towards_signs(self) -> tuple[dict[int, float], dict[int, int]]:
+        """For each lattice point: the corridor distance to the nearest point where at least
+        two signs are readable, and the next lattice point on the way there."""
+        g = self.lattice_graph
+        good = [p.index for p in self.lattice_points if len(p.readable) >= 2]
+        if not good:
+            return {}, {}
+        dist, paths = nx.multi_source_dijkstra(g, good, weight="length")
+        nxt = {i: (path[-2] if len(path) > 1 else i) for i, path in paths.items()}
+        return dist, nxt

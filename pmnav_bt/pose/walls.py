@@ -1,0 +1,88 @@
+"""The corridor axis from the walls seen in depth.
+
+Wall pixels are projected to the floor plane (walls are vertical, so every height of a
+wall lands on one line); a RANSAC line fit on those points gives the wall's direction in
+the body frame. Corridor walls run along the corridor axis, so the angle is the robot's
+heading relative to the axis, modulo pi: a heading constraint available almost
+everywhere in a functional building.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.seams import Observation
+
+MAX_RANGE_M = 6.0  # wall points farther than this are too noisy
+MIN_INLIERS = 60
+INLIER_M = 0.05
+ITERATIONS = 60
+
+
+def wall_points(obs: Observation, wall: np.ndarray, stride: int = 2) -> np.ndarray:
+    """(N, 2) floor-plane points (x forward, y left, metres) of the wall pixels in view."""
+    if obs.depth is None:
+        return np.zeros((0, 2))
+    k = obs.intrinsics
+    vs, us = np.nonzero(wall[::stride, ::stride])
+    vs, us = vs * stride, us * stride
+    z = obs.depth[vs, us].astype(float)
+    keep = np.isfinite(z) & (z > 0.2) & (z < MAX_RANGE_M)
+    z, us = z[keep], us[keep]
+    return np.stack([z, (k.cx - us) * z / k.fx], axis=1)
+
+
+def fit_wall_angle(points: np.ndarray, seed: int = 0) -> tuple[float, int] | None:
+    """The direction (rad, in (-pi/2, pi/2], body frame) of the best line through ``points``
+    and its inlier count, or None when no line has ``MIN_INLIERS`` points."""
+    n = len(points)
+    if n < MIN_INLIERS:
+        return None
+    rng = np.random.default_rng(seed)
+    best_in: np.ndarray | None = None
+    for _ in range(ITERATIONS):
+        i, j = rng.choice(n, 2, replace=False)
+        d = points[j] - points[i]
+        norm = float(np.hypot(*d))
+        if norm < 0.3:
+            continue
+        normal = np.array([-d[1], d[0]]) / norm
+        inl = np.abs((points - points[i]) @ normal) < INLIER_M
+        if best_in is None or inl.sum() > best_in.sum():
+            best_in = inl
+    if best_in is None or best_in.sum() < MIN_INLIERS:
+        return None
+    p = points[best_in]
+    p = p - p.mean(axis=0)
+    _, _, vt = np.linalg.svd(p, full_matrices=False)
+    a = math.atan2(vt[0, 1], vt[0, 0])
+    return wrap_angle(2.0 * a) / 2.0, int(best_in.sum())
+
+
+def wall_angle(obs: Observation, wall: np.ndarray) -> float | None:
+    """The wall direction in the body frame (mod pi) from one frame, or None."""
+    fit = fit_wall_angle(wall_points(obs, wall))
+    return None if fit is None else fit[0]
+
+
+def axis_in_odom(angles: list[tuple[float, float, int]]) -> float | None:
+    """Combine (view odometry yaw, wall angle in that view, inliers) into one corridor axis
+    in the odometry frame (mod pi): the inlier-weighted circular mean of the doubled angles,
+    over the views that agree with the strongest one (walls of side corridors disagree)."""
+    if not angles:
+        return None
+    dirs = [(wrap_angle(2.0 * (yaw + a)), n) for yaw, a, n in angles]
+    ref = max(dirs, key=lambda d: d[1])[0]
+    agree = [(d, n) for d, n in dirs if abs(wrap_angle(d - ref)) < math.radians(30.0)]
+    s = sum(n * math.sin(d) for d, n in agree)
+    c = sum(n * math.cos(d) for d, n in agree)
+    return math.atan2(s, c) / 2.0
+
+
+def heading_correction(axis_odom: float, rotation: float, corridor_heading: float) -> float:
+    """The rotation to add to ``map_T_odom`` so that the wall axis measured in odometry
+    (``axis_odom``, mod pi) lines up with the corridor's heading on the map, in (-pi/2, pi/2]."""
+    return wrap_angle(2.0 * (corridor_heading - (axis_odom + rotation))) / 2.0

@@ -1,0 +1,117 @@
+"""The corridor belief: fixes from what was seen, kept across glimpses, and where to go."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pmnav_bt.geometry import se2_apply, se2_compose, se2_inverse
+from pmnav_bt.map.building import load_building
+from pmnav_bt.map.generate import generate_sign_sparse
+from pmnav_bt.map.priori_map import parse_building
+from pmnav_bt.pose.belief import CorridorBelief, Glimpse
+from pmnav_bt.pose.visibility import Visibility, entity_xy
+from pmnav_bt.seams import Pose2D
+
+ODOM_T_MAP = (3.0, -2.0, 0.7)  # the odometry frame is anywhere
+
+
+def glimpse(pm, true: tuple[float, float, float], entities, blocked=None) -> Glimpse:
+    odom = se2_compose(ODOM_T_MAP, true)
+    seen = {e: tuple(se2_apply(ODOM_T_MAP, entity_xy(pm, e))) for e in entities}
+    return Glimpse(Pose2D(*odom), seen, blocked)
+
+
+@pytest.fixture(scope="module")
+def fig2():
+    return parse_building(load_building("fig2_hospital"))
+
+
+def _points(pm, n_readable):
+    vis = Visibility.of(pm)
+    return [p for p in vis.lattice_points if len(p.readable) == n_readable]
+
+
+@pytest.mark.parametrize("n", [1, 2, 3])
+def test_signs_seen_where_the_map_says_fix_the_pose(fig2, n):
+    for p in _points(fig2, n)[::9]:
+        true = (*p.xy, fig2.segments[p.segment - 1].heading)
+        b = CorridorBelief(fig2)
+        b.observe(glimpse(fig2, true, p.readable))
+        fix = b.fix()
+        assert fix is not None, p
+        np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=0.5)
+        assert abs(math.remainder(fix[0][2] - se2_inverse(ODOM_T_MAP)[2], 2 * math.pi)) < 0.05
+
+
+def test_nothing_seen_is_no_fix():
+    pm = parse_building(generate_sign_sparse(0))
+    p = _points(pm, 0)[0]
+    b = CorridorBelief(pm)
+    b.observe(glimpse(pm, (*p.xy, pm.segments[p.segment - 1].heading), ()))
+    assert b.fix() is None
+
+
+def test_sightings_of_earlier_glimpses_are_kept():
+    pm = parse_building(generate_sign_sparse(1))
+    vis = Visibility.of(pm)
+    # Two points of one segment, each reading one (different) sign only.
+    singles = [p for p in vis.lattice_points if len(p.readable) == 1]
+    pair = next(
+        (p, q)
+        for p in singles
+        for q in singles
+        if p.segment == q.segment and p.readable != q.readable
+    )
+    b = CorridorBelief(pm)
+    for p in pair:
+        b.observe(glimpse(pm, (*p.xy, pm.segments[p.segment - 1].heading), p.readable))
+    assert len(b.glimpses) == 2
+    fix = b.fix()
+    assert fix is not None
+    np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=0.5)
+
+
+def _drive(pm, xy, map_heading: float, distance: float):
+    """Move ``distance`` along a heading, staying on the corridor centre lines."""
+    p = np.asarray(xy, dtype=float)
+    for _ in range(int(distance / 0.25)):
+        q = p + 0.25 * np.array([math.cos(map_heading), math.sin(map_heading)])
+        loc = pm.locate(*q)
+        if loc.offset > 0.3:  # a wall or a dead end ahead
+            break
+        p = loc.point(pm)
+    return p
+
+
+def test_from_a_bare_stretch_following_the_lead_finds_signs_and_a_fix():
+    pm = parse_building(generate_sign_sparse(0))
+    vis = Visibility.of(pm)
+    starts = [p for p in vis.lattice_points if not p.readable][::12]
+    fixed = 0
+    for p in starts:
+        yaw = pm.segments[p.segment - 1].heading
+        xy = np.array(p.xy)
+        b = CorridorBelief(pm)
+        blocked = None
+        for _ in range(12):
+            g = glimpse(pm, (*xy, yaw), vis.readable_from(xy), blocked)
+            b.observe(g)
+            if b.fix() is not None:
+                break
+            lead = b.lead(g.odom)
+            assert lead is not None
+            # Only along the corridor axis or across it (at a junction).
+            rel = math.remainder(lead.heading - g.odom.yaw, math.pi / 2)
+            assert abs(rel) < 1e-6
+            yaw = lead.heading - ODOM_T_MAP[2]
+            moved = _drive(pm, xy, yaw, lead.distance)
+            blocked = lead.heading if np.linalg.norm(moved - xy) < lead.distance - 0.3 else None
+            xy = moved
+        fix = b.fix()
+        if fix is not None:
+            np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=0.5)
+            fixed += 1
+    assert fixed >= 0.9 * len(starts), (fixed, len(starts))
