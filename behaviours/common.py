@@ -36,6 +36,8 @@ KEYS = (
     "replans",  # int
     "failure",  # Failure: why the last thing failed (its ``cause``: the failure recovered from)
     "recovering_from",  # Failure | None: what the recovery under way started from
+    "belief",  # CorridorBelief | None: where on the corridors, while localizing
+    "pose_tracker",  # PoseTracker: map_T_odom's uncertainty, for verification and snapping
 )
 
 

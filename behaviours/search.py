@@ -16,7 +16,8 @@ from pmnav_bt.localization import Sighting, fix_pose
 from pmnav_bt.planning.resolve import entity_position, step_entity
 from pmnav_bt.seams import CoarseChoice, Entity, View
 
-# How far (m) a sighting may be from where the map puts the target and still be it.
+# How far (m) a sighting may be from where the map puts the target and still be it, when
+# no pose tracker says how uncertain the estimate is (it does after a fix).
 VERIFY_TOLERANCE = 3.0
 # How much of a verified sighting's disagreement with the map goes into map_T_odom.
 CORRECTION_GAIN = 0.9
@@ -198,15 +199,16 @@ class FineDirection(PmNavBehaviour):
 class Verify(PmNavBehaviour):
     """Verify the sighting against the map, then correct the pose estimate with it.
 
-    Reads ``sighting``, ``map_T_odom``, ``recent_sightings``; writes ``map_T_odom``,
-    ``recent_sightings``. A sighting farther than VERIFY_TOLERANCE from where the map
-    puts the target is a wrong landmark (FAILURE, TARGET_NOT_FOUND), so the search
-    runs again. A verified one re-fits ``map_T_odom`` on the last few verified
+    Reads ``sighting``, ``map_T_odom``, ``recent_sightings``, ``pose_tracker``; writes
+    ``map_T_odom``, ``recent_sightings``, ``pose_tracker``. A sighting farther from where
+    the map puts the target than the pose uncertainty allows (the tracker's tolerance, or
+    VERIFY_TOLERANCE without one) is a wrong landmark (FAILURE, TARGET_NOT_FOUND), so the
+    search runs again. A verified one re-fits ``map_T_odom`` on the last few verified
     sightings (position and heading), or shifts it towards this one alone.
     """
 
-    READS = ("sighting", "map_T_odom", "recent_sightings")
-    WRITES = ("map_T_odom", "recent_sightings")
+    READS = ("sighting", "map_T_odom", "recent_sightings", "pose_tracker")
+    WRITES = ("map_T_odom", "recent_sightings", "pose_tracker")
 
     def update(self) -> Status:
         s = self.get("sighting")
@@ -214,10 +216,13 @@ class Verify(PmNavBehaviour):
         seen = se2_apply(tf, s.odom_xy)
         err = np.asarray(s.map_xy) - seen
         dist = float(np.hypot(*err))
-        if dist > VERIFY_TOLERANCE:
+        tracker, odometer = self.get("pose_tracker"), self.ctx.odometer.distance
+        tol = tracker.verify_tolerance(odometer) if tracker is not None else VERIFY_TOLERANCE
+        if dist > tol:
             return self.fail(
                 FailureCode.TARGET_NOT_FOUND,
-                f"{s.entity} seen {dist:.1f} m from where the map puts it: not it",
+                f"{s.entity} seen {dist:.1f} m from where the map puts it (tolerance "
+                f"{tol:.1f} m): not it",
             )
         recent = [r for r in (self.get("recent_sightings") or []) if r.entity != s.entity]
         recent = (recent + [s])[-RECENT_SIGHTINGS:]
@@ -231,7 +236,11 @@ class Verify(PmNavBehaviour):
         # ... position from the newest one, the best reference for what comes next.
         x, y, yaw = tf
         gain = CORRECTION_GAIN
-        self.bb.set("map_T_odom", (x + gain * float(err[0]), y + gain * float(err[1]), yaw))
+        corrected = (x + gain * float(err[0]), y + gain * float(err[1]), yaw)
+        self.bb.set("map_T_odom", corrected)
+        if tracker is not None:
+            tracker.reset(corrected, (1.0 - gain) * float(np.hypot(*err)), odometer)
+            self.bb.set("pose_tracker", tracker)
         self.feedback_message = f"{s.entity} verified ({dist:.2f} m off the map; {how})"
         return Status.SUCCESS
 

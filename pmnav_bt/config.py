@@ -150,8 +150,12 @@ class TreeConfig(_Section):
         le=100.0,
         description="budget = max(budget_actions, factor * corridor route in forward steps)",
     )
-    localization_attempts: int = Field(4, ge=1, le=100, description="localization tries")
-    explore_distance: float = Field(2.0, gt=0.0, le=100.0, description="m explored between tries")
+    localization_attempts: int = Field(
+        8, ge=1, le=100, description="localization tries (panoramas) before giving up"
+    )
+    explore_distance: float = Field(
+        8.0, gt=0.0, le=100.0, description="at most this far (m) along the corridor between tries"
+    )
     search_range: float = Field(
         4.5,
         gt=0.0,

@@ -17,13 +17,6 @@ from pmnav_bt.behaviours.capture import CaptureViews, search_yaws
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.decorators import ClockTimeout
-from pmnav_bt.behaviours.localize import (
-    Explore,
-    FixPosition,
-    enough_doors,
-    localization_yaws,
-    read_signs,
-)
 from pmnav_bt.behaviours.monitor import Monitor
 from pmnav_bt.behaviours.motion import (
     Approach,
@@ -42,6 +35,7 @@ from pmnav_bt.behaviours.planning import (
     TargetIs,
     UpdateTarget,
 )
+from pmnav_bt.behaviours.pose import CorrectHeading, SnapToCorridor
 from pmnav_bt.behaviours.search import (
     CoarseDirection,
     FineDirection,
@@ -49,41 +43,15 @@ from pmnav_bt.behaviours.search import (
     Verify,
     target_entity,
 )
+from pmnav_bt.trees.localize import active_localize_subtree, recovery_subtree
 
 VARIANTS = ("pmnav", "coarse_only")
 
 
 def localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour.Behaviour:
-    """Capture the six localization views and fix the pose; explore and retry if too few
-    landmarks are seen."""
-    cfg = ctx.config.tree
-    fix = Sequence(
-        f"{name}Once",
-        memory=True,
-        children=[
-            CaptureViews(
-                f"{name}Views",
-                ctx,
-                localization_yaws,
-                read_signs,
-                enough=enough_doors,
-            ),
-            FixPosition(f"{name}Fix", ctx),
-        ],
-    )
-    explore = Sequence(
-        f"{name}Explore",
-        memory=True,
-        children=[
-            Explore(f"{name}Walk", ctx, cfg.explore_distance),
-            AlwaysFail(name="TryAgain"),
-        ],
-    )
-    return Retry(
-        name,
-        Selector(f"{name}OrExplore", memory=True, children=[fix, explore]),
-        num_failures=cfg.localization_attempts,
-    )
+    """Capture the six localization views, add them to the corridor belief and fix the
+    pose; with too few landmarks, drive along the corridor towards signs and retry."""
+    return active_localize_subtree(ctx, name)
 
 
 def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
@@ -107,6 +75,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
             *([] if coarse_only else [Ground("Grounding", ctx)]),
             FineDirection("FineDirection", ctx, refine=not coarse_only),
             Verify("Verification", ctx),
+            CorrectHeading("HeadingFromWalls", ctx),
         ],
     )
     research = Sequence(
@@ -171,6 +140,7 @@ def build_pmnav_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
         memory=True,
         children=[
             NoteFailure("NoteFailure", ctx),
+            recovery_subtree(ctx),
             FailureIsSuccess("TryRelocalize", localize_subtree(ctx, "Relocalize")),
             AlwaysFail(name="Replan"),
         ],
@@ -181,7 +151,11 @@ def build_pmnav_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
             "PlanOrRecover",
             memory=True,
             children=[
-                Sequence("PlanAndFollow", memory=True, children=[MakePlan("Plan", ctx), follow]),
+                Sequence(
+                    "PlanAndFollow",
+                    memory=True,
+                    children=[SnapToCorridor("SnapToCorridor", ctx), MakePlan("Plan", ctx), follow],
+                ),
                 recover,
             ],
         ),

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pmnav_bt.geometry import fit_se2, se2_apply, se2_inverse, wrap_angle
+from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.seams import Entity, Pose2D
@@ -34,6 +34,11 @@ MISREAD = math.log(P_MISS * P_SPURIOUS)  # readable here, but read far from its 
 P_THROUGH_WALL = 0.02  # the robot is where the hypothesis puts it inside a wall
 OFF_CORRIDOR_M = 1.0  # beyond a corridor's half-width by this much: inside a wall
 BLOCK_PROBE_M = 1.0  # a blocked drive: the hypothesis's corridor must end within this
+WALL_COST_M = 100.0  # a way with no signs ever ahead counts as this far
+KEEP_WAY_MASS = 0.3  # keep exploring the same way while this much belief says it goes on
+MAX_DRIFT_STEP = math.radians(20.0)  # a larger change of the wall axis is another corridor
+MIN_BLIND_GLIMPSES = 3  # glimpses before a fix from the corridors' shape alone
+BLIND_SPREAD_M = 1.0  # ... and how tight the belief must be for it
 CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
 
 
@@ -63,6 +68,11 @@ class CorridorBelief:
     glimpses: list[Glimpse] = field(default_factory=list)
     ref: Pose2D | None = None
     axis_offset: float = 0.0  # robot yaw minus corridor axis at the reference (rad)
+    # A prior from an earlier estimate: map_T_odom and its position uncertainty (m).
+    prior: tuple[tuple[float, float, float], float] | None = None
+    pending_blocked: float | None = None  # a drive was blocked heading this way (odometry)
+    _last_way: int | None = None  # the way (0-3 from the axis) the last lead chose
+    _drift: float = 0.0  # odometry heading drift since the reference, from the walls
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm)
@@ -81,27 +91,82 @@ class CorridorBelief:
         self.yaw = np.array(yaw, dtype=float)
         self.xy = self.vis.lattice_xy[self.lattice]
         self.logw = np.zeros(len(self.lattice))
+        if self.ref is None:
+            return
+        if self.prior is not None:
+            self._weigh_prior(*self.prior)
         for g in self.glimpses:
             self._weigh(g)
 
+    def _weigh_prior(self, map_T_odom: tuple[float, float, float], sigma: float) -> None:
+        """Hypotheses near where the earlier estimate puts the reference are likelier."""
+        ref = self.ref
+        est = se2_apply(map_T_odom, (ref.x, ref.y))
+        yaw = wrap_angle(map_T_odom[2] + ref.yaw)
+        d = np.linalg.norm(self.xy - est, axis=1)
+        turn = np.abs(np.angle(np.exp(1j * (self.yaw - yaw))))
+        s = max(sigma, 0.5)
+        self.logw += np.maximum(-0.5 * (d / s) ** 2, math.log(P_SPURIOUS))
+        self.logw += np.where(turn > math.radians(60.0), math.log(P_MISS), 0.0)
+
     # -- updates --------------------------------------------------------------------------
 
-    def set_axis(self, axis_odom: float) -> None:
-        """The corridor axis measured in odometry (mod pi) at the reference pose."""
-        ref = self.ref
-        if ref is None:
-            return
-        off = wrap_angle(2.0 * (ref.yaw - axis_odom)) / 2.0  # in (-pi/2, pi/2]
-        if abs(off - self.axis_offset) > 1e-3:
-            self.axis_offset = off
-            self._build()
+    def observe(self, glimpse: Glimpse, axis_odom: float | None = None) -> None:
+        """Add a panorama and reweight every hypothesis with it.
 
-    def observe(self, glimpse: Glimpse) -> None:
-        """Add a panorama and reweight every hypothesis with it."""
+        ``axis_odom``: the corridor axis measured in odometry (mod pi) there. At the first
+        glimpse (the reference) it sets the hypotheses' headings; later, how far it has
+        turned (mod pi/2) is the odometry's heading drift, taken out of the glimpse (the
+        belief works in odometry straightened by the walls)."""
+        if self.pending_blocked is not None and glimpse.blocked is None:
+            glimpse = Glimpse(glimpse.odom, glimpse.seen, self.pending_blocked)
+        self.pending_blocked = None
         if self.ref is None:
             self.ref = glimpse.odom
-        self.glimpses.append(glimpse)
-        self._weigh(glimpse)
+            self._ref_axis = axis_odom if axis_odom is not None else glimpse.odom.yaw
+            if axis_odom is not None:
+                self.axis_offset = wrap_angle(2.0 * (self.ref.yaw - axis_odom)) / 2.0
+            self._drift, self._raw, self._corr = 0.0, glimpse.odom, (glimpse.odom.x, glimpse.odom.y)
+            self.glimpses.append(glimpse)
+            self._build()
+            return
+        drift = self._drift
+        if axis_odom is not None:
+            d = wrap_angle(4.0 * (axis_odom - self._ref_axis)) / 4.0  # mod pi/2
+            if abs(wrap_angle(4.0 * (d - drift)) / 4.0) < MAX_DRIFT_STEP:
+                drift = d
+        # Straighten the odometry: the leg since the last glimpse turned by the mean drift.
+        raw, mean = glimpse.odom, (self._drift + drift) / 2.0
+        c, s = math.cos(-mean), math.sin(-mean)
+        dx, dy = raw.x - self._raw.x, raw.y - self._raw.y
+        corr = (self._corr[0] + c * dx - s * dy, self._corr[1] + s * dx + c * dy)
+        self._drift, self._raw, self._corr = drift, raw, corr
+        g = Glimpse(
+            Pose2D(corr[0], corr[1], wrap_angle(raw.yaw - drift)),
+            {e: tuple(self._straighten(xy)) for e, xy in glimpse.seen.items()},
+            None if glimpse.blocked is None else wrap_angle(glimpse.blocked - drift),
+        )
+        self.glimpses.append(g)
+        self._weigh(g)
+
+    def _straighten_tf(self) -> tuple[float, float, float]:
+        """straightened_T_odom at the last glimpse."""
+        if self.ref is None:
+            return (0.0, 0.0, 0.0)
+        c, s = math.cos(-self._drift), math.sin(-self._drift)
+        rx, ry = self._raw.x, self._raw.y
+        return (self._corr[0] - (c * rx - s * ry), self._corr[1] - (s * rx + c * ry), -self._drift)
+
+    def _straighten(self, xy) -> np.ndarray:
+        return se2_apply(self._straighten_tf(), xy)
+
+    def to_odom(self, map_T_straight: tuple[float, float, float]) -> tuple[float, float, float]:
+        """A fix in the belief's straightened frame as ``map_T_odom`` for the odometry now."""
+        return se2_compose(map_T_straight, self._straighten_tf())
+
+    def sightings(self) -> list[tuple[Entity, tuple[float, float]]]:
+        """Every sign read so far and where (odometry), oldest first."""
+        return [(e, xy) for g in self.glimpses for e, xy in g.seen.items()]
 
     def _map_T_odom(self) -> np.ndarray:
         """(N, 3) map_T_odom of each hypothesis: its pose composed with the reference's inverse."""
@@ -166,9 +231,13 @@ class CorridorBelief:
         return np.nonzero(close)[0], float(w[close].sum())
 
     def fix(self) -> tuple[tuple[float, float, float], float] | None:
-        """(map_T_odom, spread in metres) once one cluster holds FIX_MASS of the belief and
-        a sign was read; refined on the signs read (all glimpses) under that hypothesis."""
-        if not self.glimpses or not any(g.seen for g in self.glimpses):
+        """(map_T_odom, spread in metres) once one cluster holds FIX_MASS of the belief, a
+        sign was read or ``MIN_BLIND_GLIMPSES`` glimpses were taken (the corridors' shape
+        alone, the ends met and the turns taken, can tell where the robot is); refined on
+        the signs read under that hypothesis."""
+        if not self.glimpses:
+            return None
+        if not any(g.seen for g in self.glimpses) and len(self.glimpses) < MIN_BLIND_GLIMPSES:
             return None
         idx, mass = self.best_cluster()
         if mass < FIX_MASS:
@@ -183,8 +252,11 @@ class CorridorBelief:
                 if np.linalg.norm(se2_apply(tf, oxy) - m) <= 3.0 * SIGHT_SIGMA_M:
                     src.append(oxy)
                     dst.append(m)
-        if not src:
-            return None
+        if not src:  # nothing read: the hypothesis as it is, if the belief is tight enough
+            spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
+            if spread > BLIND_SPREAD_M:
+                return None
+            return self.to_odom(tf), spread + 0.5
         if len({tuple(d) for d in dst}) >= 2 and np.ptp(np.array(dst), axis=0).max() >= 2.0:
             tf, res = fit_se2(np.array(src), np.array(dst))
         else:  # one sign: the heading is the hypothesis's, the position from the sign
@@ -192,48 +264,50 @@ class CorridorBelief:
             tf = (tf[0] + float(shift[0]), tf[1] + float(shift[1]), tf[2])
             res = 0.0
         spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
-        return (float(tf[0]), float(tf[1]), float(tf[2])), math.hypot(spread, res)
+        tf = self.to_odom((float(tf[0]), float(tf[1]), float(tf[2])))
+        return tf, math.hypot(spread, res)
 
     def lead(self, odom: Pose2D, max_distance: float = 8.0) -> Lead | None:
-        """Where to drive from ``odom``: towards the nearest stretch of corridor where the
-        map says two signs are readable, voted over the hypotheses by weight."""
-        dist, nxt = self.vis.towards_signs
+        """Where to drive from ``odom``: one of the ways out along the corridor axis (or
+        across it at a junction). It keeps the way it chose last while enough of the belief
+        says that way goes on (so it explores one way to the end, then the other), else the
+        open way with the least expected corridor distance to where the map says two
+        signs are readable."""
+        dist, _ = self.vis.towards_signs
         if not dist:
             return None
         w = self.weights()
         tfs = self._map_T_odom()
-        here = _apply_many(tfs, (odom.x, odom.y))
-        votes: dict[int, list[tuple[float, float]]] = {}
         live = np.nonzero(w > 1e-4 * w.max())[0]
-        near, _ = self.vis.nearest_many(here[live])
+        p = self._straighten((odom.x, odom.y))
+        here = _apply_many(tfs[live], (p[0], p[1]))
+        near, _ = self.vis.nearest_many(here)
+        axis = self._axis()
+        open_mass = np.zeros(4)  # belief that each way (along/across the axis) is open
+        cost = np.zeros(4)
         for i, j in zip(live, near, strict=True):
-            d, k = dist.get(j, math.inf), nxt.get(j, j)
-            if not math.isfinite(d):
-                continue
-            if k == j:  # already where signs are readable: turn the way the robot faces
-                h_odom = odom.yaw
-            else:
-                a, b = self.vis.lattice_xy[j], self.vis.lattice_xy[k]
-                h_map = math.atan2(b[1] - a[1], b[0] - a[0])
-                h_odom = wrap_angle(h_map - tfs[i][2])
-            key = int(round(h_odom / (math.pi / 4))) % 8
-            votes.setdefault(key, []).append((float(w[i]), d))
-        if not votes:
-            return None
-        # The way where the most belief finds signs soonest.
-        key, vs = max(votes.items(), key=lambda kv: sum(v / max(d, 1.0) for v, d in kv[1]))
-        ws = np.array([v for v, _ in vs])
-        ds = np.array([d for _, d in vs])
-        go = float(np.clip(np.average(ds, weights=ws) + 1.0, 1.0, max_distance))
-        return Lead(wrap_angle(self._snap_heading(key * math.pi / 4)), go, float(ws.sum()))
+            ways = {}
+            for h_map, d in self.vis.exits[j]:
+                k = int(round(wrap_angle(h_map - tfs[i][2] - axis) / (math.pi / 2))) % 4
+                ways[k] = min(ways.get(k, math.inf), d)
+            for k, d in ways.items():
+                open_mass[k] += w[i]
+                cost[k] += w[i] * min(d, WALL_COST_M)
+        total = float(w[live].sum())
+        open_mass /= total
+        cost = np.where(open_mass > 0, cost / np.maximum(open_mass * total, 1e-12), np.inf)
+        k = self._last_way
+        if k is None or open_mass[k] < KEEP_WAY_MASS:
+            ok = np.nonzero(open_mass >= KEEP_WAY_MASS)[0]
+            k = int(ok[np.argmin(cost[ok])]) if len(ok) else int(np.argmax(open_mass))
+        self._last_way = k
+        go = float(np.clip(cost[k] + 1.0, 1.0, max_distance)) if np.isfinite(cost[k]) else 1.0
+        heading = wrap_angle(axis + k * math.pi / 2 + self._drift)  # back to odometry
+        return Lead(heading, go, float(open_mass[k]))
 
-    def _snap_heading(self, h: float) -> float:
-        """Round a voted heading onto the corridor axis (or its normal) seen at the reference."""
-        if self.ref is None:
-            return h
-        axis = self.ref.yaw - self.axis_offset
-        k = round(wrap_angle(h - axis) / (math.pi / 2))
-        return axis + k * math.pi / 2
+    def _axis(self) -> float:
+        """The corridor axis in odometry, as seen at the reference."""
+        return 0.0 if self.ref is None else self.ref.yaw - self.axis_offset
 
 
 def _apply_many(tfs: np.ndarray, p) -> np.ndarray:

@@ -82,6 +82,12 @@ class PoseTracker:
         self._estimate_scale()
         return how
 
+    def reset(self, map_T_odom: tuple[float, float, float], residual: float, odometer: float):
+        """A correction made elsewhere: the new transform, what it left unexplained (m)."""
+        self.map_T_odom = map_T_odom
+        self.sigma0 = max(0.3, residual + 0.3)
+        self.odometer0 = odometer
+
     def rotate(self, dyaw: float, about_odom: tuple[float, float]) -> None:
         """Turn ``map_T_odom`` by ``dyaw`` about the map point of ``about_odom`` (the robot),
         keeping that point's map position (a heading correction from the walls)."""

@@ -9,6 +9,7 @@ are and class start poses by landmark density (paper, Table 3).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from enum import Enum
 from functools import cached_property
@@ -159,6 +160,29 @@ class Visibility:
             if i < j:
                 g.add_edge(int(i), int(j), length=0.0)
         return g
+
+    @cached_property
+    def exits(self) -> list[list[tuple[float, float]]]:
+        """For each lattice point: (map heading, corridor distance to signs) of every way
+        out of it (two mid-corridor, more at a junction, one at a dead end)."""
+        g = self.lattice_graph
+        dist, _ = self.towards_signs
+        xy = self.lattice_xy
+        out: list[list[tuple[float, float]]] = []
+        for j in range(len(xy)):
+            group = {j} | {k for k in g[j] if g[j][k]["length"] == 0.0}
+            ways = {}
+            for m in group:
+                for k in g[m]:
+                    length = g[m][k]["length"]
+                    if length == 0.0 or k in group:
+                        continue
+                    h = math.atan2(xy[k][1] - xy[m][1], xy[k][0] - xy[m][0])
+                    key = round(h, 2)
+                    d = length + dist.get(k, math.inf)
+                    ways[key] = min(ways.get(key, math.inf), d)
+            out.append(sorted(ways.items()))
+        return out
 
     def nearest_lattice(self, xy) -> int:
         return int(self.nearest_many(np.asarray(xy, dtype=float).reshape(1, 2))[0][0])

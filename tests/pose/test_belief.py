@@ -112,6 +112,8 @@ def test_from_a_bare_stretch_following_the_lead_finds_signs_and_a_fix():
             xy = moved
         fix = b.fix()
         if fix is not None:
-            np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=0.5)
+            # From signs within 0.5 m; from the corridors' shape alone within 1.5 m.
+            tol = 0.5 if any(g.seen for g in b.glimpses) else 1.5
+            np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=tol)
             fixed += 1
     assert fixed >= 0.9 * len(starts), (fixed, len(starts))

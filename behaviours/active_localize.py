@@ -1,0 +1,273 @@
+"""Active localization (issue 15): a belief over corridor positions, kept across attempts,
+a fix from it (one sign and the corridor axis can be enough), and a drive along the
+corridor axis towards where the map says signs are readable."""
+
+from __future__ import annotations
+
+import math
+
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.capture import CapturedView
+from pmnav_bt.behaviours.common import PmNavBehaviour
+from pmnav_bt.behaviours.context import Context, thumbnail
+from pmnav_bt.control import rotate_command
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.localization import Sighting, fix_pose, sighting
+from pmnav_bt.perception.geometry import free_distance
+from pmnav_bt.pose.belief import CorridorBelief, Glimpse
+from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.visibility import entity_xy
+from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
+from pmnav_bt.seams import Entity, EntityKind, MotionStatus
+
+NO_PROGRESS_S = 6.0  # clock seconds without moving 0.1 m: the drive is blocked
+WALL_CHECK_S = 2.0  # clock seconds between wall checks while driving along the corridor
+ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
+
+
+def as_entity(ref) -> Entity:
+    """An Entity from a sighting's reference ("room:<id>" or an Entity)."""
+    if isinstance(ref, Entity):
+        return ref
+    kind, ident = str(ref).split(":", 1)
+    return Entity(EntityKind(kind), ident)
+
+
+def wall_mask(grounder, obs):
+    """The wall mask of a frame from the grounder, or None."""
+    surfaces = getattr(grounder, "surfaces", None)
+    if surfaces is not None:
+        return surfaces(obs).wall
+    dets = grounder.detect(obs, "wall")
+    return dets[0].mask if dets else None
+
+
+def read_panorama(ctx: Context, views: list[CapturedView]):
+    """(sightings, corridor axis in odometry or None) of a panorama. Worker only."""
+    sightings = [
+        s for v in views for d in v.detections if (s := sighting(ctx.pm, v.observation, d))
+    ]
+    angles = []
+    for v in views:
+        mask = wall_mask(ctx.grounder, v.observation)
+        if mask is None:
+            continue
+        fit = fit_wall_angle(wall_points(v.observation, mask))
+        if fit is not None:
+            angles.append((v.observation.pose.yaw, fit[0], fit[1]))
+    return sightings, axis_in_odom(angles)
+
+
+class UpdateBelief(PmNavBehaviour):
+    """Add the last panorama to the corridor belief (the signs read and where, and the
+    corridor axis from the walls); start a belief when there is none, with the current
+    estimate as its prior when there is one.
+
+    Reads ``views``, ``belief``, ``map_T_odom``, ``pose_tracker``; writes ``belief``.
+    """
+
+    READS = ("views", "belief", "map_T_odom", "pose_tracker")
+    WRITES = ("belief",)
+
+    def initialise(self) -> None:
+        ctx, views = self.ctx, self.get("views") or []
+        self._job = ctx.worker.submit(lambda c: read_panorama(ctx, views))
+
+    def update(self) -> Status:
+        if not self._job.done():
+            return Status.RUNNING
+        sightings, axis = self._job.result()
+        views = self.get("views") or []
+        belief = self.get("belief")
+        if belief is None:
+            belief = CorridorBelief(self.ctx.pm)
+            tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
+            if tf is not None:
+                sigma = tracker.sigma(self.ctx.odometer.distance) if tracker else 3.0
+                belief.prior = (tf, sigma)
+        odom = views[0].observation.pose if views else self.ctx.base.pose()
+        seen: dict[Entity, tuple[float, float]] = {}
+        for s in sightings:
+            seen.setdefault(as_entity(s.entity), s.odom_xy)
+        belief.observe(Glimpse(odom, seen), axis_odom=axis)
+        self.bb.set("belief", belief)
+        _, mass = belief.best_cluster()
+        self.feedback_message = (
+            f"{len(seen)} sign(s) read, {len(belief.glimpses)} glimpse(s); best {mass:.0%}"
+        )
+        return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
+            self._job.cancel()
+
+
+class FixFromBelief(PmNavBehaviour):
+    """Fix the map pose: from two or more landmarks of the last panorama, else from the
+    belief once one corridor position dominates it.
+
+    Reads ``belief``, ``views``, ``fix_attempts``; writes ``map_T_odom``, ``pose_tracker``,
+    ``fix_attempts``, ``belief`` (cleared on a fix). FAILURE (LOCALIZATION_FAILED) otherwise.
+    """
+
+    READS = ("belief", "views", "fix_attempts")
+    WRITES = ("map_T_odom", "pose_tracker", "fix_attempts", "belief")
+
+    def update(self) -> Status:
+        belief: CorridorBelief | None = self.get("belief")
+        attempts = (self.get("fix_attempts") or 0) + 1
+        self.bb.set("fix_attempts", attempts)
+        if belief is None:
+            return self.fail(FailureCode.LOCALIZATION_FAILED, "no panorama to localize from")
+        last = belief.glimpses[-1]
+        now = [
+            Sighting(f"{e.kind.value}:{e.id}", entity_xy(self.ctx.pm, e), xy)
+            for e, xy in last.seen.items()
+        ]
+        fix = fix_pose(now)
+        if fix is not None:
+            tf = belief.to_odom(fix.map_T_odom)  # the sightings are in the belief's frame
+            sigma, how = 0.3 + fix.residual, f"{len(fix.entities)} signs"
+        else:
+            got = belief.fix()
+            if got is None:
+                _, mass = belief.best_cluster()
+                seen = sorted({str(e) for e, _ in belief.sightings()})
+                return self.fail(
+                    FailureCode.LOCALIZATION_FAILED,
+                    f"attempt {attempts}: {len(seen)} sign(s) read so far "
+                    f"({', '.join(seen) or 'none'}); the likeliest corridor position holds "
+                    f"{mass:.0%} of the belief",
+                )
+            tf, spread = got
+            sigma, how = 0.3 + spread, f"the corridor belief ({len(belief.glimpses)} glimpses)"
+        self.bb.set("map_T_odom", tf)
+        self.bb.set(
+            "pose_tracker",
+            PoseTracker(map_T_odom=tf, sigma0=sigma, odometer0=self.ctx.odometer.distance),
+        )
+        self.bb.set("belief", None)
+        est_x, est_y = _map_xy(tf, self.ctx.base.pose())
+        views = self.get("views") or []
+        self.ctx.log(
+            "fix",
+            how,
+            thumbnail(views[-1].observation.rgb) if views else None,
+            map_pose=[est_x, est_y],
+            attempts=attempts,
+        )
+        self.feedback_message = f"at ({est_x:.1f}, {est_y:.1f}) from {how}"
+        return Status.SUCCESS
+
+
+def _map_xy(tf, pose) -> tuple[float, float]:
+    c, s = math.cos(tf[2]), math.sin(tf[2])
+    return tf[0] + c * pose.x - s * pose.y, tf[1] + s * pose.x + c * pose.y
+
+
+class FollowLead(PmNavBehaviour):
+    """Drive along the corridor axis towards where the map says signs are readable (the
+    belief's lead), or, without a belief, towards the most open view. The heading is kept
+    parallel to the walls seen in depth (odometry's rotation error does not steer it into a
+    wall). A blocked drive is remembered by the belief (the corridor ends or turns there).
+
+    Reads ``belief``, ``views``; writes nothing (the belief notes a blocked drive).
+    SUCCESS when the distance is covered or the way is blocked (exploring is best effort).
+    """
+
+    READS = ("belief", "views")
+
+    def __init__(self, name: str, ctx: Context, max_distance: float):
+        super().__init__(name, ctx)
+        self.max_distance = max_distance
+
+    def initialise(self) -> None:
+        pose = self.ctx.base.pose()
+        belief: CorridorBelief | None = self.get("belief")
+        lead = belief.lead(pose, self.max_distance) if belief is not None else None
+        if lead is not None:
+            self._heading, self._distance = lead.heading, lead.distance
+            self.feedback_message = (
+                f"{lead.distance:.1f} m along the corridor ({lead.support:.0%} of the belief)"
+            )
+        else:
+            self._heading, best = pose.yaw, -1.0
+            for v in self.get("views") or []:
+                free = free_distance(v.observation, 0.0)
+                if free > best:
+                    best, self._heading = free, v.observation.pose.yaw
+            self._distance = min(2.0, self.max_distance)
+            self.feedback_message = "towards the most open view"
+        self._start = (pose.x, pose.y)
+        self._job = None
+        self._driving = False
+        self._next_check = -math.inf
+        self._best, self._best_t = 0.0, self.ctx.now()
+
+    def _check_walls(self) -> None:
+        """Measure the wall direction in view (worker); re-aim along it when it comes."""
+        base, grounder = self.ctx.base, self.ctx.grounder
+
+        def measure(cancelled):
+            obs = base.observe()
+            mask = wall_mask(grounder, obs)
+            fit = None if mask is None else fit_wall_angle(wall_points(obs, mask))
+            return obs.pose.yaw, None if fit is None else fit[0]
+
+        self._job = self.ctx.worker.submit(measure)
+
+    def _poll_walls(self) -> None:
+        if self._job is None or not self._job.done():
+            return
+        yaw, angle = self._job.result()
+        self._job = None
+        if angle is not None and abs(angle) < ALONG_WALL_MAX:
+            self._heading = yaw + angle  # parallel to the wall in view
+
+    def update(self) -> Status:
+        base, now = self.ctx.base, self.ctx.now()
+        pose = base.pose()
+        self._poll_walls()
+        if not self._driving:
+            v, w, done = rotate_command(pose, self._heading, self.ctx.limits)
+            if not done:
+                base.set_velocity(v, w)
+                return Status.RUNNING
+            base.set_velocity(0.0, 0.0)
+            if self._next_check == -math.inf:  # aligned once: look at the walls, then go
+                self._check_walls()
+                self._next_check = now
+                return Status.RUNNING
+            if self._job is not None:
+                return Status.RUNNING
+            self._driving = True
+            self._best_t = now
+        done_m = math.hypot(pose.x - self._start[0], pose.y - self._start[1])
+        if done_m >= self._distance:
+            base.set_velocity(0.0, 0.0)
+            return Status.SUCCESS
+        if done_m > self._best + 0.1:
+            self._best, self._best_t = done_m, now
+        stuck = now - self._best_t > NO_PROGRESS_S
+        if base.motion_status() == MotionStatus.BLOCKED or stuck:
+            base.stop()
+            belief = self.get("belief")
+            if belief is not None:
+                belief.pending_blocked = self._heading
+            self.feedback_message = f"blocked after {done_m:.1f} m: the corridor ends or turns"
+            return Status.SUCCESS
+        if self._job is None and now - self._next_check > WALL_CHECK_S:
+            self._check_walls()
+            self._next_check = now
+        err = math.atan2(math.sin(self._heading - pose.yaw), math.cos(self._heading - pose.yaw))
+        lim = self.ctx.limits
+        base.set_velocity(lim.linear, max(-lim.angular, min(lim.angular, 2.0 * err)))
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if getattr(self, "_job", None) is not None:
+            self._job.cancel()
+            self._job = None
+        if new_status == Status.INVALID:
+            self.ctx.base.stop()

@@ -1,0 +1,114 @@
+"""Keep the pose estimate honest between fixes: snap it onto the corridor it must be in,
+and line its heading up with the corridor walls seen in depth."""
+
+from __future__ import annotations
+
+import math
+
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.active_localize import wall_mask
+from pmnav_bt.behaviours.common import PmNavBehaviour
+from pmnav_bt.behaviours.context import map_pose
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.snap import OffMapError, snap_to_corridor
+from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, heading_correction, wall_points
+
+MAX_WALL_CORRECTION = math.radians(15.0)  # larger: a side corridor's wall, not drift
+
+
+def tracker_of(b: PmNavBehaviour) -> PoseTracker:
+    """The blackboard's pose tracker, made from ``map_T_odom`` when there is none yet."""
+    tf = b.get("map_T_odom") or (0.0, 0.0, 0.0)
+    t = b.get("pose_tracker")
+    if t is None or t.map_T_odom != tf:
+        base = t if t is not None else PoseTracker(tf, odometer0=b.ctx.odometer.distance)
+        base.map_T_odom = tf
+        t = base
+    return t
+
+
+class SnapToCorridor(PmNavBehaviour):
+    """Move an estimate that drifted off the corridors onto the most plausible corridor.
+
+    Reads ``map_T_odom``, ``pose_tracker``; writes ``map_T_odom``, ``pose_tracker``.
+    SUCCESS (moved or not); FAILURE (LOCALIZATION_FAILED) when no corridor is plausibly
+    near, so the pose must be found again.
+    """
+
+    READS = ("map_T_odom", "pose_tracker")
+    WRITES = ("map_T_odom", "pose_tracker")
+
+    def update(self) -> Status:
+        if self.get("map_T_odom") is None:
+            return Status.SUCCESS
+        tracker = tracker_of(self)
+        odom = self.ctx.base.pose()
+        est = map_pose(tracker.map_T_odom, odom)
+        sigma = tracker.sigma(self.ctx.odometer.distance)
+        try:
+            s = snap_to_corridor(self.ctx.pm, est, sigma)
+        except OffMapError as err:
+            return self.fail(FailureCode.LOCALIZATION_FAILED, str(err))
+        if s.moved > 0.0:
+            x, y, yaw = tracker.map_T_odom
+            tracker.map_T_odom = (x + s.pose.x - est.x, y + s.pose.y - est.y, yaw)
+            self.ctx.log("snap", s.segment.name, moved=s.moved, sigma=sigma)
+        self.bb.set("map_T_odom", tracker.map_T_odom)
+        self.bb.set("pose_tracker", tracker)
+        self.feedback_message = (
+            f"snapped {s.moved:.1f} m onto {s.segment.name}" if s.moved else "on a corridor"
+        )
+        return Status.SUCCESS
+
+
+class CorrectHeading(PmNavBehaviour):
+    """Turn ``map_T_odom`` so that the corridor walls seen in the last panorama run along
+    the corridor the estimate is in (small corrections only).
+
+    Reads ``views``, ``map_T_odom``, ``pose_tracker``; writes ``map_T_odom``,
+    ``pose_tracker``. Always SUCCESS (no walls seen: nothing to correct).
+    """
+
+    READS = ("views", "map_T_odom", "pose_tracker")
+    WRITES = ("map_T_odom", "pose_tracker")
+
+    def initialise(self) -> None:
+        views, grounder = self.get("views") or [], self.ctx.grounder
+
+        def measure(cancelled):
+            angles = []
+            for v in views:
+                mask = wall_mask(grounder, v.observation)
+                fit = None if mask is None else fit_wall_angle(wall_points(v.observation, mask))
+                if fit is not None:
+                    angles.append((v.observation.pose.yaw, fit[0], fit[1]))
+            return axis_in_odom(angles)
+
+        self._job = self.ctx.worker.submit(measure)
+
+    def update(self) -> Status:
+        if not self._job.done():
+            return Status.RUNNING
+        axis = self._job.result()
+        if axis is None or self.get("map_T_odom") is None:
+            self.feedback_message = "no wall line"
+            return Status.SUCCESS
+        tracker = tracker_of(self)
+        odom = self.ctx.base.pose()
+        est = map_pose(tracker.map_T_odom, odom)
+        seg = self.ctx.pm.locate(est.x, est.y).segment
+        turn = heading_correction(axis, tracker.map_T_odom[2], seg.heading)
+        if abs(turn) > MAX_WALL_CORRECTION:
+            self.feedback_message = f"wall at {math.degrees(turn):+.0f} deg: not this corridor's"
+            return Status.SUCCESS
+        tracker.rotate(turn, (odom.x, odom.y))
+        self.bb.set("map_T_odom", tracker.map_T_odom)
+        self.bb.set("pose_tracker", tracker)
+        self.feedback_message = f"heading {math.degrees(turn):+.1f} deg from the walls"
+        return Status.SUCCESS
+
+    def terminate(self, new_status) -> None:
+        if getattr(self, "_job", None) is not None and new_status.name == "INVALID":
+            self._job.cancel()

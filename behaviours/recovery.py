@@ -1,0 +1,139 @@
+"""Recoveries like Nav2's: back up, spin to look (or to the corridor axis), wait.
+
+Each is a small leaf; the tree picks them by the failure that triggered the recovery
+(``trees.recovery``). Backing up stays within ``BACKUP_LIMIT_M``: the Create 3 has no
+cliff sensors at the back, and with its default ``safety_override: none`` it refuses to
+reverse far (hazard BACKUP_LIMIT), so a recovery never asks for more.
+"""
+
+from __future__ import annotations
+
+import math
+
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.common import PmNavBehaviour
+from pmnav_bt.behaviours.context import Context, map_pose
+from pmnav_bt.control import rotate_command
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.seams import MotionStatus
+
+BACKUP_LIMIT_M = 0.3  # the most a recovery reverses (well inside the Create 3's limit)
+BACKUP_SPEED = 0.1  # m/s
+BACKUP_TIME_S = 8.0  # clock seconds before a backup that does not move gives up
+
+
+class FailureIs(PmNavBehaviour):
+    """SUCCESS when the last failure has one of ``codes`` (a recovery's guard).
+
+    Reads ``failure``."""
+
+    READS = ("failure",)
+
+    def __init__(self, name: str, ctx: Context, *codes: FailureCode):
+        super().__init__(name, ctx)
+        self.codes = frozenset(codes)
+
+    def update(self) -> Status:
+        f = self.get("failure")
+        ok = f is not None and f.code in self.codes
+        self.feedback_message = f.code.value if f is not None else "no failure"
+        return Status.SUCCESS if ok else Status.FAILURE
+
+
+class BackUp(PmNavBehaviour):
+    """Reverse ``distance`` metres (at most BACKUP_LIMIT_M) straight back, off a wall or
+    an obstacle. SUCCESS when covered, or when the body cannot reverse further (best effort).
+    """
+
+    def __init__(self, name: str, ctx: Context, distance: float = BACKUP_LIMIT_M):
+        super().__init__(name, ctx)
+        self.distance = min(distance, BACKUP_LIMIT_M)
+
+    def initialise(self) -> None:
+        p = self.ctx.base.pose()
+        self._start = (p.x, p.y)
+        self._t0 = self.ctx.now()
+
+    def update(self) -> Status:
+        base = self.ctx.base
+        p = base.pose()
+        moved = math.hypot(p.x - self._start[0], p.y - self._start[1])
+        if moved >= self.distance - 0.01:
+            base.set_velocity(0.0, 0.0)
+            self.feedback_message = f"backed up {moved:.2f} m"
+            return Status.SUCCESS
+        if (
+            base.motion_status() == MotionStatus.BLOCKED and moved > 0.0
+        ) or self.ctx.now() - self._t0 > BACKUP_TIME_S:
+            base.stop()
+            self.feedback_message = f"backed up {moved:.2f} m (could not reverse further)"
+            return Status.SUCCESS
+        base.set_velocity(-BACKUP_SPEED, 0.0)
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self.ctx.base.stop()
+
+
+class Spin(PmNavBehaviour):
+    """Turn on the spot by ``angle`` (rad, counter-clockwise positive): look round."""
+
+    def __init__(self, name: str, ctx: Context, angle: float):
+        super().__init__(name, ctx)
+        self.angle = angle
+
+    def target(self) -> float:
+        return self.ctx.base.pose().yaw + self.angle
+
+    def initialise(self) -> None:
+        self._goal = self.target()
+
+    def update(self) -> Status:
+        v, w, done = rotate_command(self.ctx.base.pose(), self._goal, self.ctx.limits)
+        if done:
+            self.ctx.base.set_velocity(0.0, 0.0)
+            return Status.SUCCESS
+        self.ctx.base.set_velocity(v, w)
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self.ctx.base.stop()
+
+
+class FaceCorridor(Spin):
+    """Turn to the nearer direction along the corridor the estimate is in (after a drive
+    that went diagonally into a wall). Reads ``map_T_odom``."""
+
+    READS = ("map_T_odom",)
+
+    def __init__(self, name: str, ctx: Context):
+        super().__init__(name, ctx, 0.0)
+
+    def target(self) -> float:
+        odom = self.ctx.base.pose()
+        est = map_pose(self.get("map_T_odom"), odom)
+        axis = self.ctx.pm.locate(est.x, est.y).segment.heading
+        turn = wrap_angle(2.0 * (axis - est.yaw)) / 2.0  # to the nearer of the two ways
+        self.feedback_message = f"turn {math.degrees(turn):+.0f} deg onto the corridor axis"
+        return odom.yaw + turn
+
+
+class Wait(PmNavBehaviour):
+    """Wait ``seconds`` of the tree's clock (a person or a door in the way may move)."""
+
+    def __init__(self, name: str, ctx: Context, seconds: float):
+        super().__init__(name, ctx)
+        self.seconds = seconds
+
+    def initialise(self) -> None:
+        self.ctx.base.stop()
+        self._t0 = self.ctx.now()
+
+    def update(self) -> Status:
+        left = self.seconds - (self.ctx.now() - self._t0)
+        self.feedback_message = f"{max(0.0, left):.1f} s left"
+        return Status.SUCCESS if left <= 0.0 else Status.RUNNING
