@@ -78,6 +78,12 @@ class CorridorBelief:
         self.vis = Visibility.of(self.pm)
         self._build()
 
+    def __repr__(self) -> str:  # short, for tree logs
+        if self.ref is None:
+            return "CorridorBelief(no glimpse)"
+        _, mass = self.best_cluster()
+        return f"CorridorBelief({len(self.glimpses)} glimpses, best {mass:.0%})"
+
     def _build(self) -> None:
         pts = self.vis.lattice_points
         segs = self.pm.segments

@@ -51,6 +51,13 @@ class PoseTracker:
     recent: list[Verified] = field(default_factory=list)
     scale: float = 1.0  # map metres per odometry metre, once estimated
 
+    def __repr__(self) -> str:  # short, for tree logs
+        x, y, yaw = self.map_T_odom
+        return (
+            f"PoseTracker(({x:.2f}, {y:.2f}, {math.degrees(yaw):.1f} deg), sigma0 "
+            f"{self.sigma0:.2f} m at {self.odometer0:.1f} m, scale {self.scale:.3f})"
+        )
+
     def sigma(self, odometer: float) -> float:
         """Position uncertainty (m) after driving to ``odometer``."""
         d = max(0.0, odometer - self.odometer0)

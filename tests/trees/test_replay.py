@@ -206,7 +206,7 @@ def test_replay_of_a_real_episode(episode_log):
     fixed = next(t for t in rp.ticks if t["status"].get(_id(rp, "LocalizeFix")) == "SUCCESS")
     text = invoke("replay", episode_log, "--tick", fixed["tick"], "--visited-only").stdout
     assert "✔ Localize [Retry] -- succeeded" in text
-    assert "✔ LocalizeFix [FixPosition] -- at (" in text
+    assert "✔ LocalizeFix [FixFromBelief] -- at (" in text
 
 
 def _id(rp: Replay, name: str) -> str:
