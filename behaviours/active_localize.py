@@ -11,6 +11,7 @@ from py_trees.common import Status
 from pmnav_bt.behaviours.capture import CapturedView
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, thumbnail
+from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M
 from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.localization import Sighting, fix_pose, sighting
@@ -22,7 +23,10 @@ from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
 from pmnav_bt.seams import Entity, EntityKind, MotionStatus
 
 NO_PROGRESS_S = 6.0  # clock seconds without moving 0.1 m: the drive is blocked
-WALL_CHECK_S = 2.0  # clock seconds between wall checks while driving along the corridor
+MIN_BLOCKED_DRIVE_M = 0.2  # blocked sooner: a brush with a wall, not the corridor's end
+SIGN_APPROACH_M = 3.0  # with a sign in view ahead, drive this much further, then look round
+WALL_CHECK_S = 1.0  # clock seconds between wall checks while driving along the corridor
+STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
 
 
@@ -43,8 +47,15 @@ def wall_mask(grounder, obs):
     return dets[0].mask if dets else None
 
 
+def read_signs(grounder, obs) -> list:
+    """Every sign readable in a frame."""
+    reader = getattr(grounder, "read_signs", None)
+    return reader(obs) if reader is not None else grounder.detect(obs, "sign")
+
+
 def read_panorama(ctx: Context, views: list[CapturedView]):
-    """(sightings, corridor axis in odometry or None) of a panorama. Worker only."""
+    """(sightings, corridor axis in odometry or None, free floor ahead of each view) of a
+    panorama. Worker only."""
     sightings = [
         s for v in views for d in v.detections if (s := sighting(ctx.pm, v.observation, d))
     ]
@@ -56,7 +67,10 @@ def read_panorama(ctx: Context, views: list[CapturedView]):
         fit = fit_wall_angle(wall_points(v.observation, mask))
         if fit is not None:
             angles.append((v.observation.pose.yaw, fit[0], fit[1]))
-    return sightings, axis_in_odom(angles)
+    free = tuple(
+        (v.observation.pose.yaw, min(free_distance(v.observation, 0.0), 50.0)) for v in views
+    )
+    return sightings, axis_in_odom(angles), free
 
 
 class UpdateBelief(PmNavBehaviour):
@@ -77,7 +91,7 @@ class UpdateBelief(PmNavBehaviour):
     def update(self) -> Status:
         if not self._job.done():
             return Status.RUNNING
-        sightings, axis = self._job.result()
+        sightings, axis, free = self._job.result()
         views = self.get("views") or []
         belief = self.get("belief")
         if belief is None:
@@ -90,7 +104,7 @@ class UpdateBelief(PmNavBehaviour):
         seen: dict[Entity, tuple[float, float]] = {}
         for s in sightings:
             seen.setdefault(as_entity(s.entity), s.odom_xy)
-        belief.observe(Glimpse(odom, seen), axis_odom=axis)
+        belief.observe(Glimpse(odom, seen, free=free), axis_odom=axis)
         self.bb.set("belief", belief)
         _, mass = belief.best_cluster()
         self.feedback_message = (
@@ -173,7 +187,9 @@ class FollowLead(PmNavBehaviour):
     wall). A blocked drive is remembered by the belief (the corridor ends or turns there).
 
     Reads ``belief``, ``views``; writes nothing (the belief notes a blocked drive).
-    SUCCESS when the distance is covered or the way is blocked (exploring is best effort).
+    SUCCESS when the distance is covered (shortened when a sign comes into view ahead:
+    look round near it), or the way is blocked (then it backs off the wall first;
+    exploring is best effort).
     """
 
     READS = ("belief", "views")
@@ -204,6 +220,9 @@ class FollowLead(PmNavBehaviour):
         self._driving = False
         self._next_check = -math.inf
         self._best, self._best_t = 0.0, self.ctx.now()
+        self._signs_ahead = 0
+        self._free_ahead = math.inf
+        self._backing = None
 
     def _check_walls(self) -> None:
         """Measure the wall direction in view (worker); re-aim along it when it comes."""
@@ -213,21 +232,31 @@ class FollowLead(PmNavBehaviour):
             obs = base.observe()
             mask = wall_mask(grounder, obs)
             fit = None if mask is None else fit_wall_angle(wall_points(obs, mask))
-            return obs.pose.yaw, None if fit is None else fit[0]
+            signs = len(read_signs(grounder, obs))
+            return obs.pose.yaw, None if fit is None else fit[0], signs, free_distance(obs, 0.0)
 
         self._job = self.ctx.worker.submit(measure)
 
     def _poll_walls(self) -> None:
         if self._job is None or not self._job.done():
             return
-        yaw, angle = self._job.result()
+        yaw, angle, signs, free = self._job.result()
         self._job = None
         if angle is not None and abs(angle) < ALONG_WALL_MAX:
             self._heading = yaw + angle  # parallel to the wall in view
+        self._signs_ahead = signs
+        self._free_ahead = free
 
     def update(self) -> Status:
         base, now = self.ctx.base, self.ctx.now()
         pose = base.pose()
+        if self._backing is not None:  # off the wall it ran into, then done
+            x, y, t = self._backing
+            if math.hypot(pose.x - x, pose.y - y) >= BACKUP_LIMIT_M - 0.01 or now - t > 5.0:
+                base.set_velocity(0.0, 0.0)
+                return Status.SUCCESS
+            base.set_velocity(-0.1, 0.0)
+            return Status.RUNNING
         self._poll_walls()
         if not self._driving:
             v, w, done = rotate_command(pose, self._heading, self.ctx.limits)
@@ -247,16 +276,28 @@ class FollowLead(PmNavBehaviour):
         if done_m >= self._distance:
             base.set_velocity(0.0, 0.0)
             return Status.SUCCESS
+        if self._signs_ahead and self._distance > done_m + SIGN_APPROACH_M:
+            # A sign in view ahead: go a little closer (to read it well), then look round.
+            self._distance = done_m + SIGN_APPROACH_M
+            self.feedback_message = f"a sign in view after {done_m:.1f} m: look round soon"
         if done_m > self._best + 0.1:
             self._best, self._best_t = done_m, now
         stuck = now - self._best_t > NO_PROGRESS_S
-        if base.motion_status() == MotionStatus.BLOCKED or stuck:
-            base.stop()
+        if self._driving and self._free_ahead < STOP_BEFORE_M:  # a wall ahead, seen in depth
+            base.set_velocity(0.0, 0.0)
             belief = self.get("belief")
             if belief is not None:
                 belief.pending_blocked = self._heading
-            self.feedback_message = f"blocked after {done_m:.1f} m: the corridor ends or turns"
+            self.feedback_message = f"a wall ahead after {done_m:.1f} m: the corridor ends"
             return Status.SUCCESS
+        if base.motion_status() == MotionStatus.BLOCKED or stuck:
+            base.stop()
+            belief = self.get("belief")
+            if belief is not None and done_m >= MIN_BLOCKED_DRIVE_M:
+                belief.pending_blocked = self._heading  # not just a brush with a side wall
+            self.feedback_message = f"blocked after {done_m:.1f} m: the corridor ends or turns"
+            self._backing = (pose.x, pose.y, now)
+            return Status.RUNNING
         if self._job is None and now - self._next_check > WALL_CHECK_S:
             self._check_walls()
             self._next_check = now

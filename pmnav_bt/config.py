@@ -151,10 +151,10 @@ class TreeConfig(_Section):
         description="budget = max(budget_actions, factor * corridor route in forward steps)",
     )
     localization_attempts: int = Field(
-        8, ge=1, le=100, description="localization tries (panoramas) before giving up"
+        10, ge=1, le=100, description="localization tries (panoramas) before giving up"
     )
     explore_distance: float = Field(
-        8.0, gt=0.0, le=100.0, description="at most this far (m) along the corridor between tries"
+        16.0, gt=0.0, le=100.0, description="at most this far (m) along the corridor between tries"
     )
     search_range: float = Field(
         4.5,

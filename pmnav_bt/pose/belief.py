@@ -33,12 +33,16 @@ FIX_MASS = 0.85  # a cluster holding this much weight is a fix
 MISREAD = math.log(P_MISS * P_SPURIOUS)  # readable here, but read far from its place
 P_THROUGH_WALL = 0.02  # the robot is where the hypothesis puts it inside a wall
 OFF_CORRIDOR_M = 1.0  # beyond a corridor's half-width by this much: inside a wall
-BLOCK_PROBE_M = 1.0  # a blocked drive: the hypothesis's corridor must end within this
+BLOCK_PROBE_M = 1.5  # a blocked drive: the hypothesis's corridor must end within this
 WALL_COST_M = 100.0  # a way with no signs ever ahead counts as this far
 KEEP_WAY_MASS = 0.3  # keep exploring the same way while this much belief says it goes on
 MAX_DRIFT_STEP = math.radians(20.0)  # a larger change of the wall axis is another corridor
-MIN_BLIND_GLIMPSES = 3  # glimpses before a fix from the corridors' shape alone
-BLIND_SPREAD_M = 1.0  # ... and how tight the belief must be for it
+MIN_BLIND_GLIMPSES = 4  # glimpses before a fix from the corridors' shape alone
+BLIND_SPREAD_M = 0.75  # ... and how tight the belief must be for it
+LOOK_SPACING_M = 6.0  # look round at least this far beyond an earlier look in the same way
+NEAR_WALL_M = 2.0  # depth: a wall closer than this ahead of a view ...
+OPEN_M = 5.0  # ... or free floor farther than this
+P_DEPTH = 0.1  # a hypothesis that disagrees with one such depth reading
 CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
 
 
@@ -49,6 +53,8 @@ class Glimpse:
     odom: Pose2D
     seen: dict[Entity, tuple[float, float]]
     blocked: float | None = None  # odometry heading of a drive that was just blocked here
+    # Free floor (m) seen in depth straight ahead of each view: (odometry yaw, distance).
+    free: tuple[tuple[float, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -125,7 +131,7 @@ class CorridorBelief:
         turned (mod pi/2) is the odometry's heading drift, taken out of the glimpse (the
         belief works in odometry straightened by the walls)."""
         if self.pending_blocked is not None and glimpse.blocked is None:
-            glimpse = Glimpse(glimpse.odom, glimpse.seen, self.pending_blocked)
+            glimpse = Glimpse(glimpse.odom, glimpse.seen, self.pending_blocked, glimpse.free)
         self.pending_blocked = None
         if self.ref is None:
             self.ref = glimpse.odom
@@ -151,6 +157,7 @@ class CorridorBelief:
             Pose2D(corr[0], corr[1], wrap_angle(raw.yaw - drift)),
             {e: tuple(self._straighten(xy)) for e, xy in glimpse.seen.items()},
             None if glimpse.blocked is None else wrap_angle(glimpse.blocked - drift),
+            tuple((wrap_angle(y - drift), f) for y, f in glimpse.free),
         )
         self.glimpses.append(g)
         self._weigh(g)
@@ -206,6 +213,19 @@ class CorridorBelief:
             )
             pn, poff = self.vis.nearest_many(probe)
             self.logw += np.where(poff <= half[pn], math.log(P_THROUGH_WALL), 0.0)
+        # Depth: a wall close ahead of a view must be a wall on the map; far free floor, floor.
+        for yaw, free in g.free:
+            c, s_ = math.cos(yaw), math.sin(yaw)
+            if free < NEAR_WALL_M:
+                d, inside = free + 0.5, False
+            elif free > OPEN_M:
+                d, inside = OPEN_M - 1.0, True
+            else:
+                continue
+            probe = _apply_many(tfs, (g.odom.x + d * c, g.odom.y + d * s_))
+            pn, poff = self.vis.nearest_many(probe)
+            wrong = (poff <= half[pn]) if not inside else (poff > half[pn] + OFF_CORRIDOR_M)
+            self.logw += np.where(wrong, math.log(P_DEPTH), 0.0)
         # What the map says is readable at each hypothesis's position for this glimpse.
         readable = [self.vis.lattice_points[j].readable for j in near]
         seen = g.seen.keys()
@@ -308,7 +328,14 @@ class CorridorBelief:
             k = int(ok[np.argmin(cost[ok])]) if len(ok) else int(np.argmax(open_mass))
         self._last_way = k
         go = float(np.clip(cost[k] + 1.0, 1.0, max_distance)) if np.isfinite(cost[k]) else 1.0
-        heading = wrap_angle(axis + k * math.pi / 2 + self._drift)  # back to odometry
+        # Drive past the places already looked round from in that direction.
+        h = axis + k * math.pi / 2
+        u = np.array([math.cos(h), math.sin(h)])
+        ahead = [float((np.array([g.odom.x, g.odom.y]) - p) @ u) for g in self.glimpses]
+        seen_to = max([a for a in ahead if a > 0.0], default=0.0)
+        if seen_to > 0.0:
+            go = float(min(max(go, seen_to + LOOK_SPACING_M), 2.0 * max_distance))
+        heading = wrap_angle(h + self._drift)  # back to odometry
         return Lead(heading, go, float(open_mass[k]))
 
     def _axis(self) -> float:

@@ -1,0 +1,48 @@
+"""Active localization in a generated sign-sparse building: from a start where no sign is
+readable, the localization subtree drives along the corridor axis until it knows where
+it is (issue 15)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from pmnav_bt.map.generate import generate_sign_sparse
+from pmnav_bt.map.priori_map import parse_building
+from pmnav_bt.pose.visibility import Visibility
+from pmnav_bt.seams import Pose2D
+from pmnav_bt.sim.world import SimWorld
+from pmnav_bt.trees.localize import active_localize_subtree
+
+
+@pytest.fixture(scope="module")
+def world():  # overrides the fig2_hospital world of conftest
+    w = SimWorld(generate_sign_sparse(0))
+    yield w
+    w.close()
+
+
+def test_a_start_in_a_sign_less_stretch_localizes_by_driving_along_the_axis(make_rig, pm):
+    start = Pose2D(60.0, 45.0, math.radians(90.0))  # a 30 m corridor without a door
+    assert Visibility.of(pm).n_readable((start.x, start.y)) == 0
+    rig = make_rig(start, width=320, height=240, noise=0.02, seed=3)
+    tree = active_localize_subtree(rig.ctx)
+    track = []
+    seen = rig.run(tree, max_ticks=6000, until=lambda: track.append(rig.true_pose()) and False)
+    assert seen[-1].name == "SUCCESS", rig.failure
+    assert rig.get("fix_attempts") >= 2  # it had to move
+    est, true = rig.estimate(), rig.true_pose()
+    assert math.dist((est.x, est.y), (true.x, true.y)) < 1.0
+    assert rig.yaw_error(est.yaw, true.yaw) < math.radians(10)
+    # It drove along the corridors, never into a wall, and away from the start.
+    assert math.dist((true.x, true.y), (start.x, start.y)) > 5.0
+    for p in track:
+        loc = pm.locate(p.x, p.y)
+        assert loc.offset < loc.segment.width / 2, p
+    assert rig.body.stats.collisions == 0
+
+
+def test_the_sign_sparse_building_parses(pm):
+    assert pm.building.name == "sign_sparse_0"
+    assert parse_building(generate_sign_sparse(0)).segments == pm.segments

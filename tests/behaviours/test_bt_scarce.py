@@ -1,0 +1,162 @@
+"""Where landmarks are scarce (issue 15), against the simulator in fig2_hospital: an
+estimate off the corridor is snapped, a robot against a wall backs off and goes on, the
+heading is corrected from the walls and from two landmarks, and the verification
+tolerance follows the pose uncertainty."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.capture import CaptureViews, search_yaws
+from pmnav_bt.behaviours.motion import MoveToward
+from pmnav_bt.behaviours.pose import CorrectHeading, SnapToCorridor
+from pmnav_bt.behaviours.search import (
+    CoarseDirection,
+    FineDirection,
+    Ground,
+    Verify,
+    target_query,
+)
+from pmnav_bt.failures import Failure, FailureCode
+from pmnav_bt.geometry import se2_apply
+from pmnav_bt.localization import Sighting
+from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.seams import MotionStatus, Pose2D
+from pmnav_bt.trees.localize import recovery_subtree
+
+SOUTH = math.radians(-90)
+NORTH_OF_ROOM4 = Pose2D(0.0, 26.5, SOUTH)  # room4's door is at (1.2, 22)
+
+
+def targets(rig) -> dict:
+    return {s.landmark: s for s in rig.plan("0,29,-90", "room3").steps}
+
+
+def search(rig, target) -> None:
+    """Put ``target`` on the blackboard and take the search views for it."""
+    rig.set(target=target)
+    cap = CaptureViews("SearchViews", rig.ctx, lambda b: search_yaws(None), target_query)
+    rig.expect(rig.run(cap, max_ticks=300), Status.SUCCESS)
+
+
+def fine_and_verify(rig, map_T_odom) -> Verify:
+    """CoarseDirection -> Ground -> FineDirection -> Verify on the current views."""
+    rig.set(map_T_odom=map_T_odom)
+    assert rig.tick(CoarseDirection("CoarseDirection", rig.ctx)) == Status.SUCCESS
+    rig.expect(rig.run(Ground("Grounding", rig.ctx), max_ticks=100), Status.SUCCESS)
+    assert rig.tick(FineDirection("FineDirection", rig.ctx)) == Status.SUCCESS
+    verify = Verify("Verification", rig.ctx)
+    rig.tick(verify)
+    return verify
+
+
+def rotated_about(pose: Pose2D, dyaw: float) -> tuple[float, float, float]:
+    """A map_T_odom (odometry = truth) turned by ``dyaw`` about the robot: the estimate is
+    right where the robot is, with a heading error of ``dyaw``."""
+    c, s = math.cos(dyaw), math.sin(dyaw)
+    return (pose.x - (c * pose.x - s * pose.y), pose.y - (s * pose.x + c * pose.y), dyaw)
+
+
+def test_an_estimate_off_the_corridor_is_snapped_onto_it(make_rig):
+    rig = make_rig(Pose2D(0.0, 15.0, SOUTH))
+    drift = (3.5, 0.0, 0.0)  # the estimate is 3.5 m east, inside the wall
+    rig.set(map_T_odom=drift, pose_tracker=PoseTracker(drift, sigma0=2.0))
+    snap = SnapToCorridor("SnapToCorridor", rig.ctx)
+    assert rig.tick(snap) == Status.SUCCESS
+    est = rig.estimate()
+    loc = rig.pm.locate(est.x, est.y)
+    assert loc.offset < loc.segment.width / 2  # back in the corridor
+    assert est.y == pytest.approx(15.0, abs=0.01)  # along the corridor: unchanged
+    assert "snapped" in snap.feedback_message
+    assert rig.ctx.trace[-1].kind == "snap"
+
+
+def test_an_estimate_far_from_every_corridor_asks_for_a_new_fix(make_rig):
+    rig = make_rig(Pose2D(0.0, 15.0, SOUTH))
+    far = (40.0, 0.0, 0.0)
+    rig.set(map_T_odom=far, pose_tracker=PoseTracker(far, sigma0=0.5))
+    assert rig.tick(SnapToCorridor("SnapToCorridor", rig.ctx)) == Status.FAILURE
+    assert rig.failure.code == FailureCode.LOCALIZATION_FAILED
+
+
+def test_a_robot_against_a_wall_backs_off_and_continues(make_rig):
+    # Driven diagonally into the east wall of the corridor (x = 1.2): the drive hit it.
+    rig = make_rig(Pose2D(0.0, 21.0, math.radians(-45)))
+    rig.body.set_velocity(0.2, 0.0)
+    for _ in range(100):
+        rig.wait()
+        if rig.body.motion_status() == MotionStatus.BLOCKED:
+            break
+    before = rig.true_pose()
+    assert rig.body.motion_status() == MotionStatus.BLOCKED and before.x > 0.9
+    room5 = targets(rig)["room5"]
+    rig.set(target=room5, map_T_odom=(0.0, 0.0, 0.0))
+    rig.set(failure=Failure(FailureCode.BLOCKED, "2 collisions on the way"))
+    rig.expect(rig.run(recovery_subtree(rig.ctx), 300), Status.SUCCESS)
+    after = rig.true_pose()
+    assert math.dist((before.x, before.y), (after.x, after.y)) == pytest.approx(0.3, abs=0.05)
+    assert rig.yaw_error(after.yaw, SOUTH) < math.radians(3)  # onto the corridor axis
+    # ... and the same drive now gets there.
+    seen = rig.run(MoveToward("MoveOn", rig.ctx, keep=1.0), 600)
+    assert seen[-1] == Status.SUCCESS, (rig.failure, rig.true_pose())
+    assert math.dist((rig.true_pose().x, rig.true_pose().y), room5.position) == pytest.approx(
+        1.0, abs=0.3
+    )
+
+
+def test_the_recovery_follows_the_failure(make_rig):
+    rig = make_rig(Pose2D(0.0, 15.0, SOUTH))
+    rig.set(failure=Failure(FailureCode.TARGET_NOT_FOUND, "room4 not found"))
+    rig.expect(rig.run(recovery_subtree(rig.ctx), 300), Status.SUCCESS)
+    assert rig.yaw_error(rig.true_pose().yaw, -SOUTH) < math.radians(3)  # turned to look back
+    rig.set(failure=Failure(FailureCode.TIMEOUT, "slow"))
+    t0 = rig.ctx.now()
+    rig.expect(rig.run(recovery_subtree(rig.ctx), 300), Status.SUCCESS)
+    assert rig.ctx.now() - t0 >= 2.0  # waited
+    assert rig.true_pose().x == pytest.approx(0.0, abs=1e-6)
+
+
+def test_heading_error_is_corrected_from_the_corridor_walls(make_rig):
+    rig = make_rig(NORTH_OF_ROOM4)
+    search(rig, targets(rig)["room4"])
+    bias = math.radians(6.0)
+    rig.set(map_T_odom=rotated_about(rig.base.pose(), bias))
+    fix = CorrectHeading("HeadingFromWalls", rig.ctx)
+    rig.expect(rig.run(fix, 100), Status.SUCCESS)
+    assert abs(rig.get("map_T_odom")[2]) < math.radians(1.0)
+    est, true = rig.estimate(), rig.true_pose()
+    assert math.dist((est.x, est.y), (true.x, true.y)) < 0.05  # turned about the robot
+
+
+def test_heading_bias_is_corrected_after_two_landmarks(make_rig):
+    rig = make_rig(NORTH_OF_ROOM4)
+    search(rig, targets(rig)["room4"])
+    bias = math.radians(5.0)
+    tf = rotated_about(rig.base.pose(), bias)
+    # One landmark verified earlier, 9 m up the corridor, seen where it is.
+    rig.set(recent_sightings=[Sighting("room:room1", (-1.2, 26.0), (-1.2, 26.0))])
+    rig.set(pose_tracker=PoseTracker(tf, sigma0=0.3))
+    verify = fine_and_verify(rig, tf)
+    assert verify.status == Status.SUCCESS
+    assert "re-fit on 2 landmarks" in verify.feedback_message
+    assert abs(rig.get("map_T_odom")[2]) < math.radians(1.0)
+    assert rig.get("pose_tracker").map_T_odom == rig.get("map_T_odom")
+
+
+def test_verification_tolerance_follows_the_pose_uncertainty(make_rig):
+    # The same sighting, 4.1 m off after a 12 m error: rejected with a fresh fix (tolerance
+    # 2 m), accepted after a long dead-reckoned leg (tolerance above 4 m).
+    rig = make_rig(NORTH_OF_ROOM4)
+    search(rig, targets(rig)["room4"])
+    off = (0.0, 4.1, 0.0)
+    rig.set(pose_tracker=PoseTracker(off, sigma0=0.3, odometer0=0.0))
+    assert fine_and_verify(rig, off).status == Status.FAILURE
+    assert "tolerance 2.0 m" in rig.failure.message
+    rig.set(pose_tracker=PoseTracker(off, sigma0=0.3, odometer0=-30.0))  # 30 m ago
+    verify = fine_and_verify(rig, off)
+    assert verify.status == Status.SUCCESS
+    seen = se2_apply(rig.get("map_T_odom"), rig.get("sighting").odom_xy)
+    assert math.dist(seen, (1.2, 22.0)) < 0.6
