@@ -2,7 +2,8 @@
 
 Each hypothesis is a map pose for the robot at a reference odometry pose (the first
 glimpse): a lattice point of a corridor centre line, facing along the corridor either
-way (corrected by the angle of the corridor axis seen in depth, when it was measured).
+way or across it (the walls seen in depth give the robot's angle to an axis, but near a
+junction the strongest wall may run across the corridor).
 Every glimpse (a panorama: the signs read there and where each was seen, in odometry)
 reweights all hypotheses: a sign read where the map puts it under the hypothesis
 supports it, one read elsewhere or one the map says cannot be read there counts
@@ -36,6 +37,7 @@ OFF_CORRIDOR_M = 1.0  # beyond a corridor's half-width by this much: inside a wa
 BLOCK_PROBE_M = 1.5  # a blocked drive: the hypothesis's corridor must end within this
 WALL_COST_M = 100.0  # a way with no signs ever ahead counts as this far
 KEEP_WAY_MASS = 0.3  # keep exploring the same way while this much belief says it goes on
+CROSS_WAY_MASS = 0.7  # turn into a side corridor only when this much belief says it is there
 MAX_DRIFT_STEP = math.radians(20.0)  # a larger change of the wall axis is another corridor
 MIN_BLIND_GLIMPSES = 4  # glimpses before a fix from the corridors' shape alone
 BLIND_SPREAD_M = 0.75  # ... and how tight the belief must be for it
@@ -96,7 +98,7 @@ class CorridorBelief:
         lat, yaw = [], []
         for p in pts:
             h = segs[p.segment - 1].heading
-            for k in (0.0, math.pi):
+            for k in (0.0, math.pi / 2, math.pi, -math.pi / 2):
                 lat.append(p.index)
                 yaw.append(wrap_angle(h + k + self.axis_offset))
         self.lattice = np.array(lat, dtype=int)
@@ -322,10 +324,13 @@ class CorridorBelief:
         total = float(w[live].sum())
         open_mass /= total
         cost = np.where(open_mass > 0, cost / np.maximum(open_mass * total, 1e-12), np.inf)
+        # Across the axis only where the belief is sure of a junction (it is easy to be
+        # a metre or two short of one); along it while a third of the belief says it goes on.
+        need = np.array([KEEP_WAY_MASS, CROSS_WAY_MASS, KEEP_WAY_MASS, CROSS_WAY_MASS])
         k = self._last_way
-        if k is None or open_mass[k] < KEEP_WAY_MASS:
-            ok = np.nonzero(open_mass >= KEEP_WAY_MASS)[0]
-            k = int(ok[np.argmin(cost[ok])]) if len(ok) else int(np.argmax(open_mass))
+        if k is None or open_mass[k] < need[k]:
+            ok = np.nonzero(open_mass >= need)[0]
+            k = int(ok[np.argmin(cost[ok])]) if len(ok) else int(np.argmax(open_mass[::2]) * 2)
         self._last_way = k
         go = float(np.clip(cost[k] + 1.0, 1.0, max_distance)) if np.isfinite(cost[k]) else 1.0
         # Drive past the places already looked round from in that direction.

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+import shapely
 
 from pmnav_bt.geometry import se2_apply, se2_compose, se2_inverse
 from pmnav_bt.map.building import load_building
@@ -18,10 +19,27 @@ from pmnav_bt.seams import Pose2D
 ODOM_T_MAP = (3.0, -2.0, 0.7)  # the odometry frame is anywhere
 
 
-def glimpse(pm, true: tuple[float, float, float], entities, blocked=None) -> Glimpse:
+def glimpse(pm, true: tuple[float, float, float], entities, blocked=None, depth=False):
+    """What a panorama at ``true`` (map) sees, in odometry; ``depth``: the free floor
+    ahead in the four directions along and across the robot's heading, as depth gives it."""
     odom = se2_compose(ODOM_T_MAP, true)
     seen = {e: tuple(se2_apply(ODOM_T_MAP, entity_xy(pm, e))) for e in entities}
-    return Glimpse(Pose2D(*odom), seen, blocked)
+    free = ()
+    if depth:
+        free = tuple(
+            (true[2] + k * math.pi / 2 + ODOM_T_MAP[2], _free(pm, true, true[2] + k * math.pi / 2))
+            for k in range(4)
+        )
+    return Glimpse(Pose2D(*odom), seen, blocked, free)
+
+
+def _free(pm, true, h: float) -> float:
+    poly = Visibility.of(pm).corridors
+    for i in range(1, 60):
+        d = 0.25 * i
+        if not poly.covers(shapely.Point(true[0] + d * math.cos(h), true[1] + d * math.sin(h))):
+            return d - 0.25
+    return 50.0
 
 
 @pytest.fixture(scope="module")
@@ -97,7 +115,7 @@ def test_from_a_bare_stretch_following_the_lead_finds_signs_and_a_fix():
         b = CorridorBelief(pm)
         blocked = None
         for _ in range(12):
-            g = glimpse(pm, (*xy, yaw), vis.readable_from(xy), blocked)
+            g = glimpse(pm, (*xy, yaw), vis.readable_from(xy), blocked, depth=True)
             b.observe(g)
             if b.fix() is not None:
                 break
