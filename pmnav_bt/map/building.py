@@ -458,6 +458,10 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
         return p
     if os.path.lexists(p):
         return p
+    from pmnav_bt.map.generate import is_generated_name  # generate imports this module
+
+    if is_generated_name(text):
+        return p  # a generated building ("sign_sparse_3"): no file, no folder of its own
     builtin = BUILTIN_DIR / f"{name_or_path}.yaml"
     if builtin.is_file():
         return builtin

@@ -158,12 +158,17 @@ def generate_sign_sparse(seed: int = 0) -> Building:
     )
 
 
+def is_generated_name(name: str) -> bool:
+    """True for a generated family's building name, such as "sign_sparse_3"."""
+    stem, _, seed = name.rpartition("_")
+    return stem == SIGN_SPARSE_FAMILY and seed.isdigit() and len(seed) < 10
+
+
 def generated_family(name: str) -> Building | None:
     """The generated building a name such as "sign_sparse_3" denotes, or None."""
-    stem, _, seed = name.rpartition("_")
-    if stem == SIGN_SPARSE_FAMILY and seed.isdigit():
-        return generate_sign_sparse(int(seed))
-    return None
+    if not is_generated_name(name):
+        return None
+    return generate_sign_sparse(int(name.rpartition("_")[2]))
 
 
 def _merge_straight_runs(g: nx.Graph) -> nx.Graph:
