@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.building import load_building, resolve_building_path
 from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.visibility import (
@@ -60,6 +60,7 @@ def test_the_sign_sparse_family_has_long_bare_stretches_and_near_identical_signs
     assert len({s[1:] for s in signs}) < len(signs)  # the same numbers in several wings
     assert generate_sign_sparse(0) == sparse.building  # seeded
     assert load_building("sign_sparse_0") == sparse.building  # by family name
+    assert resolve_building_path("sign_sparse_0").name == "sign_sparse_0"  # no file needed
 
 
 def test_towards_signs_leads_from_every_bare_point(sparse):
