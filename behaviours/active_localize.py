@@ -8,7 +8,6 @@ import math
 
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.capture import CapturedView
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, thumbnail
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M
@@ -53,11 +52,11 @@ def read_signs(grounder, obs) -> list:
     return reader(obs) if reader is not None else grounder.detect(obs, "sign")
 
 
-def read_panorama(ctx: Context, views: list[CapturedView]):
+def read_panorama(ctx: Context, views: list):
     """(sightings, corridor axis in odometry or None, free floor ahead of each view) of a
     panorama. Worker only."""
     sightings = [
-        s for v in views for d in v.detections if (s := sighting(ctx.pm, v.observation, d))
+        s for v in views for d in v.detections or () if (s := sighting(ctx.pm, v.observation, d))
     ]
     angles = []
     for v in views:
