@@ -313,22 +313,32 @@ class CorridorBelief:
         axis = self._axis()
         open_mass = np.zeros(4)  # belief that each way (along/across the axis) is open
         cost = np.zeros(4)
+        run = [[] for _ in range(4)]  # (weight, distance to the next junction) per way
+        side_mass = 0.0  # belief that the robot is at a junction with a side corridor
         for i, j in zip(live, near, strict=True):
-            ways = {}
+            ways: dict[int, tuple[float, float]] = {}
             for h_map, d in self.vis.exits[j]:
                 k = int(round(wrap_angle(h_map - tfs[i][2] - axis) / (math.pi / 2))) % 4
-                ways[k] = min(ways.get(k, math.inf), d)
-            for k, d in ways.items():
+                r = self.vis.run_lengths[j].get(h_map, 0.0)
+                if k not in ways or d < ways[k][0]:
+                    ways[k] = (d, r)
+            if 1 in ways or 3 in ways:
+                side_mass += w[i]
+            for k, (d, r) in ways.items():
                 open_mass[k] += w[i]
                 cost[k] += w[i] * min(d, WALL_COST_M)
+                run[k].append((w[i], r))
         total = float(w[live].sum())
         open_mass /= total
+        side_mass /= total
         cost = np.where(open_mass > 0, cost / np.maximum(open_mass * total, 1e-12), np.inf)
-        # Across the axis only where the belief is sure of a junction (it is easy to be
-        # a metre or two short of one); along it while a third of the belief says it goes on.
-        need = np.array([KEEP_WAY_MASS, CROSS_WAY_MASS, KEEP_WAY_MASS, CROSS_WAY_MASS])
+        # Across the axis only where the belief is sure of a junction (it is easy to be a
+        # metre or two short of one); along it while a third of the belief says it goes on,
+        # except at a junction, where the way is chosen afresh.
+        cross = CROSS_WAY_MASS if side_mass < CROSS_WAY_MASS else KEEP_WAY_MASS
+        need = np.array([KEEP_WAY_MASS, cross, KEEP_WAY_MASS, cross])
         k = self._last_way
-        if k is None or open_mass[k] < need[k]:
+        if k is None or open_mass[k] < need[k] or side_mass >= CROSS_WAY_MASS:
             ok = np.nonzero(open_mass >= need)[0]
             k = int(ok[np.argmin(cost[ok])]) if len(ok) else int(np.argmax(open_mass[::2]) * 2)
         self._last_way = k
@@ -340,6 +350,18 @@ class CorridorBelief:
         seen_to = max([a for a in ahead if a > 0.0], default=0.0)
         if seen_to > 0.0:
             go = float(min(max(go, seen_to + LOOK_SPACING_M), 2.0 * max_distance))
+        # Stop at the next junction (most of the belief agrees where): look round there.
+        if run[k]:
+            ws, rs = np.array(run[k]).T
+            to_junction = float(
+                rs[np.argsort(rs)][np.searchsorted(np.cumsum(ws[np.argsort(rs)]), ws.sum() / 2)]
+            )
+            at = p + u * to_junction
+            looked = any(
+                math.hypot(g.odom.x - at[0], g.odom.y - at[1]) < 3.0 for g in self.glimpses
+            )
+            if 1.0 < to_junction < go and not looked:
+                go = to_junction
         heading = wrap_angle(h + self._drift)  # back to odometry
         return Lead(heading, go, float(open_mass[k]))
 

@@ -164,9 +164,10 @@ class Visibility:
     @cached_property
     def exits(self) -> list[list[tuple[float, float]]]:
         """For each lattice point: (map heading, corridor distance to signs) of every way
-        out of it (two mid-corridor, more at a junction, one at a dead end)."""
+        out of it (two mid-corridor, more at a junction, one at a dead end); infinite for
+        a way whose nearest signs lie back through the point."""
         g = self.lattice_graph
-        dist, _ = self.towards_signs
+        dist, nxt = self.towards_signs
         xy = self.lattice_xy
         out: list[list[tuple[float, float]]] = []
         for j in range(len(xy)):
@@ -179,9 +180,41 @@ class Visibility:
                         continue
                     h = math.atan2(xy[k][1] - xy[m][1], xy[k][0] - xy[m][0])
                     key = round(h, 2)
-                    d = length + dist.get(k, math.inf)
+                    # The nearest signs that way, unless the way there comes back (a dead end).
+                    d = length + dist.get(k, math.inf) if nxt.get(k) not in group else math.inf
                     ways[key] = min(ways.get(key, math.inf), d)
             out.append(sorted(ways.items()))
+        return out
+
+    @cached_property
+    def run_lengths(self) -> list[dict[float, float]]:
+        """For each lattice point and way out (keyed like ``exits``): how far straight on
+        to the next junction or corridor end."""
+        g, xy, exits = self.lattice_graph, self.lattice_xy, self.exits
+
+        def step(m: int, key: float) -> tuple[int, float] | None:
+            group = {m} | {k for k in g[m] if g[m][k]["length"] == 0.0}
+            for a in group:
+                for k in g[a]:
+                    length = g[a][k]["length"]
+                    if length == 0.0 or k in group:
+                        continue
+                    h = math.atan2(xy[k][1] - xy[a][1], xy[k][0] - xy[a][0])
+                    if abs(math.remainder(h - key, 2 * math.pi)) < 0.05:
+                        return k, length
+            return None
+
+        out: list[dict[float, float]] = []
+        for j in range(len(xy)):
+            runs = {}
+            for key, _ in exits[j]:
+                d, m = 0.0, j
+                while (nxt := step(m, key)) is not None:
+                    m, d = nxt[0], d + nxt[1]
+                    if len(exits[m]) != 2:
+                        break
+                runs[key] = d
+            out.append(runs)
         return out
 
     def nearest_lattice(self, xy) -> int:
