@@ -356,6 +356,7 @@ def table3(
     from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
     from pmnav_bt.pose.visibility import READ_RANGE_M
 
+    check_output_dir(out)
     cfg = _config(config, overrides)
     names: list[str] = []
     for part in (p.strip() for p in building.split(",") if p.strip()):
