@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import shapely
 
 from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
@@ -45,6 +46,7 @@ LOOK_SPACING_M = 6.0  # look round at least this far beyond an earlier look in t
 NEAR_WALL_M = 2.0  # depth: a wall closer than this ahead of a view ...
 OPEN_M = 5.0  # ... or free floor farther than this
 P_DEPTH = 0.1  # a hypothesis that disagrees with one such depth reading
+JUNCTION_REACH_M = 1.0  # side corridors of a junction this close are the robot's
 CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
 
 
@@ -315,13 +317,24 @@ class CorridorBelief:
         cost = np.zeros(4)
         run = [[] for _ in range(4)]  # (weight, distance to the next junction) per way
         side_mass = 0.0  # belief that the robot is at a junction with a side corridor
-        for i, j in zip(live, near, strict=True):
+        # Side corridors of a junction within reach count (it is easy to stop a little off
+        # its centre); along the axis only the nearest point's ways (a dead end stays one).
+        pairs = self.vis._lattice_tree.query(
+            shapely.points(here), predicate="dwithin", distance=JUNCTION_REACH_M
+        )
+        reach: dict[int, list[int]] = {}
+        for a, b in pairs.T:
+            reach.setdefault(int(a), []).append(int(b))
+        for n, (i, j) in enumerate(zip(live, near, strict=True)):
             ways: dict[int, tuple[float, float]] = {}
-            for h_map, d in self.vis.exits[j]:
-                k = int(round(wrap_angle(h_map - tfs[i][2] - axis) / (math.pi / 2))) % 4
-                r = self.vis.run_lengths[j].get(h_map, 0.0)
-                if k not in ways or d < ways[k][0]:
-                    ways[k] = (d, r)
+            for m in {j, *reach.get(n, ())}:
+                for h_map, d in self.vis.exits[m]:
+                    k = int(round(wrap_angle(h_map - tfs[i][2] - axis) / (math.pi / 2))) % 4
+                    if m != j and k % 2 == 0:
+                        continue
+                    r = self.vis.run_lengths[m].get(h_map, 0.0)
+                    if k not in ways or d < ways[k][0]:
+                        ways[k] = (d, r)
             if 1 in ways or 3 in ways:
                 side_mass += w[i]
             for k, (d, r) in ways.items():
