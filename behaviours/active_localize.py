@@ -19,7 +19,7 @@ from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.visibility import entity_xy
 from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
-from pmnav_bt.seams import Entity, EntityKind, MotionStatus
+from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation
 
 NO_PROGRESS_S = 6.0  # clock seconds without moving 0.1 m: the drive is blocked
 MIN_BLOCKED_DRIVE_M = 0.2  # blocked sooner: a brush with a wall, not the corridor's end
@@ -29,27 +29,9 @@ STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
 
 
-def as_entity(ref) -> Entity:
-    """An Entity from a sighting's reference ("room:<id>" or an Entity)."""
-    if isinstance(ref, Entity):
-        return ref
-    kind, ident = str(ref).split(":", 1)
-    return Entity(EntityKind(kind), ident)
-
-
-def wall_mask(grounder, obs):
-    """The wall mask of a frame from the grounder, or None."""
-    surfaces = getattr(grounder, "surfaces", None)
-    if surfaces is not None:
-        return surfaces(obs).wall
-    dets = grounder.detect(obs, "wall")
-    return dets[0].mask if dets else None
-
-
-def read_signs(grounder, obs) -> list:
-    """Every sign readable in a frame."""
-    reader = getattr(grounder, "read_signs", None)
-    return reader(obs) if reader is not None else grounder.detect(obs, "sign")
+def wall_mask(grounder: Grounder, obs: Observation):
+    """The wall mask of a frame (the grounder's surfaces)."""
+    return grounder.surfaces(obs).wall
 
 
 def read_panorama(ctx: Context, views: list):
@@ -88,9 +70,10 @@ class UpdateBelief(PmNavBehaviour):
         self._job = ctx.worker.submit(lambda c: read_panorama(ctx, views))
 
     def update(self) -> Status:
-        if not self._job.done():
-            return Status.RUNNING
-        sightings, axis, free = self._job.result()
+        status, read = self.poll(self._job, "reading the panorama")
+        if status is not None:
+            return status
+        sightings, axis, free = read
         views = self.get("views") or []
         belief = self.get("belief")
         if belief is None:
@@ -102,7 +85,7 @@ class UpdateBelief(PmNavBehaviour):
         odom = views[0].observation.pose if views else self.ctx.base.pose()
         seen: dict[Entity, tuple[float, float]] = {}
         for s in sightings:
-            seen.setdefault(as_entity(s.entity), s.odom_xy)
+            seen.setdefault(s.entity, s.odom_xy)
         belief.observe(Glimpse(odom, seen, free=free), axis_odom=axis)
         self.bb.set("belief", belief)
         _, mass = belief.best_cluster()
@@ -134,10 +117,7 @@ class FixFromBelief(PmNavBehaviour):
         if belief is None:
             return self.fail(FailureCode.LOCALIZATION_FAILED, "no panorama to localize from")
         last = belief.glimpses[-1]
-        now = [
-            Sighting(f"{e.kind.value}:{e.id}", entity_xy(self.ctx.pm, e), xy)
-            for e, xy in last.seen.items()
-        ]
+        now = [Sighting(e, entity_xy(self.ctx.pm, e), xy) for e, xy in last.seen.items()]
         fix = fix_pose(now)
         if fix is not None:
             tf = belief.to_odom(fix.map_T_odom)  # the sightings are in the belief's frame
@@ -231,7 +211,7 @@ class FollowLead(PmNavBehaviour):
             obs = base.observe()
             mask = wall_mask(grounder, obs)
             fit = None if mask is None else fit_wall_angle(wall_points(obs, mask))
-            signs = len(read_signs(grounder, obs))
+            signs = len(grounder.read_signs(obs))
             return obs.pose.yaw, None if fit is None else fit[0], signs, free_distance(obs, 0.0)
 
         self._job = self.ctx.worker.submit(measure)
@@ -239,8 +219,11 @@ class FollowLead(PmNavBehaviour):
     def _poll_walls(self) -> None:
         if self._job is None or not self._job.done():
             return
-        yaw, angle, signs, free = self._job.result()
-        self._job = None
+        job, self._job = self._job, None
+        try:
+            yaw, angle, signs, free = job.result()
+        except Exception:  # noqa: BLE001 - a lost wall check: drive on, check again
+            return
         if angle is not None and abs(angle) < ALONG_WALL_MAX:
             self._heading = yaw + angle  # parallel to the wall in view
         self._signs_ahead = signs

@@ -89,9 +89,9 @@ class CorrectHeading(PmNavBehaviour):
         self._job = self.ctx.worker.submit(measure)
 
     def update(self) -> Status:
-        if not self._job.done():
-            return Status.RUNNING
-        axis = self._job.result()
+        status, axis = self.poll(self._job, "measuring the walls")
+        if status is not None:
+            return status
         if axis is None or self.get("map_T_odom") is None:
             self.feedback_message = "no wall line"
             return Status.SUCCESS

@@ -20,7 +20,7 @@ from py_trees.decorators import Retry
 from pmnav_bt.behaviours.active_localize import FixFromBelief, FollowLead, UpdateBelief
 from pmnav_bt.behaviours.capture import CaptureViews
 from pmnav_bt.behaviours.context import Context
-from pmnav_bt.behaviours.localize import enough_doors, localization_yaws, sign_query
+from pmnav_bt.behaviours.localize import enough_doors, localization_yaws, read_signs
 from pmnav_bt.behaviours.recovery import BackUp, FaceCorridor, FailureIs, Spin, Wait
 from pmnav_bt.failures import FailureCode
 
@@ -38,8 +38,8 @@ def active_localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.be
                 f"{name}Views",
                 ctx,
                 localization_yaws,
-                sign_query,
-                enough=lambda views: enough_doors(ctx, views),
+                read_signs,
+                enough=enough_doors,
             ),
             UpdateBelief(f"{name}Belief", ctx),
             FixFromBelief(f"{name}Fix", ctx),

@@ -29,7 +29,7 @@ LATTICE_M = 0.5  # spacing of the lattice points along the corridor centre lines
 
 def entity_xy(pm: PrioriMap, entity: Entity) -> tuple[float, float]:
     """Where the map puts a room's door or a landmark's face on the wall."""
-    return entity_position(pm, f"{entity.kind.value}:{entity.id}")
+    return entity_position(pm, entity)
 
 
 def map_entities(pm: PrioriMap) -> list[Entity]:

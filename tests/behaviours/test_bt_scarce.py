@@ -18,13 +18,13 @@ from pmnav_bt.behaviours.search import (
     FineDirection,
     Ground,
     Verify,
-    target_query,
+    target_entity,
 )
 from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.geometry import se2_apply
 from pmnav_bt.localization import Sighting
 from pmnav_bt.pose.correction import PoseTracker
-from pmnav_bt.seams import MotionStatus, Pose2D
+from pmnav_bt.seams import Entity, MotionStatus, Pose2D
 from pmnav_bt.trees.localize import recovery_subtree
 
 SOUTH = math.radians(-90)
@@ -38,16 +38,16 @@ def targets(rig) -> dict:
 def search(rig, target) -> None:
     """Put ``target`` on the blackboard and take the search views for it."""
     rig.set(target=target)
-    cap = CaptureViews("SearchViews", rig.ctx, lambda b: search_yaws(None), target_query)
+    cap = CaptureViews("SearchViews", rig.ctx, lambda b: search_yaws(None), target_entity)
     rig.expect(rig.run(cap, max_ticks=300), Status.SUCCESS)
 
 
 def fine_and_verify(rig, map_T_odom) -> Verify:
     """CoarseDirection -> Ground -> FineDirection -> Verify on the current views."""
     rig.set(map_T_odom=map_T_odom)
-    assert rig.tick(CoarseDirection("CoarseDirection", rig.ctx)) == Status.SUCCESS
+    rig.expect(rig.run(CoarseDirection("CoarseDirection", rig.ctx)), Status.SUCCESS)
     rig.expect(rig.run(Ground("Grounding", rig.ctx), max_ticks=100), Status.SUCCESS)
-    assert rig.tick(FineDirection("FineDirection", rig.ctx)) == Status.SUCCESS
+    rig.expect(rig.run(FineDirection("FineDirection", rig.ctx)), Status.SUCCESS)
     verify = Verify("Verification", rig.ctx)
     rig.tick(verify)
     return verify
@@ -137,7 +137,7 @@ def test_heading_bias_is_corrected_after_two_landmarks(make_rig):
     bias = math.radians(5.0)
     tf = rotated_about(rig.base.pose(), bias)
     # One landmark verified earlier, 9 m up the corridor, seen where it is.
-    rig.set(recent_sightings=[Sighting("room:room1", (-1.2, 26.0), (-1.2, 26.0))])
+    rig.set(recent_sightings=[Sighting(Entity.room("room1"), (-1.2, 26.0), (-1.2, 26.0))])
     rig.set(pose_tracker=PoseTracker(tf, sigma0=0.3))
     verify = fine_and_verify(rig, tf)
     assert verify.status == Status.SUCCESS
