@@ -14,7 +14,8 @@ from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.visibility import LandmarkDensity, Visibility
 
 
-def test_starts_are_classed_by_the_signs_readable_there():
+def test_starts_are_classed_by_the_signs_readable_there(tmp_path, monkeypatch):
+    monkeypatch.setenv("PMNAV_CACHE", str(tmp_path))
     starts = classified_starts("sign_sparse_0", n=3, seed=1)
     assert {s.density for s in starts} == {c.value for c in LandmarkDensity}
     vis = Visibility.of(parse_building(load_building("sign_sparse_0")))

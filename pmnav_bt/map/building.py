@@ -404,12 +404,6 @@ def building_from_data(data: Any, source: str = "<data>", base_dir: Path | None 
 def load_building(path: str | Path) -> Building:
     """Read and validate a building file (or a built-in building's name, or a generated
     family's: "sign_sparse_<seed>")."""
-    if isinstance(path, str) and not Path(path).exists():
-        from pmnav_bt.map.generate import generated_family  # generate imports this module
-
-        generated = generated_family(path)
-        if generated is not None:
-            return generated
     path = resolve_building_path(path)
     try:
         data = load_yaml(path, "building")
@@ -458,10 +452,11 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
         return p
     if os.path.lexists(p):
         return p
-    from pmnav_bt.map.generate import is_generated_name  # generate imports this module
+    from pmnav_bt.map.generate import generated_file  # generate imports this module
 
-    if is_generated_name(text):
-        return p  # a generated building ("sign_sparse_3"): no file, no folder of its own
+    generated = generated_file(text)  # "sign_sparse_3": written once to the cache folder
+    if generated is not None:
+        return generated
     builtin = BUILTIN_DIR / f"{name_or_path}.yaml"
     if builtin.is_file():
         return builtin

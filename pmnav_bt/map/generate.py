@@ -10,11 +10,13 @@ doors; a few elevators and stairs are spread over the floor.
 from __future__ import annotations
 
 import math
+import os
 import random
+from pathlib import Path
 
 import networkx as nx
 
-from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
+from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data, dump_building
 
 ROOM_PITCH = 3.0  # metres between door centres along a corridor (alternating walls)
 JUNCTION_CLEARANCE = 2.5  # no door closer than this to a junction
@@ -169,6 +171,26 @@ def generated_family(name: str) -> Building | None:
     if not is_generated_name(name):
         return None
     return generate_sign_sparse(int(name.rpartition("_")[2]))
+
+
+def generated_file(name: str) -> Path | None:
+    """The building file of a generated family's name, written once to the cache folder
+    (``$PMNAV_CACHE`` or ``$XDG_CACHE_HOME/pmnav``, default ``~/.cache/pmnav``), so that a
+    generated building has a file like any other (episodes record its path and hash)."""
+    b = generated_family(name)
+    if b is None:
+        return None
+    root = os.environ.get("PMNAV_CACHE") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "pmnav"
+    )
+    path = Path(root) / "buildings" / f"{name}.yaml"
+    text = dump_building(b)
+    if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(path)  # atomic: parallel runs never read half a file
+    return path
 
 
 def _merge_straight_runs(g: nx.Graph) -> nx.Graph:

@@ -51,7 +51,10 @@ def test_walls_block_the_view_round_a_corner(sparse):
     assert blocked > 0
 
 
-def test_the_sign_sparse_family_has_long_bare_stretches_and_near_identical_signs(sparse):
+def test_the_sign_sparse_family_has_long_bare_stretches_and_near_identical_signs(
+    sparse, tmp_path, monkeypatch
+):
+    monkeypatch.setenv("PMNAV_CACHE", str(tmp_path))
     vis = Visibility.of(sparse)
     bare = [p for p in vis.lattice_points if not p.readable]
     assert len(bare) * vis.lattice >= 40.0  # metres of corridor where nothing is readable
@@ -60,7 +63,8 @@ def test_the_sign_sparse_family_has_long_bare_stretches_and_near_identical_signs
     assert len({s[1:] for s in signs}) < len(signs)  # the same numbers in several wings
     assert generate_sign_sparse(0) == sparse.building  # seeded
     assert load_building("sign_sparse_0") == sparse.building  # by family name
-    assert resolve_building_path("sign_sparse_0").name == "sign_sparse_0"  # no file needed
+    path = resolve_building_path("sign_sparse_0")  # written once to the cache folder
+    assert path == tmp_path / "buildings" / "sign_sparse_0.yaml" and path.is_file()
 
 
 def test_towards_signs_leads_from_every_bare_point(sparse):
