@@ -32,10 +32,21 @@ def ros_required():
         pytest.skip(why)
 
 
+def _next_domain_id() -> int:
+    """A ROS_DOMAIN_ID in 1..101 that no other test of this run has had (for < 101 tests)."""
+    return domain_id_for(os.getpid() * 7 + next(_counter))
+
+
+@pytest.fixture(scope="session")
+def new_domain_id(ros_required):
+    """A function giving a fresh domain id, for fixtures wider than one test."""
+    return _next_domain_id
+
+
 @pytest.fixture
 def domain_id(ros_required) -> int:
     """A ROS_DOMAIN_ID in 1..101 for this test only."""
-    d = domain_id_for(os.getpid() * 7 + next(_counter))
+    d = _next_domain_id()
     os.environ["ROS_DOMAIN_ID"] = str(d)
     return d
 

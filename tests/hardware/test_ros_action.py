@@ -66,13 +66,12 @@ def _wait(pred, timeout: float, what: str):
 
 
 @pytest.fixture(scope="module")
-def launched(tmp_path_factory, ros_required):
-    from pmnav_bt.hardware.env import domain_id_for
+def launched(tmp_path_factory, new_domain_id):
     from pmnav_bt.hardware.runtime import RosRuntime
     from pmnav_bt.hardware.testing import Probe
 
     tmp = tmp_path_factory.mktemp("launch")
-    domain = domain_id_for(hash(str(tmp)) + 31)
+    domain = new_domain_id()  # a hash could land on a domain an earlier test still uses
     record = tmp / "run.mcap"
     log = open(tmp / "launch.log", "w", encoding="utf-8")  # noqa: SIM115
     launcher = subprocess.Popen(
