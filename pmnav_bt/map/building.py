@@ -103,7 +103,20 @@ class Edge(_Strict):
         return data
 
 
-class Room(_Strict):
+class _Named:
+    """What people call a room or landmark (``name`` or ``id``), and what its sign reads."""
+
+    @property
+    def display_name(self) -> str:
+        return self.name or self.id
+
+    @property
+    def sign_text(self) -> str:
+        """The text on its sign plate (defaults to the display name)."""
+        return self.sign or self.display_name
+
+
+class Room(_Named, _Strict):
     """A room behind a door on a corridor. ``door`` is the door centre, in the corridor wall."""
 
     id: Ident
@@ -112,17 +125,8 @@ class Room(_Strict):
     door: Point
     sign: Text = ""
 
-    @property
-    def display_name(self) -> str:
-        return self.name or self.id
 
-    @property
-    def sign_text(self) -> str:
-        """The text on the sign plate beside the door (defaults to the display name)."""
-        return self.sign or self.display_name
-
-
-class Landmark(_Strict):
+class Landmark(_Named, _Strict):
     """A non-room landmark (elevator, stairs, reception desk, a named sign ...)."""
 
     id: Ident
@@ -131,15 +135,6 @@ class Landmark(_Strict):
     aliases: tuple[Text, ...] = Field(default=(), max_length=MAX_ALIASES)
     pos: Point
     sign: Text = ""
-
-    @property
-    def display_name(self) -> str:
-        return self.name or self.id
-
-    @property
-    def sign_text(self) -> str:
-        """The text on the landmark's sign (defaults to the display name)."""
-        return self.sign or self.display_name
 
 
 class FloorPlan(_Strict):

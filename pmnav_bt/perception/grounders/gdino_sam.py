@@ -24,7 +24,7 @@ from pmnav_bt.loading import weights_file
 from pmnav_bt.map.building import Building
 from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.doors import DoorLayout
-from pmnav_bt.perception.grounders.ocr import OcrGrounder
+from pmnav_bt.perception.grounders.ocr import OcrGrounder, reader_and_layout
 from pmnav_bt.perception.signs import SignReader
 from pmnav_bt.registry import BackendDeps
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
@@ -218,15 +218,7 @@ def _mask_point(obs: Observation, mask: np.ndarray | None) -> tuple[float, float
 def build(deps: BackendDeps) -> GdinoSamGrounder:
     """The ``gdino_sam`` back end from ``config.grounder`` (registry factory)."""
     g = deps.config.grounder
-    reader = SignReader(
-        threads=g.ocr_threads, max_candidates=g.ocr_max_candidates, min_score=g.ocr_min_score
-    )
-    layout = DoorLayout(
-        sign_to_door=g.sign_to_door,
-        door_width=g.door_width,
-        door_height=g.door_height,
-        default_side=g.door_side,
-    )
+    reader, layout = reader_and_layout(g)
     return GdinoSamGrounder(
         deps.pm.building,
         g.gdino_path,

@@ -122,9 +122,8 @@ class OcrGrounder:
         )
 
 
-def build(deps: BackendDeps) -> OcrGrounder:
-    """The ``ocr`` back end from ``config.grounder`` (registry factory)."""
-    g = deps.config.grounder
+def reader_and_layout(g) -> tuple[SignReader, DoorLayout]:
+    """The sign reader and door layout ``config.grounder`` describes (ocr and gdino_sam)."""
     reader = SignReader(
         threads=g.ocr_threads, max_candidates=g.ocr_max_candidates, min_score=g.ocr_min_score
     )
@@ -134,4 +133,9 @@ def build(deps: BackendDeps) -> OcrGrounder:
         door_height=g.door_height,
         default_side=g.door_side,
     )
-    return OcrGrounder(deps.pm.building, reader, layout)
+    return reader, layout
+
+
+def build(deps: BackendDeps) -> OcrGrounder:
+    """The ``ocr`` back end from ``config.grounder`` (registry factory)."""
+    return OcrGrounder(deps.pm.building, *reader_and_layout(deps.config.grounder))
