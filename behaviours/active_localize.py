@@ -10,6 +10,7 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, thumbnail
+from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M
 from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import FailureCode
@@ -104,11 +105,12 @@ class FixFromBelief(PmNavBehaviour):
     belief once one corridor position dominates it.
 
     Reads ``belief``, ``views``, ``fix_attempts``; writes ``map_T_odom``, ``pose_tracker``,
-    ``fix_attempts``, ``belief`` (cleared on a fix). FAILURE (LOCALIZATION_FAILED) otherwise.
+    ``fix_attempts``, ``belief`` and ``recent_sightings`` (both cleared on a fix).
+    FAILURE (LOCALIZATION_FAILED) otherwise.
     """
 
     READS = ("belief", "views", "fix_attempts")
-    WRITES = ("map_T_odom", "pose_tracker", "fix_attempts", "belief")
+    WRITES = ("map_T_odom", "pose_tracker", "fix_attempts", "belief", "recent_sightings")
 
     def update(self) -> Status:
         belief: CorridorBelief | None = self.get("belief")
@@ -141,6 +143,7 @@ class FixFromBelief(PmNavBehaviour):
             PoseTracker(map_T_odom=tf, sigma0=sigma, odometer0=self.ctx.odometer.distance),
         )
         self.bb.set("belief", None)
+        forget_stale_sightings(self)
         est_x, est_y = _map_xy(tf, self.ctx.base.pose())
         views = self.get("views") or []
         self.ctx.log(

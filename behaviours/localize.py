@@ -35,15 +35,29 @@ def distinct_landmarks(views: list[View]) -> set[Entity]:
     return {d.entity for v in views for d in v.detections or () if d.entity is not None}
 
 
+def forget_stale_sightings(b: PmNavBehaviour) -> None:
+    """Drop the verified sightings kept for heading re-fits, on a new fix.
+
+    A re-fit assumes one rigid ``map_T_odom`` over its sightings; the panorama spins of a
+    (re)localization turn the body a full circle or more, and odometry's rotation bias
+    turns the odometry frame with them, so sightings from before a fix no longer share its
+    frame. Mixed with new ones they re-fit the heading wrong by as much as the drift since
+    (about 18 deg in fig2_hospital with the ``ocr`` grounder), and the robot then drives
+    into a side wall that its depth watch rightly calls an obstacle.
+    """
+    b.bb.set("recent_sightings", None)
+
+
 class FixPosition(PmNavBehaviour):
     """Fix the map pose from the landmarks in the localization views.
 
-    Reads ``views``, ``fix_attempts``; writes ``map_T_odom``, ``fix_attempts``.
+    Reads ``views``, ``fix_attempts``; writes ``map_T_odom``, ``fix_attempts``,
+    ``recent_sightings`` (cleared on a fix: see ``forget_stale_sightings``).
     FAILURE (LOCALIZATION_FAILED) with fewer than two consistent landmarks.
     """
 
     READS = ("views", "fix_attempts")
-    WRITES = ("map_T_odom", "fix_attempts")
+    WRITES = ("map_T_odom", "fix_attempts", "recent_sightings")
 
     def initialise(self) -> None:
         pm, views = self.ctx.pm, self.get("views") or []
@@ -75,6 +89,7 @@ class FixPosition(PmNavBehaviour):
                 "; two are needed",
             )
         self.bb.set("map_T_odom", fix.map_T_odom)
+        forget_stale_sightings(self)
         est = fix.map_pose(self.ctx.base.pose())
         views = self.get("views") or []
         self.ctx.log(

@@ -111,3 +111,20 @@ def test_explore_blocked_is_best_effort_success(make_rig):
     assert rig.true_pose().y == pytest.approx(19.3 + 0.17, abs=0.05)  # against the box
     assert rig.body.stats.collisions == 1
     assert rig.stopped()
+
+
+def test_a_fix_forgets_the_sightings_kept_for_heading_re_fits(make_rig):
+    # Sightings verified before this fix were made in an odometry frame that the panorama's
+    # spin has since turned: kept, they would re-fit the heading off by that turn.
+    from pmnav_bt.localization import Sighting
+    from pmnav_bt.seams import Entity
+
+    rig = make_rig(Pose2D(0.0, 28.0, SOUTH))
+    stale = [
+        Sighting(Entity.room("room1"), (-1.2, 26.0), (3.0, 25.0)),
+        Sighting(Entity.room("room2"), (-1.2, 18.0), (5.0, 17.5)),
+    ]
+    rig.set(recent_sightings=stale)
+    capture(rig, enough=enough_doors)
+    rig.expect(rig.run(FixPosition("Fix", rig.ctx)), Status.SUCCESS)
+    assert rig.get("recent_sightings") is None
