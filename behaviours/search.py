@@ -14,7 +14,7 @@ from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply
 from pmnav_bt.localization import Sighting, fix_pose
 from pmnav_bt.planning.resolve import entity_position, step_entity
-from pmnav_bt.seams import CoarseChoice, Entity, View
+from pmnav_bt.seams import CoarseChoice, Entity, EntityKind, View
 
 # How far (m) a sighting may be from where the map puts the target and still be it, when
 # no pose tracker says how uncertain the estimate is (it does after a fix).
@@ -225,11 +225,18 @@ class Verify(PmNavBehaviour):
                 f"{tol:.1f} m): not it",
             )
         recent = [r for r in (self.get("recent_sightings") or []) if r.entity != s.entity]
-        recent = (recent + [s])[-RECENT_SIGHTINGS:]
-        self.bb.set("recent_sightings", recent)
+        landmark = s.entity.kind is EntityKind.LANDMARK
+        if not landmark:
+            recent = (recent + [s])[-RECENT_SIGHTINGS:]
+            self.bb.set("recent_sightings", recent)
         refit = fix_pose(recent, max_residual=REFIT_RESIDUAL) if len(recent) >= 2 else None
         how = "shifted"
-        if refit is not None and _spread(recent) >= MIN_REFIT_SPREAD:
+        if landmark:
+            # A landmark is known by its sign, which may hang beside it (an elevator's,
+            # ~1.5 m along the wall): it tells how far the wall is, not where along it.
+            err = across_wall(self.ctx.pm, s.entity, err)
+            how = "shifted across its wall"
+        elif refit is not None and _spread(recent) >= MIN_REFIT_SPREAD:
             tf = refit.map_T_odom  # heading from the recent landmarks ...
             err = np.asarray(s.map_xy) - se2_apply(tf, s.odom_xy)
             how = f"re-fit on {len(refit.entities)} landmarks, shifted"
@@ -243,6 +250,13 @@ class Verify(PmNavBehaviour):
             self.bb.set("pose_tracker", tracker)
         self.feedback_message = f"{s.entity} verified ({dist:.2f} m off the map; {how})"
         return Status.SUCCESS
+
+
+def across_wall(pm, entity: Entity, err: np.ndarray) -> np.ndarray:
+    """The part of ``err`` (map metres) across the corridor wall that ``entity`` is on."""
+    heading = pm.segments[pm.places[entity.id].segment - 1].heading
+    normal = np.array([-math.sin(heading), math.cos(heading)])
+    return normal * float(err @ normal)
 
 
 def _spread(sightings: list[Sighting]) -> float:

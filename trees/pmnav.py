@@ -82,7 +82,9 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
         "MoveOnAndResearch",
         memory=True,
         children=[
-            MoveToward("MoveOn", ctx, keep=1.0, distance=cfg.research_distance),
+            # On up to level with the target (its node): a sign hangs beside its door,
+            # maybe on the far side, readable (not just visible) only from about there.
+            MoveToward("MoveOn", ctx, keep=0.0, distance=cfg.research_distance),
             AlwaysFail(name="SearchAgain"),
         ],
     )

@@ -262,3 +262,24 @@ def test_detector_coarse_direction_seam_grounds_plain_views(make_rig):
     assert picked.view.relative_yaw == pytest.approx(best[0].relative_yaw)
     assert picked.detection.entity == Entity.room("room4")
     assert rig.ctx.coarse.choose(plain, Entity.room("room3")) is None  # 16 m: unreadable
+
+
+def test_a_landmark_sighting_corrects_only_across_its_wall_and_joins_no_re_fit(make_rig):
+    # A landmark is read by its sign, which may hang beside it (an elevator's ~1.5 m along
+    # the wall): seen 1.5 m along the N-S corridor from the map's point and 0.4 m across.
+    from pmnav_bt.pose.visibility import entity_xy
+
+    rig = make_rig(NORTH_OF_ROOM4)
+    desk = Entity.landmark("reception")
+    map_xy = entity_xy(rig.pm, desk)
+    odom_xy = (map_xy[0] - 0.4, map_xy[1] + 1.5)
+    recent = [Sighting(Entity.room("room1"), (-1.2, 26.0), (-1.2, 26.0))]
+    rig.set(sighting=Sighting(desk, map_xy, odom_xy), recent_sightings=recent)
+    rig.set(map_T_odom=(0.0, 0.0, 0.0))
+    verify = Verify("Verification", rig.ctx)
+    rig.tick(verify)
+    assert verify.status == Status.SUCCESS
+    assert "across its wall" in verify.feedback_message
+    tf = rig.get("map_T_odom")
+    assert tf == pytest.approx((CORRECTION_GAIN * 0.4, 0.0, 0.0), abs=1e-9)  # not along it
+    assert rig.get("recent_sightings") == recent  # no heading re-fit on its sign
