@@ -162,7 +162,13 @@ class TreeConfig(_Section):
         le=100.0,
         description="drive until a target is this close (by the map) before searching",
     )
-    search_attempts: int = Field(3, ge=1, le=100, description="searches for one landmark")
+    search_attempts: int = Field(
+        4,
+        ge=1,
+        le=100,
+        description="searches for one landmark (the last from level with it: a sign on the "
+        "door's far side is readable only from there)",
+    )
     research_distance: float = Field(
         2.0,
         gt=0.0,
