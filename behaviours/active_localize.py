@@ -12,7 +12,6 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, thumbnail
 from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M
-from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.localization import Sighting, fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance
@@ -244,11 +243,8 @@ class FollowLead(PmNavBehaviour):
             return Status.RUNNING
         self._poll_walls()
         if not self._driving:
-            v, w, done = rotate_command(pose, self._heading, self.ctx.limits)
-            if not done:
-                base.set_velocity(v, w)
+            if not self.face(self._heading, pose):
                 return Status.RUNNING
-            base.set_velocity(0.0, 0.0)
             if self._next_check == -math.inf:  # aligned once: look at the walls, then go
                 self._check_walls()
                 self._next_check = now

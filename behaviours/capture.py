@@ -14,7 +14,6 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context
-from pmnav_bt.control import rotate_command
 from pmnav_bt.geometry import Action, wrap_angle
 from pmnav_bt.seams import Entity, View
 
@@ -94,11 +93,8 @@ class CaptureViews(PmNavBehaviour):
                 self.bb.set("views", list(self._views))
                 return Status.SUCCESS
         goal = self._start_yaw + self._todo[0]
-        v, w, done = rotate_command(self.ctx.base.pose(), goal, self.ctx.limits)
-        if not done:
-            self.ctx.base.set_velocity(v, w)
+        if not self.face(goal):
             return Status.RUNNING
-        self.ctx.base.set_velocity(0.0, 0.0)
         what, base, grounder = self._grounding, self.ctx.base, self.ctx.grounder
 
         def take(cancelled):

@@ -11,7 +11,9 @@ import py_trees
 from py_trees.common import Access, Status
 
 from pmnav_bt.behaviours.context import Context
+from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import Failure, FailureCode, failure_from
+from pmnav_bt.seams import Pose2D
 from pmnav_bt.worker import Job
 
 NAMESPACE = "/pmnav"
@@ -67,6 +69,14 @@ class PmNavBehaviour(py_trees.behaviour.Behaviour):
     def get(self, key: str, default=None):
         """A blackboard value, or ``default`` when unset."""
         return self.bb.get(key) if self.bb.exists(key) else default
+
+    def face(self, yaw: float, pose: Pose2D | None = None) -> bool:
+        """Turn towards ``yaw`` (rad) at the body's limits; True, with the body stopped, once
+        facing it. ``pose``: the pose to turn from (default: odometry)."""
+        base = self.ctx.base
+        v, w, done = rotate_command(base.pose() if pose is None else pose, yaw, self.ctx.limits)
+        base.set_velocity(*((0.0, 0.0) if done else (v, w)))
+        return done
 
     def fail(self, code: FailureCode, message: str) -> Status:
         """Record why, and return FAILURE."""

@@ -14,7 +14,7 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
-from pmnav_bt.control import goto_command, rotate_command
+from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
 from pmnav_bt.perception.corner import is_corner, is_opening, mask_ratios
@@ -236,14 +236,11 @@ class TurnOnto(PmNavBehaviour):
 
     def update(self) -> Status:
         est = map_pose(self.get("map_T_odom"), self.ctx.base.pose())
-        v, w, done = rotate_command(est, self._heading, self.ctx.limits)
-        if done:
-            self.ctx.base.set_velocity(0.0, 0.0)
-            t = self.get("target")
-            self.ctx.log("turn", t.landmark, action=t.action.value)
-            return Status.SUCCESS
-        self.ctx.base.set_velocity(v, w)
-        return Status.RUNNING
+        if not self.face(self._heading, est):
+            return Status.RUNNING
+        t = self.get("target")
+        self.ctx.log("turn", t.landmark, action=t.action.value)
+        return Status.SUCCESS
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID:

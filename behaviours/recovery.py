@@ -14,7 +14,6 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, map_pose
-from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.seams import MotionStatus
@@ -92,12 +91,7 @@ class Spin(PmNavBehaviour):
         self._goal = self.target()
 
     def update(self) -> Status:
-        v, w, done = rotate_command(self.ctx.base.pose(), self._goal, self.ctx.limits)
-        if done:
-            self.ctx.base.set_velocity(0.0, 0.0)
-            return Status.SUCCESS
-        self.ctx.base.set_velocity(v, w)
-        return Status.RUNNING
+        return Status.SUCCESS if self.face(self._goal) else Status.RUNNING
 
     def terminate(self, new_status: Status) -> None:
         if new_status == Status.INVALID:

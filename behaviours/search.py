@@ -9,7 +9,6 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import map_pose, thumbnail
-from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply
 from pmnav_bt.localization import Sighting, fix_pose
@@ -102,11 +101,8 @@ class Ground(PmNavBehaviour):
     def update(self) -> Status:
         base = self.ctx.base
         if self._job is None:
-            v, w, done = rotate_command(base.pose(), self._yaw, self.ctx.limits)
-            if not done:
-                base.set_velocity(v, w)
+            if not self.face(self._yaw):
                 return Status.RUNNING
-            base.set_velocity(0.0, 0.0)
             target, grounder = self._target, self.ctx.grounder
 
             def take(cancelled):
