@@ -50,6 +50,7 @@ from pmnav_bt.map.building import (
     resolve_building_path,
 )
 from pmnav_bt.map.free_space import free_space_polygon
+from pmnav_bt.map.generate import is_generated_name
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.seams import CREATE3_RADIUS_M, Pose2D
@@ -268,14 +269,15 @@ def save_episodes(episodes: Sequence[Episode], path: str | Path) -> Path:
 def episode_building_file(episode: Episode) -> Path:
     """The building file an episode was made for, checked against its recorded sha256.
 
-    A recorded path that no longer exists falls back to the built-in building of the
-    episode's name when its content is the same (episode files of built-ins travel).
+    A recorded path that no longer exists falls back to the built-in (or generated)
+    building of the episode's name when its content is the same (episode files of
+    built-ins travel; a Ray node regenerates a generated building in its own cache).
     """
     path = episode.building_path
     if not path:
         return resolve_building_path(episode.building)
     if not Path(path).is_file():
-        if episode.building in builtin_buildings():
+        if episode.building in builtin_buildings() or is_generated_name(episode.building):
             builtin = resolve_building_path(episode.building)
             if not episode.building_sha256 or building_sha256(builtin) == episode.building_sha256:
                 return builtin

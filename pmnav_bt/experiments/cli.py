@@ -9,6 +9,8 @@ level: pybullet and py_trees load inside the commands that need them.
 
 from __future__ import annotations
 
+import sys
+
 from pmnav_bt.cli import app
 from pmnav_bt.cli import main as _run
 from pmnav_bt.experiments.plan_cli import app as plan_app
@@ -20,9 +22,21 @@ app.add_typer(sim_app, name="sim")
 app.add_typer(tree_app, name="tree")
 
 
+def optional_value(args: list[str], option: str, default: str) -> list[str]:
+    """``--ray`` may stand alone: give it ``default`` when no value follows it."""
+    out = list(args)
+    for i, a in enumerate(out):
+        if a == "--":
+            break
+        if a == option and (i + 1 == len(out) or out[i + 1].startswith("-")):
+            out.insert(i + 1, default)
+    return out
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point of ``pmnav``: user errors become one line on stderr and exit status 2."""
-    _run(argv)
+    args = list(sys.argv[1:] if argv is None else argv)
+    _run(optional_value(args, "--ray", "local"))
 
 
 if __name__ == "__main__":  # pragma: no cover

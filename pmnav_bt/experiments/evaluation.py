@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pmnav_bt.config import Config
-from pmnav_bt.errors import PmNavError
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
 from pmnav_bt.loading import atomic_write_text, safe_filename
 
@@ -217,26 +216,30 @@ def episodes_for(buildings: Iterable[str], tiers: Iterable[str], n: int, seed: i
     return out, notes
 
 
+def _error_result(episode, error: str) -> EpisodeResult:
+    return EpisodeResult(
+        episode_id=episode.id,
+        tier=episode.tier,
+        success=False,
+        spl=0.0,
+        path_length=0.0,
+        steps=0,
+        failure_reason=None,
+        building=episode.building,
+        route_length=episode.route_length,
+        error=error,
+    )
+
+
 def _run_one(args) -> dict:
-    """One episode in a pool process; a crash becomes an errored result (counted apart
-    from navigation failures), not a lost run."""
+    """One episode in a worker (pool process or Ray task); a crash becomes an errored
+    result (counted apart from navigation failures), not a lost run."""
     episode, config_json = args
     config = Config.model_validate_json(config_json)
     try:
         run = run_episode(episode, config, out_dir=None, plot=False)
     except Exception as err:  # noqa: BLE001 - reported in the results, with its type
-        return EpisodeResult(
-            episode_id=episode.id,
-            tier=episode.tier,
-            success=False,
-            spl=0.0,
-            path_length=0.0,
-            steps=0,
-            failure_reason=None,
-            building=episode.building,
-            route_length=episode.route_length,
-            error=f"{type(err).__name__}: {err}",
-        ).to_dict()
+        return _error_result(episode, f"{type(err).__name__}: {err}").to_dict()
     return run.result.to_dict()
 
 
@@ -247,54 +250,59 @@ def evaluate(
     progress: Callable[[str, int, int], None] | None = None,
     on_result: Callable[[str, EpisodeResult], None] | None = None,
     finished: dict[str, list[EpisodeResult]] | None = None,
+    ray: str | None = None,
+    done: dict[tuple[str, str], EpisodeResult] | None = None,
 ) -> dict[str, list[EpisodeResult]]:
-    """Run every episode under each named config; results per config name.
+    """Run every episode under each named config; results per config name, in episode
+    order.
 
-    ``on_result(name, result)`` is called as each episode ends (to save it at once).
-    ``finished``, when given, is filled as results arrive: after an interruption it
-    holds what finished. Pool workers ignore Ctrl-C; on any exception the pool is
-    terminated before the exception goes on.
+    ``done`` holds results already on disk, keyed (config name, episode id): those runs
+    are skipped and their results included (``--resume``). ``on_result(name, result)`` is
+    called as each new run ends (to save it at once); ``progress(name, done, total)``
+    after it. ``finished``, when given, is filled as results arrive: after an
+    interruption it holds what finished. Runs go to ``jobs`` pool processes, or to Ray
+    (``ray``: "local" or a cluster address; see ``executors``); the same seeds give the
+    same results either way.
     """
-    results: dict[str, list[EpisodeResult]] = {} if finished is None else finished
-    total = len(episodes) * len(configs)
-    done = 0
-    for name, cfg in configs.items():
-        tasks = [(e, cfg.model_dump_json()) for e in episodes]
-        got: list[EpisodeResult] = results.setdefault(name, [])
+    from pmnav_bt.experiments.executors import TaskCrash, run_tasks
 
-        def take(row: dict, name: str = name, got: list = got) -> None:
-            nonlocal done
-            r = EpisodeResult.from_dict(row)
-            got.append(r)
+    done = done or {}
+    results: dict[str, list[EpisodeResult]] = {} if finished is None else finished
+    for name in configs:
+        results.setdefault(name, []).extend(
+            done[(name, e.id)] for e in episodes if (name, e.id) in done
+        )
+    todo = [(n, e) for n in configs for e in episodes if (n, e.id) not in done]
+    total = len(episodes) * len(configs)
+    count = total - len(todo)
+    blobs = {n: c.model_dump_json() for n, c in configs.items()}
+    payload = [(e, blobs[n]) for n, e in todo]
+    try:
+        for i, row in run_tasks(_run_one, payload, jobs=jobs, ray=ray):
+            name, episode = todo[i]
+            r = (
+                _error_result(episode, row.message)
+                if isinstance(row, TaskCrash)
+                else EpisodeResult.from_dict(row)
+            )
+            results[name].append(r)
             if on_result:
                 on_result(name, r)
-            done += 1
+            count += 1
             if progress:
-                progress(name, done, total)
-
-        if jobs > 1:
-            import multiprocessing as mp
-
-            from pmnav_bt.interrupts import quiet_worker
-
-            pool = mp.get_context("spawn").Pool(jobs, initializer=quiet_worker)
-            try:
-                for row in pool.imap_unordered(_run_one, tasks):
-                    take(row)
-            finally:
-                pool.terminate()
-                pool.join()
-            order = {e.id: i for i, e in enumerate(episodes)}
-            got.sort(key=lambda r: order.get(r.episode_id, 0))
-        else:
-            for t in tasks:
-                take(_run_one(t))
+                progress(name, count, total)
+    finally:
+        order = {e.id: i for i, e in enumerate(episodes)}
+        for rs in results.values():
+            rs.sort(key=lambda r: order.get(r.episode_id, 0))
     return results
 
 
 def comparison_markdown(results: dict[str, list[EpisodeResult]]) -> str:
     """SR, SPL and soft SPL per tier, one column group per variant (like the paper's
     Table 1); an errors column when episodes could not be run."""
+    from pmnav_bt.experiments.variants import variant_title
+
     tables = {name: aggregate_by_tier(rs) for name, rs in results.items()}
     tiers = []
     for t in tables.values():
@@ -305,7 +313,7 @@ def comparison_markdown(results: dict[str, list[EpisodeResult]]) -> str:
     metrics = ("SR", "SPL", "soft SPL") + (("errors",) if errors else ())
     head = (
         "| tier | n | "
-        + " | ".join(f"{VARIANT_NAMES.get(n, n)} {m}" for n in tables for m in metrics)
+        + " | ".join(f"{variant_title(n)} {m}" for n in tables for m in metrics)
         + " |"
     )
     sep = "|---|---|" + "---|" * (len(metrics) * len(tables))
@@ -341,10 +349,7 @@ def save_evaluation(results: dict[str, list[EpisodeResult]], out_dir: Path, head
 
 
 def variant_configs(base: Config, variants: Iterable[str]) -> dict[str, Config]:
-    """One config per tree variant."""
-    out = {}
-    for v in variants:
-        if v not in VARIANT_NAMES:
-            raise PmNavError(f"unknown variant {v!r}; choose from {', '.join(VARIANT_NAMES)}")
-        out[v] = base.model_copy(update={"tree": base.tree.model_copy(update={"variant": v})})
-    return out
+    """One config per named evaluation variant (``pmnav_bt.experiments.variants``)."""
+    from pmnav_bt.experiments.variants import variant_configs as _configs
+
+    return _configs(base, variants)

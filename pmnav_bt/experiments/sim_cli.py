@@ -101,12 +101,18 @@ def _tiers(tier: str) -> list[str]:
 
 
 def _buildings(building: str) -> list[str]:
-    """'all' (every built-in building), or comma-separated files and built-in names."""
+    """Comma-separated files, built-in names, 'all' (every built-in) and FAMILY:N."""
     from pmnav_bt.map.building import builtin_buildings
+    from pmnav_bt.map.generate import family_members
 
-    if building.strip() == "all":
-        return builtin_buildings()
-    return [b.strip() for b in building.split(",") if b.strip()]
+    out: list[str] = []
+    for part in (b.strip() for b in building.split(",") if b.strip()):
+        try:
+            members = family_members(part)
+        except ValueError as err:
+            raise PmNavError(f"--building {err}") from None
+        out += builtin_buildings() if part == "all" else members or [part]
+    return out
 
 
 def _config(config: Path | None, overrides: list[str] | None):
@@ -223,43 +229,87 @@ def run(
         raise typer.Exit(1)
 
 
+RAY_OPT = typer.Option(
+    None,
+    "--ray",
+    help="Run episodes as Ray tasks: '--ray' alone starts a local Ray with --jobs CPUs; "
+    "'--ray ADDRESS' joins a cluster (ray://head:10001, head:6379, auto). Needs the "
+    "[ray] extra.",
+)
+RESUME_OPT = typer.Option(
+    False,
+    "--resume",
+    help="Keep the results.jsonl in --out and run only what it lacks (refused if it was "
+    "made under another config).",
+)
+
+
+def _jobs(jobs: int | None) -> int:
+    return cli_values.jobs(jobs) if jobs is not None else min(2, cli_values.cpu_count())
+
+
+def eval_header(building, tier, n, seed, cfg, configs) -> str:
+    """The results.md header: what ran, each variant's grounder, the tier rules."""
+    from pmnav_bt.eval.task import budget_rule
+    from pmnav_bt.eval.tiers import tier_definition
+    from pmnav_bt.experiments.variants import variant_title
+
+    g = cfg.grounder
+    grounders = "; ".join(
+        f"{variant_title(name)}: grounder {c.grounder.backend}" for name, c in configs.items()
+    )
+    return (
+        f"# PM-Nav evaluation\n\nbuildings: {building}; tiers: {tier}; {n} per tier per "
+        f"building; seed {seed}; {grounders} (miss {g.miss_rate:.0%}, false positives "
+        f"{g.false_positive_rate:.0%}); odometry noise {cfg.sim.odometry_noise:.0%}; camera "
+        f"{cfg.sim.width}x{cfg.sim.height}\n\nTiers:\n"
+        + tier_definition(budget_rule(cfg.tree.budget_actions, cfg.tree.budget_path_factor))
+    )
+
+
 @app.command("eval")
 def eval_(
     building: str = typer.Option(
-        "all", "--building", help="Comma-separated building files or built-in names, or all."
+        "all",
+        "--building",
+        help="Comma-separated building files or built-in names, 'all' (the built-ins), or "
+        "FAMILY:N (N generated buildings: gen_small:100, sign_sparse:3).",
     ),
     tier: str = typer.Option("all", "--tier", help="easy, medium, hard, a list, or all."),
     n: int = typer.Option(20, "-n", min=1, help="Episodes per tier per building."),
     seed: int = typer.Option(0, "--seed"),
-    variants: str = typer.Option("pmnav,coarse_only", "--variants", help="Tree variants."),
+    variants: str = typer.Option(
+        "pmnav,coarse_only",
+        "--variants",
+        help="Comma-separated evaluation variants (pmnav, coarse_only, pmnav_oracle, ...).",
+    ),
     jobs: int | None = typer.Option(
         None, "--jobs", help="Episodes run in parallel [default: 2, at most the CPUs]."
     ),
     out: Path = typer.Option(Path("out/eval"), "--out", help="Folder for results.json/.md."),
+    resume: bool = RESUME_OPT,
+    ray: str | None = RAY_OPT,
     config: Path | None = CONFIG_OPT,
     overrides: list[str] | None = SET_OPT,
 ) -> None:
-    """Run many episodes and print SR/SPL per tier for each tree variant (paper Table 1).
+    """Run many episodes and print SR/SPL per tier for each variant (paper Table 1).
 
-    Exits 1 when episodes could not be run (errors are counted apart from failures).
+    Results stream to OUT/results.jsonl as each episode ends; Ctrl-C keeps them and
+    writes a partial table; --resume goes on from them. Exits 1 when episodes could not
+    be run (errors are counted apart from failures).
     """
-    from rich.progress import Progress
-
-    from pmnav_bt.eval.task import budget_rule
-    from pmnav_bt.eval.tiers import tier_definition
     from pmnav_bt.experiments.evaluation import (
         comparison_markdown,
         episodes_for,
         error_counts,
-        evaluate,
         save_evaluation,
         variant_configs,
     )
-    from pmnav_bt.interrupts import Interrupted, JsonlAppender, stop_signals
+    from pmnav_bt.experiments.stored_run import run_stored_evaluation
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
-    jobs = cli_values.jobs(jobs) if jobs is not None else min(2, cli_values.cpu_count())
+    jobs = _jobs(jobs)
     cfg = _config(config, overrides)
     check_output_dir(out)
     names = [v.strip() for v in variants.split(",") if v.strip()]
@@ -269,50 +319,30 @@ def eval_(
         typer.echo(f"note: {note}", err=True)
     if not eps:
         raise PmNavError("no episodes to run")
-    total = len(eps) * len(configs)
-    finished: dict = {}
-    with JsonlAppender(out / "results.jsonl") as log, stop_signals():
-        save = lambda name, r: log.write({"variant": name, **r.to_dict()})  # noqa: E731
-        try:
-            if sys.stderr.isatty():
-                with Progress(transient=False) as bar:
-                    task = bar.add_task("episodes", total=total)
-                    results = evaluate(
-                        eps,
-                        configs,
-                        jobs=jobs,
-                        progress=lambda name, done, _: bar.update(task, completed=done),
-                        on_result=save,
-                        finished=finished,
-                    )
-            else:  # a log: a line every tenth of the way
-                step = max(1, total // 10)
-
-                def report(name: str, done: int, _total: int) -> None:
-                    if done % step == 0 or done == total:
-                        typer.echo(f"{done}/{total} episodes ({name})", err=True)
-
-                results = evaluate(
-                    eps, configs, jobs=jobs, progress=report, on_result=save, finished=finished
-                )
-        except Interrupted as stop:
-            kept = {k: v for k, v in finished.items() if v}
-            if kept:
-                save_evaluation(kept, out, f"# PM-Nav evaluation (stopped by {stop.signame})")
-            typer.echo(
-                f"pmnav: stopped by {stop.signame} after {log.count} of {total} episodes; "
-                f"finished ones are in {out / 'results.jsonl'}",
-                err=True,
+    echo = lambda text: typer.echo(text, err=True)  # noqa: E731
+    run = run_stored_evaluation(eps, configs, out, jobs=jobs, ray=ray, resume=resume, echo=echo)
+    header = eval_header(building, tier, n, seed, cfg, configs)
+    results = {k: v for k, v in run.results.items() if v}
+    if run.stopped_by:
+        if results:
+            save_evaluation(
+                results,
+                out,
+                header.replace(
+                    "# PM-Nav evaluation",
+                    "# PM-Nav evaluation "
+                    f"(partial: stopped by {run.stopped_by}, {sum(map(len, results.values()))} of "
+                    f"{run.total} runs)",
+                    1,
+                ),
             )
-            raise typer.Exit(stop.exit_code) from None
-    g = cfg.grounder
-    header = (
-        f"# PM-Nav evaluation\n\nbuildings: {building}; tiers: {tier}; {n} per tier per "
-        f"building; seed {seed}; grounder {g.backend} (miss {g.miss_rate:.0%}, false positives "
-        f"{g.false_positive_rate:.0%}); odometry noise {cfg.sim.odometry_noise:.0%}; camera "
-        f"{cfg.sim.width}x{cfg.sim.height}\n\nTiers:\n"
-        + tier_definition(budget_rule(cfg.tree.budget_actions, cfg.tree.budget_path_factor))
-    )
+            typer.echo(comparison_markdown(results), err=True)
+        typer.echo(
+            f"pmnav: stopped by {run.stopped_by} after {run.resumed + run.new} of {run.total} "
+            f"episodes; finished ones are in {out / 'results.jsonl'} (go on with --resume)",
+            err=True,
+        )
+        raise typer.Exit(run.exit_code)
     md = save_evaluation(results, out, header)
     typer.echo(comparison_markdown(results))
     typer.echo(f"wrote {md} and {out / 'results.json'}")

@@ -160,17 +160,54 @@ def generate_sign_sparse(seed: int = 0) -> Building:
     )
 
 
+SMALL_FAMILY = "gen_small"
+
+
+def generate_small(seed: int = 0) -> Building:
+    """The small generated family (the scale test's buildings): a 2x2 junction grid of
+    16 m corridors (a tree, no loops), ten rooms and two landmarks: cheap to simulate,
+    yet with turns and forks."""
+    return generate_building(
+        n_rooms=10,
+        seed=seed,
+        spacing=16.0,
+        loop_fraction=0.0,
+        name=f"{SMALL_FAMILY}_{seed}",
+        n_landmarks=2,
+    )
+
+
+FAMILIES = {SIGN_SPARSE_FAMILY: generate_sign_sparse, SMALL_FAMILY: generate_small}
+
+
 def is_generated_name(name: str) -> bool:
     """True for a generated family's building name, such as "sign_sparse_3"."""
     stem, _, seed = name.rpartition("_")
-    return stem == SIGN_SPARSE_FAMILY and seed.isdigit() and len(seed) < 10
+    return stem in FAMILIES and seed.isdigit() and len(seed) < 10
+
+
+def family_members(spec: str) -> list[str] | None:
+    """ "FAMILY:N" -> the family's first N building names ("gen_small:3" -> gen_small_0,
+    gen_small_1, gen_small_2); None when ``spec`` is not of that form; ValueError for an
+    unknown family or a bad N."""
+    family, sep, count = spec.partition(":")
+    if not sep:
+        return None
+    if family not in FAMILIES:
+        raise ValueError(
+            f"{spec!r}: unknown building family {family!r}; choose {', '.join(FAMILIES)}"
+        )
+    if not count.isdigit() or not 1 <= int(count) <= 100_000:
+        raise ValueError(f"{spec!r}: expected {family}:N with N from 1 to 100000")
+    return [f"{family}_{k}" for k in range(int(count))]
 
 
 def generated_family(name: str) -> Building | None:
     """The generated building a name such as "sign_sparse_3" denotes, or None."""
     if not is_generated_name(name):
         return None
-    return generate_sign_sparse(int(name.rpartition("_")[2]))
+    stem, _, seed = name.rpartition("_")
+    return FAMILIES[stem](int(seed))
 
 
 def generated_file(name: str) -> Path | None:

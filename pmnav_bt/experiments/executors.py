@@ -1,0 +1,111 @@
+"""Run independent tasks in this process, in a process pool, or as Ray tasks.
+
+``run_tasks(fn, tasks, jobs, ray)`` yields ``(index, result)`` as each task ends, in
+completion order. ``fn`` must be a module-level function (pickled by reference) that
+never raises for a task's own failure (it returns an errored row instead). Stopping
+(Interrupted, KeyboardInterrupt, any exception) cancels what is left: pool workers are
+terminated, Ray tasks cancelled, and a Ray runtime this call started is shut down.
+
+Ray is optional (``pip install 'pmnav-bt[ray]'``): ``ray=None`` never imports it;
+``ray="local"`` starts a private single-machine runtime with ``jobs`` CPUs on loopback;
+any other string is a cluster address (``ray://head:10001`` or ``head:6379``, or
+``auto`` for the cluster this machine belongs to).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
+
+from pmnav_bt.errors import PmNavError
+
+LOCAL = "local"
+
+
+class RayUnavailable(PmNavError):
+    """--ray was asked for but Ray is not installed or cannot start."""
+
+
+def run_tasks(
+    fn: Callable[[Any], Any], tasks: Sequence[Any], jobs: int = 1, ray: str | None = None
+) -> Iterator[tuple[int, Any]]:
+    if not tasks:
+        return
+    if ray is not None:
+        yield from _ray(fn, tasks, jobs, ray)
+    elif jobs > 1:
+        yield from _pool(fn, tasks, jobs)
+    else:
+        for i, t in enumerate(tasks):
+            yield i, fn(t)
+
+
+def _indexed(args: tuple[Callable, int, Any]) -> tuple[int, Any]:
+    fn, i, task = args
+    return i, fn(task)
+
+
+def _pool(fn, tasks, jobs) -> Iterator[tuple[int, Any]]:
+    import multiprocessing as mp
+
+    from pmnav_bt.interrupts import quiet_worker
+
+    pool = mp.get_context("spawn").Pool(min(jobs, len(tasks)), initializer=quiet_worker)
+    try:
+        yield from pool.imap_unordered(_indexed, [(fn, i, t) for i, t in enumerate(tasks)])
+    finally:
+        pool.terminate()
+        pool.join()
+
+
+def ray_init(address: str, jobs: int):
+    """Connect to (or start) Ray; returns the module and whether this call started it."""
+    try:
+        import ray
+    except ImportError:
+        raise RayUnavailable(
+            "--ray needs Ray: pip install 'pmnav-bt[ray]' (or pip install 'ray==2.60.*')"
+        ) from None
+    if ray.is_initialized():
+        return ray, False
+    kw: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
+    try:
+        if address == LOCAL:
+            ray.init(num_cpus=jobs, _node_ip_address="127.0.0.1", **kw)
+        else:
+            ray.init(address=address, **kw)
+    except Exception as err:  # noqa: BLE001 - Ray raises many kinds; one line for the user
+        msg = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise RayUnavailable(f"--ray {address}: cannot start or reach Ray: {msg}") from None
+    return ray, True
+
+
+class TaskCrash:
+    """What a Ray task that died (its worker killed, out of memory) yields instead."""
+
+    def __init__(self, message: str):
+        self.message = message
+
+
+def _call(fn, i: int, task):
+    return i, fn(task)
+
+
+def _ray(fn, tasks, jobs, address) -> Iterator[tuple[int, Any]]:
+    ray, started = ray_init(address, jobs)
+    remote = ray.remote(num_cpus=1, max_retries=0)(_call)
+    pending: dict = {}
+    try:
+        pending = {remote.remote(fn, i, t): i for i, t in enumerate(tasks)}
+        while pending:
+            ready, _ = ray.wait(list(pending), num_returns=1)
+            i = pending.pop(ready[0])
+            try:
+                yield ray.get(ready[0])
+            except ray.exceptions.RayError as err:
+                yield i, TaskCrash(f"{type(err).__name__}: {str(err).splitlines()[0]}")
+    finally:
+        for r in pending:
+            ray.cancel(r, force=True)
+        if started:
+            ray.shutdown()

@@ -1,0 +1,106 @@
+"""The evaluation as a run that survives: results stream to ``results.jsonl`` (keyed,
+resumable), Ctrl-C/SIGTERM keeps them and writes a partial table, progress shows rate
+and ETA. Shared by ``pmnav sim eval`` and ``pmnav report``."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+from pmnav_bt.config import Config
+from pmnav_bt.eval.metrics import EpisodeResult
+from pmnav_bt.experiments.runstore import Expected, ResultStore, record_key, stable_hash
+from pmnav_bt.experiments.variants import config_hash
+
+_RESULT_FIELDS = {f.name for f in fields(EpisodeResult)}
+
+
+def episode_sha(episode) -> str:
+    """A hash of what defines an episode (its building by content, not by path)."""
+    d = episode.to_dict()
+    d.pop("building_path", None)
+    return stable_hash(d)
+
+
+def result_of(row: dict) -> EpisodeResult:
+    """An EpisodeResult from a results.jsonl row (the store's own fields dropped)."""
+    return EpisodeResult.from_dict({k: v for k, v in row.items() if k in _RESULT_FIELDS})
+
+
+@dataclass
+class RunOutcome:
+    results: dict[str, list[EpisodeResult]]
+    new: int  # runs finished in this session
+    resumed: int  # runs found done on disk
+    total: int
+    stopped_by: str | None = None  # SIGINT or SIGTERM when interrupted
+    exit_code: int = 0
+
+
+def run_stored_evaluation(
+    episodes: list,
+    configs: dict[str, Config],
+    out: Path,
+    jobs: int = 1,
+    ray: str | None = None,
+    resume: bool = False,
+    echo=print,
+) -> RunOutcome:
+    """Run (or resume) the evaluation into ``out/results.jsonl``; on SIGINT/SIGTERM return
+    what finished with ``stopped_by`` set (the caller writes the partial table)."""
+    from pmnav_bt.experiments.evaluation import evaluate
+    from pmnav_bt.experiments.progress import LogProgress, bar_columns
+    from pmnav_bt.interrupts import Interrupted, stop_signals
+
+    shas = {e.id: episode_sha(e) for e in episodes}
+    expected = [
+        Expected(record_key(n, e.id), n, shas[e.id], config_hash(c))
+        for n, c in configs.items()
+        for e in episodes
+    ]
+    total = len(expected)
+    finished: dict[str, list[EpisodeResult]] = {}
+    with ResultStore(out / "results.jsonl", expected, resume) as store:
+        done = {(row["variant"], row["episode_id"]): result_of(row) for row in store.done.values()}
+        if resume:
+            echo(f"resuming {out / 'results.jsonl'}: {len(done)} of {total} runs done")
+            if store.duplicates:
+                echo(f"note: {store.duplicates} duplicate rows ignored (first kept)")
+
+        def save(name: str, r: EpisodeResult) -> None:
+            store.write(record_key(name, r.episode_id), r.to_dict())
+
+        outcome = RunOutcome(finished, 0, len(done), total)
+        with stop_signals():
+            try:
+                if sys.stderr.isatty():
+                    from rich.progress import Progress
+
+                    with Progress(*bar_columns(), transient=False) as bar:
+                        task = bar.add_task("episodes", total=total, completed=len(done), rate="")
+                        log = LogProgress(total, len(done))
+
+                        def tick(name: str, n: int, _total: int) -> None:
+                            rate = log.line(n).split("; ")[1:2]
+                            bar.update(task, completed=n, rate=rate[0] if rate else "")
+
+                        evaluate(
+                            episodes, configs, jobs, tick, save, finished, ray=ray, done=done
+                        )
+                else:
+                    log = LogProgress(total, len(done))
+                    evaluate(
+                        episodes,
+                        configs,
+                        jobs,
+                        lambda name, n, _t: log(n, name),
+                        save,
+                        finished,
+                        ray=ray,
+                        done=done,
+                    )
+            except Interrupted as stop:
+                outcome.stopped_by, outcome.exit_code = stop.signame, stop.exit_code
+        outcome.new = store.count
+    return outcome

@@ -1,0 +1,83 @@
+"""Named evaluation variants: a tree variant plus config overrides, a label, and whether
+it is an oracle (ground-truth perception, labelled so in every table).
+
+Adding a variant is one line in ``VARIANTS``. A variant's overrides are applied on top of
+the run's config (``--config``/``--set``), so anything it does not set (the grounder, for
+``pmnav``) is the run's; the report states each variant's grounder from its own config.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from pmnav_bt.config import Config, ConfigError, _set_dotted
+from pmnav_bt.errors import PmNavError
+
+ORACLE_LABEL = "oracle: simulator labels"
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One row of the evaluation: ``overrides`` are ``section.key: value`` pairs."""
+
+    name: str
+    label: str
+    overrides: tuple[tuple[str, object], ...]
+    oracle: bool = False
+
+    @property
+    def title(self) -> str:
+        """The label as shown in tables: oracles say so."""
+        return f"{self.label} ({ORACLE_LABEL})" if self.oracle else self.label
+
+    def config(self, base: Config) -> Config:
+        """``base`` with this variant's overrides applied."""
+        data = base.model_dump(mode="json")
+        for key, value in self.overrides:
+            _set_dotted(data, key, value, label=f"variant {self.name}")
+        try:
+            return Config.model_validate(data)
+        except ValueError as err:
+            raise ConfigError(f"variant {self.name}: {err}".splitlines()[0]) from None
+
+
+VARIANTS: dict[str, Variant] = {
+    v.name: v
+    for v in (
+        Variant("pmnav", "PM-Nav", (("tree.variant", "pmnav"),)),
+        Variant("coarse_only", "coarse-only", (("tree.variant", "coarse_only"),)),
+        Variant(
+            "pmnav_oracle",
+            "PM-Nav",
+            (("tree.variant", "pmnav"), ("grounder.backend", "sim_gt")),
+            oracle=True,
+        ),
+    )
+}
+
+
+def get_variant(name: str) -> Variant:
+    """The variant called ``name``; PmNavError naming the known ones otherwise."""
+    if name not in VARIANTS:
+        raise PmNavError(f"unknown variant {name!r}; choose from {', '.join(VARIANTS)}")
+    return VARIANTS[name]
+
+
+def variant_title(name: str) -> str:
+    """A variant's table title, or its name when it is not (or no longer) registered."""
+    v = VARIANTS.get(name)
+    return v.title if v else name
+
+
+def variant_configs(base: Config, names: Iterable[str]) -> dict[str, Config]:
+    """One config per named variant, in the order given."""
+    return {n: get_variant(n).config(base) for n in names}
+
+
+def config_hash(config: Config) -> str:
+    """A short, stable hash of everything in a config (keys sorted)."""
+    text = json.dumps(config.model_dump(mode="json"), sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
