@@ -14,6 +14,8 @@ any other string is a cluster address (``ray://head:10001`` or ``head:6379``, or
 
 from __future__ import annotations
 
+import os
+import sys
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
@@ -59,7 +61,13 @@ def _pool(fn, tasks, jobs) -> Iterator[tuple[int, Any]]:
 
 
 def ray_init(address: str, jobs: int):
-    """Connect to (or start) Ray; returns the module and whether this call started it."""
+    """Connect to (or start) Ray; returns the module and whether this call started it.
+
+    A local runtime stays on loopback: Ray otherwise resolves 127.0.0.1 to the machine's
+    routable address (``resolve_ip_for_localhost``); its switch for that is the (oddly
+    named) RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0, read when Ray is first imported."""
+    if address == LOCAL and "ray" not in sys.modules:
+        os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
     try:
         import ray
     except ImportError:
