@@ -17,7 +17,7 @@ import json
 import math
 import random
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
 import numpy as np
@@ -161,33 +161,67 @@ def run_localization(start: LocStart, config: Config) -> LocResult:
     return LocResult(start, ok, attempts, pos_err, yaw_err, driven, why, time.perf_counter() - t0)
 
 
+def _crashed(start: LocStart, error: str) -> dict:
+    r = LocResult(start, False, 0, None, None, 0.0, f"error: {error}", 0.0)
+    return {**asdict(r), "start": asdict(start)}
+
+
 def _run_one(args) -> dict:
+    """One start in a worker; a crash becomes a failed run that says so."""
     start, config_json = args
-    r = run_localization(start, Config.model_validate_json(config_json))
+    try:
+        r = run_localization(start, Config.model_validate_json(config_json))
+    except Exception as err:  # noqa: BLE001 - reported in the results, with its type
+        return _crashed(start, f"{type(err).__name__}: {err}")
     d = asdict(r)
     d["start"] = asdict(start)
     return d
 
 
-def run_study(starts: list[LocStart], config: Config, jobs: int = 1, progress=None):
-    """Every start once; results in order."""
-    tasks = [(s, config.model_dump_json()) for s in starts]
-    rows = []
-    if jobs > 1:
-        import multiprocessing as mp
-        from concurrent.futures import ProcessPoolExecutor
+def run_study(
+    starts: list[LocStart],
+    config: Config,
+    jobs: int = 1,
+    progress=None,
+    ray: str | None = None,
+    done: dict[int, dict] | None = None,
+    on_row=None,
+    finished: list | None = None,
+):
+    """Every start once (in the pool or on Ray); results in the order of ``starts``.
 
-        with ProcessPoolExecutor(jobs, mp_context=mp.get_context("spawn")) as pool:
-            for row in pool.map(_run_one, tasks):
-                rows.append(row)
-                if progress:
-                    progress(len(rows), len(tasks))
-    else:
-        for t in tasks:
-            rows.append(_run_one(t))
-            if progress:
-                progress(len(rows), len(tasks))
-    return [LocResult(**{**r, "start": LocStart(**r["start"])}) for r in rows]
+    ``done`` maps indices of ``starts`` to rows already on disk (``--resume``): they are
+    not run again. ``on_row(index, row)`` is called as each new run ends; ``finished``
+    (when given) collects ``(index, row)`` as they arrive, for an interruption."""
+    from pmnav_bt.experiments.executors import TaskCrash, run_tasks
+
+    done = dict(done or {})
+    blob = config.model_dump_json()
+    todo = [i for i in range(len(starts)) if i not in done]
+    got = finished if finished is not None else []
+    got.extend(done.items())
+    for k, row in run_tasks(_run_one, [(starts[i], blob) for i in todo], jobs=jobs, ray=ray):
+        i = todo[k]
+        if isinstance(row, TaskCrash):
+            row = _crashed(starts[i], row.message)
+        got.append((i, row))
+        if on_row:
+            on_row(i, row)
+        if progress:
+            progress(len(got), len(starts))
+    return [result_of_row(r) for _, r in sorted(got, key=lambda p: p[0])]
+
+
+def result_of_row(row: dict) -> LocResult:
+    """A LocResult from its stored row (extra keys, such as the store's, ignored)."""
+    names = {f.name for f in fields(LocResult)}
+    r = {k: v for k, v in row.items() if k in names}
+    return LocResult(**{**r, "start": LocStart(**row["start"])})
+
+
+def start_key(start: LocStart) -> str:
+    """A start's identity in results.jsonl."""
+    return f"{start.building}-{start.density}-{start.seed}"
 
 
 def table(results: list[LocResult], title: str = "") -> str:

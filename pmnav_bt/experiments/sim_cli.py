@@ -371,6 +371,8 @@ def table3(
     seed: int = typer.Option(0, "--seed"),
     jobs: int = typer.Option(1, "--jobs", min=1, help="Runs in parallel."),
     out: Path = typer.Option(Path("out/table3"), "--out", help="Folder for results.json/.md."),
+    resume: bool = RESUME_OPT,
+    ray: str | None = RAY_OPT,
     config: Path | None = CONFIG_OPT,
     overrides: list[str] | None = SET_OPT,
 ) -> None:
@@ -379,10 +381,10 @@ def table3(
         SUCCESS_POS_M,
         SUCCESS_YAW_DEG,
         classified_starts,
-        run_study,
         save,
         table,
     )
+    from pmnav_bt.experiments.stored_run import run_stored_study
     from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
     from pmnav_bt.pose.visibility import READ_RANGE_M
 
@@ -397,12 +399,9 @@ def table3(
     starts = [s for b in names for s in classified_starts(b, n, seed)]
     if not starts:
         raise PmNavError("no start poses to run")
-
-    def report(done: int, total: int) -> None:
-        if done % max(1, total // 10) == 0 or done == total:
-            typer.echo(f"{done}/{total} localization runs", err=True)
-
-    results = run_study(starts, cfg, jobs=jobs, progress=report)
+    echo = lambda text: typer.echo(text, err=True)  # noqa: E731
+    run = run_stored_study(starts, cfg, out, jobs=jobs, ray=ray, resume=resume, echo=echo)
+    results = run.results
     header = (
         f"# Localization by landmark density (paper Table 3)\n\nbuildings: {', '.join(names)}; "
         f"up to {n} starts per class per building; seed {seed}; grounder {cfg.grounder.backend} "
@@ -412,6 +411,16 @@ def table3(
         f"localization subtree succeeds within {SUCCESS_POS_M:g} m and {SUCCESS_YAW_DEG:g} deg "
         "of the truth. SDF = S * 2 / max(2, d), d = panoramas taken."
     )
+    if run.stopped_by:
+        if results:
+            save(results, out, header + f"\n\nPARTIAL: stopped by {run.stopped_by}.")
+            typer.echo(table(results), err=True)
+        typer.echo(
+            f"pmnav: stopped by {run.stopped_by} after {len(results)} of {run.total} runs; "
+            f"finished ones are in {out / 'results.jsonl'} (go on with --resume)",
+            err=True,
+        )
+        raise typer.Exit(run.exit_code)
     md = save(results, out, header)
     typer.echo(header)
     typer.echo(table(results))

@@ -85,9 +85,7 @@ def run_stored_evaluation(
                             rate = log.line(n).split("; ")[1:2]
                             bar.update(task, completed=n, rate=rate[0] if rate else "")
 
-                        evaluate(
-                            episodes, configs, jobs, tick, save, finished, ray=ray, done=done
-                        )
+                        evaluate(episodes, configs, jobs, tick, save, finished, ray=ray, done=done)
                 else:
                     log = LogProgress(total, len(done))
                     evaluate(
@@ -102,5 +100,66 @@ def run_stored_evaluation(
                     )
             except Interrupted as stop:
                 outcome.stopped_by, outcome.exit_code = stop.signame, stop.exit_code
+        outcome.new = store.count
+    return outcome
+
+
+@dataclass
+class StudyOutcome:
+    results: list  # LocResult, in the order of the starts (finished ones only if stopped)
+    new: int
+    resumed: int
+    total: int
+    stopped_by: str | None = None
+    exit_code: int = 0
+
+
+STUDY = "localization"
+
+
+def run_stored_study(
+    starts: list,
+    config: Config,
+    out: Path,
+    jobs: int = 1,
+    ray: str | None = None,
+    resume: bool = False,
+    echo=print,
+) -> StudyOutcome:
+    """The Table 3 study as a run that survives (see ``run_stored_evaluation``)."""
+    from dataclasses import asdict
+
+    from pmnav_bt.experiments.localization_study import result_of_row, run_study, start_key
+    from pmnav_bt.experiments.progress import LogProgress
+    from pmnav_bt.interrupts import Interrupted, stop_signals
+
+    keys = [record_key(STUDY, start_key(s)) for s in starts]
+    chash = config_hash(config)
+    expected = [
+        Expected(k, STUDY, stable_hash(asdict(s)), chash) for k, s in zip(keys, starts, strict=True)
+    ]
+    index = {k: i for i, k in enumerate(keys)}
+    got: list = []
+    with ResultStore(out / "results.jsonl", expected, resume) as store:
+        done = {index[k]: row for k, row in store.done.items()}
+        if resume:
+            echo(f"resuming {out / 'results.jsonl'}: {len(done)} of {len(starts)} runs done")
+        log = LogProgress(len(starts), len(done), what="localization runs")
+        outcome = StudyOutcome([], 0, len(done), len(starts))
+        with stop_signals():
+            try:
+                outcome.results = run_study(
+                    starts,
+                    config,
+                    jobs=jobs,
+                    progress=lambda n, _t: log(n),
+                    ray=ray,
+                    done=done,
+                    on_row=lambda i, row: store.write(keys[i], row),
+                    finished=got,
+                )
+            except Interrupted as stop:
+                outcome.stopped_by, outcome.exit_code = stop.signame, stop.exit_code
+                outcome.results = [result_of_row(r) for _, r in sorted(got, key=lambda p: p[0])]
         outcome.new = store.count
     return outcome
