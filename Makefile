@@ -1,7 +1,7 @@
 # Quick start: `make demo` runs the main job on a built-in building; `make test` runs the tests.
 # Both create .venv on first use: torch 2.13.0 (CPU) first, so the project's torch range
 # installs nothing more, then the project with its dev, ROS 2 (rclpy, Fast DDS) and
-# perception (OCR, GroundingDINO + SAM) extras.
+# perception (OCR, GroundingDINO + SAM) extras, and Ray (--ray; its tests run in CI).
 
 PY ?= python3
 VENV := .venv
@@ -16,7 +16,7 @@ $(VENV)/.installed: pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet torch==2.13.0
-	$(BIN)/pip install --quiet -e ".[dev,ros,ocr,gdino]"
+	$(BIN)/pip install --quiet -e ".[dev,ros,ocr,gdino,ray]"
 	# rapidocr's metadata names opencv-python; its other dependencies are the [ocr] extra.
 	$(BIN)/pip install --quiet --no-deps rapidocr-onnxruntime==1.4.4
 	touch $@

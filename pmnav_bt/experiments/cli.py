@@ -14,12 +14,14 @@ import sys
 from pmnav_bt.cli import app
 from pmnav_bt.cli import main as _run
 from pmnav_bt.experiments.plan_cli import app as plan_app
+from pmnav_bt.experiments.report import report
 from pmnav_bt.experiments.sim_cli import app as sim_app
 from pmnav_bt.trees.cli import app as tree_app
 
 app.add_typer(plan_app, name="plan")
 app.add_typer(sim_app, name="sim")
 app.add_typer(tree_app, name="tree")
+app.command("report")(report)
 
 
 def optional_value(args: list[str], option: str, default: str) -> list[str]:

@@ -1,9 +1,11 @@
 """Named evaluation variants: a tree variant plus config overrides, a label, and whether
 it is an oracle (ground-truth perception, labelled so in every table).
 
-Adding a variant is one line in ``VARIANTS``. A variant's overrides are applied on top of
-the run's config (``--config``/``--set``), so anything it does not set (the grounder, for
-``pmnav``) is the run's; the report states each variant's grounder from its own config.
+Adding a variant is one line in ``VARIANTS``, e.g.
+``Variant("mapless", "map-less", (("tree.variant", "mapless"),), tables=("1",))``.
+A variant's overrides are applied on top of the run's config (``--config``/``--set``),
+so anything it does not set (the grounder, for ``pmnav``) is the run's; the report
+states each variant's grounder from its own config.
 """
 
 from __future__ import annotations
@@ -21,12 +23,15 @@ ORACLE_LABEL = "oracle: simulator labels"
 
 @dataclass(frozen=True)
 class Variant:
-    """One row of the evaluation: ``overrides`` are ``section.key: value`` pairs."""
+    """One row of the evaluation: ``overrides`` are ``section.key: value`` pairs;
+    ``tables``: the report's tables it appears in ("1": navigation vs the baselines,
+    "4": action refinement)."""
 
     name: str
     label: str
     overrides: tuple[tuple[str, object], ...]
     oracle: bool = False
+    tables: tuple[str, ...] = ("1", "4")
 
     @property
     def title(self) -> str:
@@ -54,6 +59,7 @@ VARIANTS: dict[str, Variant] = {
             "PM-Nav",
             (("tree.variant", "pmnav"), ("grounder.backend", "sim_gt")),
             oracle=True,
+            tables=("4",),
         ),
     )
 }
