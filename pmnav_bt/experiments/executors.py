@@ -94,6 +94,9 @@ class TaskCrash:
     def __init__(self, message: str):
         self.message = message
 
+    def __repr__(self) -> str:
+        return f"TaskCrash({self.message!r})"
+
 
 def _call(fn, i: int, task):
     return i, fn(task)
