@@ -4,6 +4,7 @@ one line when the config changed."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -51,10 +52,8 @@ def _keys(path) -> list[str]:
         return []
     keys = []
     for line in text.splitlines():
-        try:
+        with contextlib.suppress(ValueError):  # the torn tail
             keys.append(json.loads(line)["key"])
-        except ValueError:
-            pass  # the torn tail
     return keys
 
 
