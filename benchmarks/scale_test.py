@@ -103,7 +103,7 @@ def main() -> None:
     resume = [*cmd, "--resume"]
     stamp(f"phase resume: {shlex.join(resume)}")
     t0 = time.monotonic()
-    before = len({r['key'] for r in rows(results)})
+    before = len({r["key"] for r in rows(results)})
     rc = subprocess.call(resume, stdout=log, stderr=log)
     dt = time.monotonic() - t0
     got = rows(results)
