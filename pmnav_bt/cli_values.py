@@ -121,6 +121,8 @@ def run_cli(app: Callable, argv: list[str] | None, prog: str, format_error: Call
     errors and usage errors, the command's own status otherwise.
     """
     ce = _click_exceptions()
+    # typer >= 0.29 keeps Abort in typer.exceptions, not in its vendored click
+    abort = getattr(ce, "Abort", None) or __import__("typer.exceptions").exceptions.Abort
     try:
         rv = app(args=argv, prog_name=prog, standalone_mode=False)
     except PmNavError as err:
@@ -131,7 +133,7 @@ def run_cli(app: Callable, argv: list[str] | None, prog: str, format_error: Call
             sys.exit(2)  # typer has printed the help
         where = f"{err.ctx.command_path}: " if getattr(err, "ctx", None) else ""
         _die(prog, where + err.format_message(), err.exit_code)
-    except ce.Abort:
+    except abort:
         _die(prog, "interrupted", 130)
     except OSError as err:  # a disk that filled up mid-write, a folder removed under us
         name = f"{_short(err.filename, 80)}: " if err.filename else ""

@@ -17,6 +17,7 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 from pmnav_bt.errors import PmNavError
@@ -102,6 +103,19 @@ def _call(fn, i: int, task):
     return i, fn(task)
 
 
+@contextmanager
+def _signals_through_ray():
+    """A signal handler's exception (Interrupted) raised while Ray's Cython code waits
+    comes out as a SystemError caused by it: raise the exception itself."""
+    try:
+        yield
+    except SystemError as err:
+        cause = err.__cause__ or err.__context__
+        if isinstance(cause, BaseException) and not isinstance(cause, Exception):
+            raise cause from None
+        raise
+
+
 def _ray(fn, tasks, jobs, address) -> Iterator[tuple[int, Any]]:
     ray, started = ray_init(address, jobs)
     remote = ray.remote(num_cpus=1, max_retries=0)(_call)
@@ -109,12 +123,15 @@ def _ray(fn, tasks, jobs, address) -> Iterator[tuple[int, Any]]:
     try:
         pending = {remote.remote(fn, i, t): i for i, t in enumerate(tasks)}
         while pending:
-            ready, _ = ray.wait(list(pending), num_returns=1)
+            with _signals_through_ray():
+                ready, _ = ray.wait(list(pending), num_returns=1)
             i = pending.pop(ready[0])
             try:
-                yield ray.get(ready[0])
+                with _signals_through_ray():
+                    row = ray.get(ready[0])
             except ray.exceptions.RayError as err:
-                yield i, TaskCrash(f"{type(err).__name__}: {str(err).splitlines()[0]}")
+                row = i, TaskCrash(f"{type(err).__name__}: {str(err).splitlines()[0]}")
+            yield row
     finally:
         for r in pending:
             ray.cancel(r, force=True)
