@@ -5,6 +5,11 @@
 from __future__ import annotations
 
 import math
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -47,3 +52,33 @@ def test_stopping_early_terminates_the_pool():
     first = next(it)
     it.close()  # what an Interrupted on the way up does
     assert first[1] == math.factorial(first[0])
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="process groups")
+def test_ctrl_c_during_a_ray_run_keeps_the_finished_episodes(tmp_path):
+    pytest.importorskip("ray")
+    out = tmp_path / "eval"
+    cmd = [
+        sys.executable, "-m", "pmnav_bt.experiments.cli", "sim", "eval", "--building",
+        "straight_office", "--tier", "easy", "-n", "8", "--variants", "pmnav", "--jobs", "2",
+        "--ray", "--out", str(out),
+    ]  # fmt: skip
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True
+    )
+    results = out / "results.jsonl"
+    try:
+        deadline = time.monotonic() + 150
+        while time.monotonic() < deadline and (
+            not results.exists() or not results.read_text().count("\n")
+        ):
+            assert proc.poll() is None, proc.communicate()
+            time.sleep(0.2)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=90)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130 and "Traceback" not in err, err[-2000:]
+    done = results.read_text().count("\n")
+    assert 1 <= done < 8 and f"after {done} of 8 episodes" in err
