@@ -3,8 +3,10 @@ the same seeds giving the same results across the three.
 
 Runs ``pmnav sim eval`` on a few short episodes (generated gen_small buildings, easy tier,
 ground-truth perception sim_gt, the default 320x240 camera) once per mode, timing the whole
-command (start-up included: what a user waits for) and the episodes alone (the rows'
-wall times), then compares the results.jsonl rows minus their wall times.
+command (start-up included: what a user waits for), its CPU seconds (which the other
+users of a shared machine do not change much) and the episodes alone (the rows' wall
+times), then compares the results.jsonl rows minus their wall times. The load average
+is printed: on a busy machine the wall-clock rates say more about the others.
 
 Run: python benchmarks/bench_eval_throughput.py [--buildings 2] [-n 4] [--out out/bench]
 Target: none; on a 2-core machine --jobs 2 should beat --jobs 1 and Ray should be within
@@ -16,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -27,6 +30,12 @@ MODES = {
     "--jobs 2": ["--jobs", "2"],
     "--ray": ["--jobs", "2", "--ray"],
 }
+
+
+def _cpu() -> float:
+    """CPU seconds of every finished descendant (load-independent, unlike the wall)."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def rows(path: Path) -> dict[str, dict]:
@@ -53,18 +62,21 @@ def main() -> None:
     got = {}
     for mode, flags in MODES.items():
         out = a.out / mode.strip("-").replace(" ", "")
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), _cpu()
         p = subprocess.run([*base, *flags, "--out", str(out)], capture_output=True, text=True)
-        dt = time.perf_counter() - t0
+        dt, cpu = time.perf_counter() - t0, _cpu() - c0
         if p.returncode != 0:
             sys.exit(f"{mode}: exit {p.returncode}: {p.stderr.strip().splitlines()[-1]}")
         got[mode] = rows(out / "results.jsonl")
         busy = sum(
             json.loads(x)["wall_time"] for x in (out / "results.jsonl").read_text().splitlines()
         )
+        # Ray's workers are the raylet's children, reaped there: not in our rusage.
+        cpu_text = "CPU n/a (Ray's workers)" if "--ray" in flags else f"{cpu / total:.1f} CPU-s"
         print(
             f"{mode:>9}: {total} episodes in {dt:6.1f} s = {total / dt * 3600:6.0f} episodes/h "
-            f"(whole command); mean episode {busy / total:.1f} s wall in its worker"
+            f"(whole command); {cpu_text} per episode (start-up included); "
+            f"mean episode {busy / total:.1f} s wall in its worker"
         )
     ref = got["--jobs 1"]
     same = all(g == ref for g in got.values())
