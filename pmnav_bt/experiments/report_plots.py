@@ -3,6 +3,7 @@ failure codes per variant."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from pmnav_bt.experiments.report_tables import (
@@ -30,7 +31,7 @@ def plot_sr_spl(results: Results, path: Path) -> Path:
     tiers = [*tiers_present(results), "all"]
     names = list(results)
     stats = {n: tier_stats(results[n]) for n in names}
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), sharey=True)
     width = 0.8 / max(1, len(names))
     for ax, metric, k in ((axes[0], "SR", 0), (axes[1], "SPL", 1)):
         for j, n in enumerate(names):
@@ -53,8 +54,10 @@ def plot_sr_spl(results: Results, path: Path) -> Path:
         ax.set_ylim(0, 110)
         ax.grid(axis="y", alpha=0.3)
     axes[0].set_ylabel("%")
-    axes[1].legend(fontsize=8, loc="upper right")
-    fig.tight_layout()
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=min(4, len(names)), fontsize=8)
+    rows = math.ceil(len(names) / 4)
+    fig.tight_layout(rect=(0, 0.06 * rows, 1, 1))
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     plt.close(fig)
