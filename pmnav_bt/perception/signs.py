@@ -72,7 +72,10 @@ def _engine(threads: int):
 
 def text_line_boxes(gray: np.ndarray, min_h: int = MIN_LINE_PX) -> list[tuple[Box, float]]:
     """Dense, high-contrast regions: text lines, or whole plates where the text touches the
-    plate's border; each with its estimated text-line height (pixels)."""
+    plate's border; each with its estimated text-line height (pixels).
+
+    The closing joins the characters of small text; the characters of text seen close up
+    (gaps wider than the closing) are joined afterwards by ``join_characters``."""
     h, w = gray.shape
     grad = cv2.morphologyEx(gray, cv2.MORPH_GRADIENT, np.ones((3, 3), np.uint8))
     edges = (grad >= 60).astype(np.uint8)
@@ -80,16 +83,56 @@ def text_line_boxes(gray: np.ndarray, min_h: int = MIN_LINE_PX) -> list[tuple[Bo
     kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (k, max(1, k // 3)))
     closed = cv2.morphologyEx(edges, cv2.MORPH_CLOSE, kernel)
     n, _, stats, _ = cv2.connectedComponentsWithStats(closed, connectivity=8)
+    boxes = [
+        (int(x), int(y), int(x + bw), int(y + bh))
+        for x, y, bw, bh, _ in stats[1:]
+        if min_h <= bh <= h // 4
+    ]
     out: list[tuple[Box, float]] = []
-    for i in range(1, n):
-        x, y, bw, bh, _ = stats[i]
-        if bh < min_h or bw < min_h or bh > h // 4 or bw > w * 0.9:
+    for (x0, y0, x1, y1), chars in join_characters(boxes):
+        bw, bh = x1 - x0, y1 - y0
+        if bw < min_h or bw > w * 0.9:
             continue
-        fill = float(edges[y : y + bh, x : x + bw].mean())
+        fill = float(edges[y0:y1, x0:x1].mean())
         if fill >= 0.25 and bw >= 0.7 * bh:
-            line_h = bh if fill >= 0.45 else bh / 3.0  # sparse: a plate, about 3 lines high
-            out.append(((float(x), float(y), float(x + bw), float(y + bh)), float(line_h)))
+            # sparse and not a row of characters: a plate, about 3 lines high
+            line_h = bh if fill >= 0.45 or chars > 1 else bh / 3.0
+            out.append(((float(x0), float(y0), float(x1), float(y1)), float(line_h)))
     return out
+
+
+def join_characters(
+    boxes: list[tuple[int, int, int, int]],
+) -> list[tuple[tuple[int, int, int, int], int]]:
+    """Join character-shaped boxes (no wider than 1.2 x their height) standing side by side
+    on one line (similar heights, overlapping rows, gaps under 0.6 x the height) into
+    words: (box, number of characters). Other boxes pass through with a count of 1."""
+
+    def char_like(b):
+        return b[2] - b[0] <= 1.2 * (b[3] - b[1])
+
+    out: list[list] = []
+    for b in sorted(boxes):
+        bh = b[3] - b[1]
+        for g in out:
+            gb, last = g[0], g[2]
+            lh = last[3] - last[1]
+            rows = min(b[3], last[3]) - max(b[1], last[1])
+            if (
+                g[1] > 0
+                and char_like(b)
+                and char_like(last)
+                and max(bh, lh) <= 1.5 * min(bh, lh)
+                and rows >= 0.6 * min(bh, lh)
+                and -0.2 * lh <= b[0] - last[2] <= 0.6 * max(bh, lh)
+            ):
+                g[0] = (min(gb[0], b[0]), min(gb[1], b[1]), max(gb[2], b[2]), max(gb[3], b[3]))
+                g[1] += 1
+                g[2] = b
+                break
+        else:
+            out.append([b, 1 if char_like(b) else 0, b])
+    return [(g[0], max(1, g[1])) for g in out]
 
 
 def group_lines(lines: list[tuple[Box, float]]) -> list[tuple[Box, float]]:

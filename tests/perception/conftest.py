@@ -17,11 +17,13 @@ WALL_RGB = (200, 196, 180)
 RANGE = 1.8  # m to the wall
 
 
-def wall_frame(signs: list[tuple[str, float]], depth: bool = True) -> Observation:
-    """A camera facing a plain wall RANGE m away, with sign plates at lateral offsets
+def wall_frame(
+    signs: list[tuple[str, float]], depth: bool = True, range_m: float = RANGE
+) -> Observation:
+    """A camera facing a plain wall ``range_m`` away, with sign plates at lateral offsets
     (m, left positive) centred at camera height."""
     rgb = np.full((K.height, K.width, 3), WALL_RGB, np.uint8)
-    px_per_m = K.fx / RANGE
+    px_per_m = K.fx / range_m
     for text, y_left in signs:
         tex = make_sign(text)
         w = int(round(tex.width_m * px_per_m))
@@ -32,7 +34,7 @@ def wall_frame(signs: list[tuple[str, float]], depth: bool = True) -> Observatio
         su0, sv0 = max(u0, 0), max(v0, 0)
         su1, sv1 = min(u0 + w, K.width), min(v0 + h, K.height)
         rgb[sv0:sv1, su0:su1] = img[sv0 - v0 : sv1 - v0, su0 - u0 : su1 - u0]
-    d = np.full((K.height, K.width), RANGE, np.float32) if depth else None
+    d = np.full((K.height, K.width), range_m, np.float32) if depth else None
     return Observation(rgb, Pose2D(0.0, 0.0, 0.0), 0.0, K, depth=d, camera_height=1.6)
 
 

@@ -52,6 +52,15 @@ def test_a_sign_cut_by_the_image_border_is_still_named(grounder, wall):
     assert signs[0].box[0] <= 2  # it touches the border
 
 
+def test_a_number_seen_close_up_and_cut_by_the_border_is_read_whole(grounder, wall):
+    """At 1 m a bare "113" has characters farther apart than the candidate finder's
+    closing: they are joined into one word, not read as "13" (room 13 has no such sign)."""
+    half_view = 1.0 * math.tan(wall.K.hfov / 2)
+    obs = wall.frame([("113", half_view - 0.25)], range_m=1.0)
+    signs = grounder.read_signs(obs)
+    assert [d.entity for d in signs] == [Entity.room("room13")]
+
+
 def test_without_depth_signs_are_named_but_not_placed(grounder, wall):
     obs = wall.frame([("102 Pharmacy", 0.0)], depth=False)
     signs = grounder.read_signs(obs)
