@@ -15,6 +15,7 @@ from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.localization import Sighting, fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance
+from pmnav_bt.perception.read_range import sign_visible_range
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.visibility import entity_xy
@@ -77,7 +78,7 @@ class UpdateBelief(PmNavBehaviour):
         views = self.get("views") or []
         belief = self.get("belief")
         if belief is None:
-            belief = CorridorBelief(self.ctx.pm)
+            belief = CorridorBelief(self.ctx.pm, read_range=sign_visible_range(self.ctx.config))
             tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
             if tf is not None:
                 sigma = tracker.sigma(self.ctx.odometer.distance) if tracker else 3.0

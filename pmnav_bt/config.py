@@ -41,7 +41,11 @@ def _registered(seam: str):
 
 
 class GrounderConfig(_Section):
-    backend: str = Field("sim_gt", description="grounder back end (pmnav backends lists them)")
+    backend: str = Field(
+        "ocr",
+        description="grounder back end (pmnav backends lists them); sim_gt: the simulator's "
+        "labels, an oracle",
+    )
     _check_backend = _registered("grounder")
     miss_rate: float = Field(0.0, ge=0.0, le=1.0, description="chance a readable sign is missed")
     false_positive_rate: float = Field(
@@ -156,11 +160,12 @@ class TreeConfig(_Section):
     explore_distance: float = Field(
         16.0, gt=0.0, le=100.0, description="at most this far (m) along the corridor between tries"
     )
-    search_range: float = Field(
-        4.5,
+    search_range: float | None = Field(
+        None,
         gt=0.0,
         le=100.0,
-        description="drive until a target is this close (by the map) before searching",
+        description="drive until a target is this close (by the map) before searching; "
+        "unset: from the grounder's read range (pmnav_bt/perception/read_range.py)",
     )
     search_attempts: int = Field(
         4,
@@ -169,11 +174,12 @@ class TreeConfig(_Section):
         description="searches for one landmark (the last from level with it: a sign on the "
         "door's far side is readable only from there)",
     )
-    research_distance: float = Field(
-        2.0,
+    research_distance: float | None = Field(
+        None,
         gt=0.0,
         le=100.0,
-        description="move this far towards a target not found before searching again",
+        description="move this far towards a target not found before searching again; "
+        "unset: from the grounder's read range",
     )
     replans: int = Field(2, ge=0, le=100, description="re-localize-and-replan recoveries")
     goal_offset: float = Field(

@@ -43,6 +43,7 @@ from pmnav_bt.behaviours.search import (
     Verify,
     target_entity,
 )
+from pmnav_bt.perception.read_range import search_settings
 from pmnav_bt.trees.localize import active_localize_subtree, recovery_subtree
 
 VARIANTS = ("pmnav", "coarse_only")
@@ -58,6 +59,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
     """One plan step: target determination, then search-verify-approach for a visible
     target or drive-turn-check for an unseen turn or fork, then target update."""
     cfg = ctx.config.tree
+    ranges = search_settings(ctx.config)  # from the reader's range unless set
     coarse_only = cfg.variant == "coarse_only"
     search_once = Sequence(
         "SearchOnce",
@@ -84,7 +86,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
         children=[
             # On up to level with the target (its node): a sign hangs beside its door,
             # maybe on the far side, readable (not just visible) only from about there.
-            MoveToward("MoveOn", ctx, keep=0.0, distance=cfg.research_distance),
+            MoveToward("MoveOn", ctx, keep=0.0, distance=ranges.research_distance),
             AlwaysFail(name="SearchAgain"),
         ],
     )
@@ -93,7 +95,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
         memory=True,
         children=[
             TargetIs("IsVisible", ctx, visible=True),
-            MoveToward("IntoSearchRange", ctx, keep=cfg.search_range),
+            MoveToward("IntoSearchRange", ctx, keep=ranges.search_range),
             Retry(
                 "Search",
                 Selector("SearchOrMoveOn", memory=True, children=[search_once, research]),

@@ -83,9 +83,10 @@ class CorridorBelief:
     pending_blocked: float | None = None  # a drive was blocked heading this way (odometry)
     _last_way: int | None = None  # the way (0-3 from the axis) the last lead chose
     _drift: float = 0.0  # odometry heading drift since the reference, from the walls
+    read_range: float | None = None  # m, signs are read to (None: visibility.READ_RANGE_M)
 
     def __post_init__(self) -> None:
-        self.vis = Visibility.of(self.pm)
+        self.vis = Visibility.of(self.pm, self.read_range)
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs

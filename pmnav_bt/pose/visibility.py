@@ -74,11 +74,14 @@ class Visibility:
         self._eye = np.array([self._inset(p) for p in self._xy]).reshape(-1, 2)
 
     @classmethod
-    def of(cls, pm: PrioriMap) -> Visibility:
-        """The cached Visibility of ``pm``."""
-        v = pm.__dict__.get("_visibility")
+    def of(cls, pm: PrioriMap, read_range: float | None = None) -> Visibility:
+        """The cached Visibility of ``pm`` for signs read to ``read_range`` (None:
+        ``READ_RANGE_M``; the OCR reader's comes from perception/read_range.py)."""
+        r = READ_RANGE_M if read_range is None else float(read_range)
+        cache = pm.__dict__.setdefault("_visibility", {})
+        v = cache.get(r)
         if v is None:
-            v = pm.__dict__["_visibility"] = cls(pm)
+            v = cache[r] = cls(pm, read_range=r)
         return v
 
     @cached_property

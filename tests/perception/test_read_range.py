@@ -1,0 +1,74 @@
+"""The reader's measured range is the one source of the tree's search distances."""
+
+from __future__ import annotations
+
+import pytest
+
+from pmnav_bt.config import load_config
+from pmnav_bt.perception.read_range import (
+    ocr_read_range,
+    search_settings,
+    sign_read_range,
+    sign_visible_range,
+)
+
+
+def test_the_measured_widths_read_to_the_last_reliable_band():
+    # benchmarks/bench_signs.py: 94 % at 1.5-2.5 m and 49 % beyond at 320 px; 84 % at
+    # 2.5-3.5 m and 30 % beyond at 640 px.
+    assert ocr_read_range(320) == 2.5 and ocr_read_range(640) == 3.5
+    assert ocr_read_range(320, recall=0.25) == 3.5 and ocr_read_range(640, recall=0.25) == 4.5
+
+
+def test_other_widths_between_and_beyond_the_measured_ones():
+    assert ocr_read_range(480) == pytest.approx(3.0)
+    assert ocr_read_range(160) == pytest.approx(1.25)  # half the pixels on a sign's text
+    assert ocr_read_range(1280) == 3.5  # no farther than measured: crops are upscaled anyway
+    widths = [80, 160, 240, 320, 400, 640, 1920]
+    ranges = [ocr_read_range(w) for w in widths]
+    assert ranges == sorted(ranges)
+
+
+def test_the_tree_searches_within_the_readers_range():
+    ocr = search_settings(load_config(None, ["grounder.backend=ocr"]))
+    assert (ocr.search_range, ocr.research_distance, ocr.read_range) == (2.0, 1.0, 2.5)
+    big = search_settings(load_config(None, ["sim.width=640", "sim.height=480"]))
+    assert (big.search_range, big.research_distance) == (3.0, 1.5)
+    # The oracle reads to its max_range (9 m): the settings it was tuned with.
+    oracle = load_config(None, ["grounder.backend=sim_gt"])
+    assert (search_settings(oracle).search_range, search_settings(oracle).research_distance) == (
+        4.5,
+        2.0,
+    )
+    assert sign_read_range(oracle) == 9.0 and sign_visible_range(oracle) is None
+    # A value set in the config wins.
+    own = search_settings(load_config(None, ["tree.search_range=3.3"]))
+    assert (own.search_range, own.research_distance) == (3.3, 1.65)
+
+
+def test_the_localization_belief_expects_signs_where_the_reader_can_read_them(fig2_map):
+    from pmnav_bt.pose.belief import CorridorBelief
+
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    belief = CorridorBelief(fig2_map, read_range=sign_visible_range(cfg))
+    assert belief.vis.read_range == 3.5
+    assert CorridorBelief(fig2_map).vis.read_range == 9.5  # the oracle's
+    near = belief.vis.readable_from((16.0, 0.0))
+    assert near and near < CorridorBelief(fig2_map).vis.readable_from((16.0, 0.0))
+
+
+def test_the_built_tree_uses_them(fig2_map):
+    from types import SimpleNamespace
+
+    from pmnav_bt.trees.pmnav import step_subtree
+
+    def keeps(cfg) -> dict[str, tuple[float, float]]:
+        root = step_subtree(SimpleNamespace(config=cfg, now=lambda: 0.0))
+        return {
+            b.name: (b.keep, b.distance)
+            for b in root.iterate()
+            if b.name in ("IntoSearchRange", "MoveOn")
+        }
+
+    got = keeps(load_config(None, ["grounder.backend=ocr"]))
+    assert got["IntoSearchRange"][0] == 2.0 and got["MoveOn"] == (0.0, 1.0)
