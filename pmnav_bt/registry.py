@@ -116,6 +116,14 @@ GROUNDERS = Registry(
         ),
     ],
 )
+
+
+def grounder_label(name: str) -> str:
+    """The grounder's name as results print it: ``sim_gt (oracle)`` for a back end that
+    reads the simulator's labels, so an oracle's figures are never taken for perception."""
+    return f"{name} (oracle)" if GROUNDERS.spec(name).needs_sim_labels else name
+
+
 COARSE = Registry(
     "coarse",
     [

@@ -16,8 +16,10 @@ from pmnav_bt.registry import GROUNDERS, REGISTRIES, BackendSpec, build_backends
 from pmnav_bt.seams import CoarseDirection, Grounder, Planner, Refiner
 
 
-def test_the_default_config_builds_every_seam_from_the_registry(fig2_map):
-    cfg = load_config(overrides=["grounder.miss_rate=0.25", "planner.max_gap=6"])
+def test_a_config_builds_every_seam_from_the_registry(fig2_map):
+    cfg = load_config(
+        overrides=["grounder.backend=sim_gt", "grounder.miss_rate=0.25", "planner.max_gap=6"]
+    )
     b = build_backends(cfg, fig2_map, on_robot=False, seed=3)
     assert isinstance(b.grounder, GroundTruthGrounder) and isinstance(b.grounder, Grounder)
     assert (b.grounder.miss_rate, b.grounder.seed) == (0.25, 3)
@@ -31,7 +33,7 @@ def test_the_default_config_builds_every_seam_from_the_registry(fig2_map):
 
 def test_a_simulator_only_grounder_is_refused_on_a_robot_in_one_line(fig2_map):
     with pytest.raises(BackendError) as info:
-        build_backends(load_config(), fig2_map, on_robot=True)
+        build_backends(load_config(overrides=["grounder.backend=sim_gt"]), fig2_map, on_robot=True)
     msg = str(info.value)
     assert "\n" not in msg and "grounder.backend 'sim_gt'" in msg and "robot" in msg
 
@@ -66,4 +68,5 @@ def test_pmnav_backends_lists_every_registered_back_end(capsys):
         for name in registry.names():
             line = next(x for x in out.splitlines() if x.split()[:2] == [f"{seam}.backend", name])
             assert registry.spec(name).summary in line
-    assert "[default, sim only]" in next(x for x in out.splitlines() if " sim_gt " in x)
+    assert "[sim only]" in next(x for x in out.splitlines() if " sim_gt " in x)
+    assert "[default]" in next(x for x in out.splitlines() if " ocr " in x)

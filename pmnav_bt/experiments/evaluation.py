@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from pmnav_bt.config import Config
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
 from pmnav_bt.loading import atomic_write_text, safe_filename
+from pmnav_bt.registry import grounder_label
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.sim.episodes import Episode
@@ -190,7 +191,8 @@ def _plot(
     ]
     verdict = "SUCCESS" if result.success else f"FAILED ({result.failure_reason})"
     caption = (
-        f"{VARIANT_NAMES.get(config.tree.variant, config.tree.variant)}: {verdict}; "
+        f"{VARIANT_NAMES.get(config.tree.variant, config.tree.variant)} "
+        f"[{grounder_label(config.grounder.backend)}]: {verdict}; "
         f"SPL {result.spl:.2f}; {result.path_length:.1f} m driven, "
         f"{result.shortest_path_length:.1f} m shortest; {outcome.actions} actions"
     )
@@ -329,7 +331,30 @@ def comparison_markdown(results: dict[str, list[EpisodeResult]]) -> str:
             vals = [f"{row.sr:.1f}", f"{row.spl:.1f}", f"{row.soft_spl:.1f}"]
             cells.append(" | ".join(vals + ([str(row.errors)] if errors else [])))
         lines.append(f"| {tier} | {count} | " + " | ".join(cells) + " |")
+    lines.append("")
+    lines += [f"- {variant_title(name)}: {run_summary(rs)}" for name, rs in results.items()]
     return "\n".join(lines)
+
+
+def failure_code(reason: str) -> str:
+    """The code of a failure reason ("BUDGET_EXCEEDED: ..." -> BUDGET_EXCEEDED)."""
+    head = reason.split(":", 1)[0].strip()
+    return head if head.replace("_", "").isalpha() and head.isupper() else "OTHER"
+
+
+def run_summary(results: list[EpisodeResult]) -> str:
+    """Failure codes with their counts, and episode wall time mean and p95."""
+    import numpy as np
+
+    codes: dict[str, int] = {}
+    for r in results:
+        if r.error is None and not r.success:
+            c = failure_code(r.failure_reason or "")
+            codes[c] = codes.get(c, 0) + 1
+    fails = ", ".join(f"{c} {k}" for c, k in sorted(codes.items())) or "none"
+    walls = [r.wall_time for r in results if r.error is None]
+    wall = f"{np.mean(walls):.1f} s / {np.percentile(walls, 95):.1f} s" if walls else "-"
+    return f"failures: {fails}; episode wall time mean / p95: {wall}"
 
 
 def error_counts(results: dict[str, list[EpisodeResult]]) -> dict[str, int]:

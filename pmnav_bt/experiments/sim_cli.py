@@ -14,6 +14,7 @@ import typer
 from pmnav_bt import cli_values
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.loading import check_output_dir, check_output_file, safe_filename
+from pmnav_bt.registry import grounder_label
 from pmnav_bt.sim.poses import PoseError, parse_pose  # noqa: F401 - PoseError: part of this CLI
 
 app = typer.Typer(
@@ -206,7 +207,8 @@ def run(
 
         live = LiveTree()
     typer.echo(
-        f"{VARIANT_NAMES[cfg.tree.variant]} in {ep.building}: {ep.id} ({ep.tier}), "
+        f"{VARIANT_NAMES[cfg.tree.variant]} [{grounder_label(cfg.grounder.backend)}] in "
+        f"{ep.building}: {ep.id} ({ep.tier}), "
         f"start ({ep.start_x:.1f}, {ep.start_y:.1f}, {math.degrees(ep.start_yaw):.0f} deg), "
         f"corridor route {ep.route_length:.1f} m"
     )
@@ -256,7 +258,8 @@ def eval_header(building, tier, n, seed, cfg, configs) -> str:
 
     g = cfg.grounder
     grounders = "; ".join(
-        f"{variant_title(name)}: grounder {c.grounder.backend}" for name, c in configs.items()
+        f"{variant_title(name)}: grounder {grounder_label(c.grounder.backend)}"
+        for name, c in configs.items()
     )
     return (
         f"# PM-Nav evaluation\n\nbuildings: {building}; tiers: {tier}; {n} per tier per "
@@ -279,7 +282,7 @@ def eval_(
     n: int = typer.Option(20, "-n", min=1, help="Episodes per tier per building."),
     seed: int = typer.Option(0, "--seed"),
     variants: str = typer.Option(
-        "pmnav,coarse_only",
+        "pmnav,coarse_only,pmnav_oracle",
         "--variants",
         help="Comma-separated evaluation variants (pmnav, coarse_only, pmnav_oracle, ...).",
     ),
@@ -404,7 +407,8 @@ def table3(
     results = run.results
     header = (
         f"# Localization by landmark density (paper Table 3)\n\nbuildings: {', '.join(names)}; "
-        f"up to {n} starts per class per building; seed {seed}; grounder {cfg.grounder.backend} "
+        f"up to {n} starts per class per building; seed {seed}; grounder "
+        f"{grounder_label(cfg.grounder.backend)} "
         f"(miss {cfg.grounder.miss_rate:.0%}); odometry noise {cfg.sim.odometry_noise:.0%}.\n"
         f"Class: signs the priori-map says are readable from the start (line of sight, "
         f"<= {READ_RANGE_M:g} m): redundant > 2, minimal = 2, scarce 0-1. Success: the "

@@ -26,6 +26,7 @@ from pmnav_bt.seams import MotionStatus, Pose2D
 from pmnav_bt.sim.odometry import NoisyOdometry
 from pmnav_bt.sim.robot import SimBase
 from pmnav_bt.sim.world import SimWorld
+from pmnav_bt.testing.oracle import ORACLE
 from pmnav_bt.trees.runner import make_context
 
 PERIOD = 0.1  # seconds of sim time between ticks (the runner's 10 Hz)
@@ -166,7 +167,7 @@ def make_rig(world, pm, clean_blackboard):
     ) -> Rig:
         body = SimBase(world, pose=pose, width=width, height=height, segmentation=segmentation)
         base = body if noise is None else NoisyOdometry(body, noise, seed=seed)
-        ctx = make_context(base, pm, load_config(overrides=list(overrides)), seed, budget)
+        ctx = make_context(base, pm, load_config(overrides=[ORACLE, *overrides]), seed, budget)
         bb = py_trees.blackboard.Client(name="test", namespace=NAMESPACE)
         for key in KEYS:
             bb.register_key(key=key, access=Access.WRITE)

@@ -28,6 +28,7 @@ from pmnav_bt.testing.doubles import (
     FakeRefiner,
     ScriptedGrounder,
 )
+from pmnav_bt.testing.oracle import ORACLE
 from pmnav_bt.trees.runner import make_context
 
 PERIOD = 0.1
@@ -108,7 +109,7 @@ def rig():
             refiner=refiner or FakeRefiner(),
             planner=planner or FakePlanner(),
         )
-        cfg = load_config(overrides=list(overrides))
+        cfg = load_config(overrides=[ORACLE, *overrides])
         ctx = make_context(base, pm, cfg, deferred_work=deferred, backends=backends)
         bb = py_trees.blackboard.Client(name="test", namespace=NAMESPACE)
         for key in KEYS:

@@ -20,6 +20,7 @@ from pmnav_bt.testing.doubles import (
     FakeRefiner,
     ScriptedGrounder,
 )
+from pmnav_bt.testing.oracle import ORACLE
 from pmnav_bt.trees.runner import RunOutcome, make_context, run_tree
 
 START = Pose2D(4.0, 0.0, 0.0)  # straight_office, facing east down the corridor
@@ -41,7 +42,7 @@ def mission(
         grounder or ScriptedGrounder(pm), FakeCoarseDirection(), FakeRefiner(), FakePlanner()
     )
     ctx = make_context(
-        base, pm, load_config(overrides=list(overrides)), deferred_work=True, backends=backends
+        base, pm, load_config(overrides=[ORACLE, *overrides]), deferred_work=True, backends=backends
     )
     hook = (lambda tree: on_tick(ctx)) if on_tick is not None else None
     out = run_tree(ctx, goal, max_ticks=max_ticks, on_tick=hook)

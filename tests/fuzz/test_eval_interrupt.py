@@ -61,6 +61,8 @@ def test_eval_interrupted_keeps_finished_episodes(tmp_path, signame, jobs):
             "40",
             "--variants",
             "pmnav",
+            "--set",
+            "grounder.backend=sim_gt",  # the oracle: fast episodes
             "--jobs",
             str(jobs),
             "--out",

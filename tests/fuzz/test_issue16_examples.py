@@ -483,13 +483,13 @@ def test_run_files_stay_in_out_whatever_the_episode_id(tmp_path):
     goal): `../../..` in it never reaches outside --out."""
     from dataclasses import replace
 
-    from pmnav_bt.config import load_config
     from pmnav_bt.experiments.evaluation import custom_episode, run_episode
+    from pmnav_bt.testing.oracle import oracle_config
 
     TRIED["issue examples: in-process CLI"] += 1
     ep = replace(custom_episode("straight_office", "room1"), id="../../../evil/x")
     out = tmp_path / "a" / "out"
-    r = run_episode(ep, load_config(), out_dir=out)
+    r = run_episode(ep, oracle_config(), out_dir=out)
     assert r.tree_log.parent == out and r.plot.parent == out
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a"]
     assert sorted(p.name for p in (tmp_path / "a").iterdir()) == ["out"]

@@ -83,6 +83,7 @@ def launched(tmp_path_factory, new_domain_id):
             "width:=240",
             "height:=180",
             f"record:={record}",
+            "overrides:=grounder.backend=sim_gt",  # the oracle (the simulator's labels)
         ],  # fmt: skip
         env=ros_env(domain_id=domain),
         stdout=log,

@@ -26,6 +26,7 @@ from pmnav_bt.sim.episodes import generate_episodes
 BUILDING = "fig2_hospital"
 CAMERA = {"width": 240, "height": 180}  # small, but signs stay readable
 READY_S = 45.0  # process start (imports, pybullet world) on a busy 2-core machine
+ORACLE = "grounder.backend=sim_gt"  # the simulator's labels: the tests of the ROS plumbing
 
 pytestmark = pytest.mark.timeout(240)
 
@@ -101,6 +102,7 @@ def _run_episode(
         sim_params,
         budget=ep.step_budget,
         odom_fault_s=3.0,
+        tree_log=str(tmp_path / "tree.jsonl"),  # for a failure's post-mortem
         **ctl_params,
     )
     procs = (sim, ctl)
@@ -138,7 +140,7 @@ def _run_episode(
 
 def test_easy_episode_over_dds(probe, domain_id, tmp_path):
     ep = _episode("easy", 0)
-    _run_episode(probe, domain_id, tmp_path, ep, timeout=90.0)
+    _run_episode(probe, domain_id, tmp_path, ep, timeout=90.0, overrides=ORACLE)
 
 
 @pytest.mark.slow  # since the localization/real-stack merges it can exceed 150 s: issue 9
@@ -164,14 +166,16 @@ def test_easy_episode_with_the_real_stack_over_dds(probe, domain_id, tmp_path):
 def test_medium_episode_over_dds(probe, domain_id, tmp_path):
     ep = _episode("medium", 1)
     assert ep.turns >= 1 and not ep.goal_visible
-    _run_episode(probe, domain_id, tmp_path, ep, timeout=150.0)
+    _run_episode(probe, domain_id, tmp_path, ep, timeout=150.0, overrides=ORACLE)
 
 
 def test_faults_over_dds(probe, domain_id, tmp_path):
     """One simulated base and a controller with default timeouts, in turn: a bad goal,
     cancel, odometry lost, camera lost, Ctrl-C, and (a second controller) killed."""
     ep = _episode("easy", 0)
-    sim, ctl = _start(domain_id, tmp_path, (ep.start_x, ep.start_y, ep.start_yaw), ep.seed)
+    sim, ctl = _start(
+        domain_id, tmp_path, (ep.start_x, ep.start_y, ep.start_yaw), ep.seed, overrides=ORACLE
+    )
     procs = (sim, ctl)
     try:
         _ready(probe, procs)
@@ -251,7 +255,7 @@ def test_faults_over_dds(probe, domain_id, tmp_path):
         # The controller is killed mid-motion: the base stops by its own 0.5 s timeout.
         ctl = Proc(
             "pmnav_bt.hardware.node",
-            {"building": BUILDING, "seed": ep.seed},
+            {"building": BUILDING, "seed": ep.seed, "overrides": ORACLE},
             domain_id,
             tmp_path / "controller2.log",
         )

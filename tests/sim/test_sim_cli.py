@@ -11,6 +11,7 @@ import yaml
 from pmnav_bt.experiments.cli import main
 from pmnav_bt.map.building import BUILTIN_DIR, load_building
 from pmnav_bt.map.floorplan import rasterize_building, save_ros_map
+from pmnav_bt.testing.oracle import ORACLE_SET
 
 
 def run(capsys, *argv) -> tuple[int, str, str]:
@@ -58,7 +59,8 @@ def test_run_an_episode_file_needs_no_goal_and_plots_the_ros_map(capsys, own_bui
     code, _, err = run(capsys, "sim", "run", "--episodes", str(eps), "--goal", "room1")
     assert code == 2 and "drop --goal" in err
     # The floor plan (maps/ros.yaml, relative to the building file) is found for the plot.
-    code, out, err = run(capsys, "sim", "run", "--episodes", str(eps), "--index", "0", "--out", "o")
+    argv = ["sim", "run", "--episodes", str(eps), "--index", "0", "--out", "o", *ORACLE_SET]
+    code, out, err = run(capsys, *argv)
     assert code == 0, out + err
     assert "SUCCESS" in out and "trajectory plot:" in out
     assert len(list((tmp_path / "elsewhere" / "o").glob("*.trajectory.png"))) == 1
@@ -66,16 +68,21 @@ def test_run_an_episode_file_needs_no_goal_and_plots_the_ros_map(capsys, own_bui
 
 def test_run_a_goal_in_an_own_building_by_relative_path(capsys, own_building):
     rel = "../plans/my_office.yaml"
-    code, out, err = run(capsys, "sim", "run", "--building", rel, "--goal", "room1", "--out", "o")
+    argv = ["sim", "run", "--building", rel, "--goal", "room1", "--out", "o", *ORACLE_SET]
+    code, out, err = run(capsys, *argv)
     assert code == 0, out + err
-    assert "PM-Nav in my_office" in out and "SUCCESS" in out
+    assert "PM-Nav [sim_gt (oracle)] in my_office" in out and "SUCCESS" in out
 
 
 def test_eval_an_own_building_from_another_directory(capsys, own_building):
     argv = ["sim", "eval", "--building", str(own_building), "--tier", "easy", "-n", "1"]
-    code, out, err = run(capsys, *argv, "--variants", "pmnav", "--jobs", "1", "--out", "o")
+    code, out, err = run(
+        capsys, *argv, "--variants", "pmnav", "--jobs", "1", "--out", "o", *ORACLE_SET
+    )
     assert code == 0, out + err
     assert "| easy | 1 | 100.0 |" in out
+    # The oracle is labelled as such wherever results print.
+    assert "PM-Nav: grounder sim_gt (oracle)" in Path("o/results.md").read_text()
     results = json.loads(Path("o/results.json").read_text())["pmnav"]
     assert results[0]["error"] is None and results[0]["building"] == "my_office"
 

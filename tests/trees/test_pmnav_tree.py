@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import pytest
 
-from pmnav_bt.config import load_config
 from pmnav_bt.experiments.evaluation import custom_episode, run_episode
 from pmnav_bt.sim.episodes import generate_episodes
+from pmnav_bt.testing.oracle import oracle_config
 from pmnav_bt.trees.snapshots import Replay
 
 pytestmark = pytest.mark.timeout(240)
@@ -23,7 +23,7 @@ def shortest(tier: str):
 
 @pytest.mark.parametrize("tier", ["easy", "medium", "hard"])
 def test_an_episode_of_each_tier_succeeds(tier, tmp_path):
-    run = run_episode(shortest(tier), load_config(), out_dir=tmp_path)
+    run = run_episode(shortest(tier), oracle_config(), out_dir=tmp_path)
     r = run.result
     assert r.success, r.failure_reason
     # SPL against the free-space geodesic to the 1 m disc: the tree stops 0.6 m from the
@@ -36,8 +36,8 @@ def test_an_episode_of_each_tier_succeeds(tier, tmp_path):
 
 def test_same_seed_same_episode():
     ep = shortest("easy")
-    a = run_episode(ep, load_config(), plot=False).result
-    b = run_episode(ep, load_config(), plot=False).result
+    a = run_episode(ep, oracle_config(), plot=False).result
+    b = run_episode(ep, oracle_config(), plot=False).result
     assert (a.path_length, a.steps, a.success) == (b.path_length, b.steps, b.success)
 
 
@@ -47,7 +47,7 @@ def test_blocked_corridor_ends_with_blocked():
     def block(world):
         world.add_obstacle(0.0, 24.0, 2.4)  # wall to wall, between the start and room2
 
-    r = run_episode(ep, load_config(), plot=False, setup_world=block).result
+    r = run_episode(ep, oracle_config(), plot=False, setup_world=block).result
     assert not r.success
     assert r.failure_reason.startswith("BLOCKED"), r.failure_reason
     assert r.collisions <= 1  # seen in depth before (or at) the first touch
@@ -55,7 +55,7 @@ def test_blocked_corridor_ends_with_blocked():
 
 def test_hidden_goal_sign_re_search_then_replan_then_target_not_found(tmp_path):
     ep = shortest("easy")
-    cfg = load_config(overrides=[f"grounder.hidden=[{ep.goal}]", "tree.replans=1"])
+    cfg = oracle_config(f"grounder.hidden=[{ep.goal}]", "tree.replans=1")
     run = run_episode(ep, cfg, out_dir=tmp_path, plot=False)
     assert not run.result.success
     assert run.result.failure_reason.startswith("TARGET_NOT_FOUND"), run.result.failure_reason
@@ -82,6 +82,6 @@ def test_hidden_intermediate_landmark_is_avoided_after_a_replan():
         for s in GraphPlanner().plan(pm, start, ep.goal).steps
         if s.visible and s.look_for != ep.goal
     )
-    cfg = load_config(overrides=[f"grounder.hidden=[{first}]"])
+    cfg = oracle_config(f"grounder.hidden=[{first}]")
     r = run_episode(ep, cfg, plot=False).result
     assert r.success, r.failure_reason

@@ -177,19 +177,19 @@ def test_tick_record_missing_a_field(tmp_path, log):
 @pytest.fixture(scope="module")
 def episode_log(tmp_path_factory):
     """A real log: 60 ticks of PM-Nav in the pybullet fig2_hospital (localizes at ~46)."""
-    from pmnav_bt.config import load_config
     from pmnav_bt.map.building import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.seams import Pose2D
     from pmnav_bt.sim.robot import SimBase
     from pmnav_bt.sim.world import SimWorld
+    from pmnav_bt.testing.oracle import oracle_config
     from pmnav_bt.trees.runner import make_context, run_tree
 
     b = load_building("fig2_hospital")
     path = tmp_path_factory.mktemp("episode") / "tree.jsonl"
     with SimWorld(b) as world:
         base = SimBase(world, pose=Pose2D(22.0, 0.0, math.radians(0)))
-        ctx = make_context(base, parse_building(b), load_config())
+        ctx = make_context(base, parse_building(b), oracle_config())
         with open(path, "w", encoding="utf-8") as out:
             outcome = run_tree(ctx, "room17", max_ticks=60, log=out)
     assert outcome.ticks == 60
