@@ -1,7 +1,8 @@
 """Panoramic capture: turn through a set of relative yaws and take a frame at each.
 
 Used for localization (30, 90, ..., 330 deg) and for search (0, +-30, +-60, +-90 deg
-minus the view the last action rules out). Frames are taken and grounded in the
+minus the view the last action rules out, centred on the target when the map puts it
+off to a side: ``search_centre``). Frames are taken and grounded in the
 worker; the tick only steers and polls.
 """
 
@@ -19,6 +20,7 @@ from pmnav_bt.seams import Entity, View
 
 LOCALIZATION_YAWS_DEG = (30, 90, 150, 210, 270, 330)
 SEARCH_YAWS_DEG = (0, 30, -30, 60, -60, 90, -90)
+AHEAD_DEG = 45.0  # a target this near the heading is searched with the paper's views
 
 
 # What a panorama grounds in each frame: every readable sign (localization), or one entity.
@@ -26,10 +28,22 @@ READ_SIGNS = "signs"
 Grounding = Entity | str | None  # an Entity, READ_SIGNS, or None (just take the frames)
 
 
-def search_yaws(last_action: Action | None) -> list[float]:
-    """The paper's search views; after a left turn -90 is left out, after a right turn +90."""
+def search_yaws(last_action: Action | None, centre: float = 0.0) -> list[float]:
+    """The paper's search views around ``centre`` (rad from the heading); after a left turn
+    -90 is left out, after a right turn +90."""
     excluded = {Action.TURN_LEFT: -90, Action.TURN_RIGHT: 90}.get(last_action)
-    return [math.radians(y) for y in SEARCH_YAWS_DEG if y != excluded]
+    return [centre + math.radians(y) for y in SEARCH_YAWS_DEG if y != excluded]
+
+
+def search_centre(bearing: float) -> float:
+    """Where the search views centre (rad from the heading), given the target's bearing by
+    the map: on the heading (the paper's views) while the target is within
+    ``AHEAD_DEG`` of it, else on the target, to the nearest 30 deg. A door's sign hangs
+    beside it: from level with a door, or past it, the sign is out of the forward fan."""
+    if abs(bearing) <= math.radians(AHEAD_DEG):
+        return 0.0
+    step = math.radians(30.0)
+    return round(bearing / step) * step
 
 
 def sweep_order(yaws: list[float]) -> list[float]:
@@ -45,13 +59,14 @@ class CaptureViews(PmNavBehaviour):
     READ_SIGNS (every readable sign, for localization), an Entity (the search target),
     or None (frames only).
 
-    Blackboard: reads what ``yaws``/``what`` read (``target``, ``last_action``);
+    Blackboard: reads what ``yaws``/``what`` read (``target``, ``last_action``,
+    ``map_T_odom``);
     writes ``views`` (list[View]). Stops early when ``enough(views)`` is true. Ends
     facing the last view. FAILURE if the body faults or a frame cannot be taken or
     grounded (SENSOR_TIMEOUT for a silent camera, the back end's code otherwise).
     """
 
-    READS = ("target", "last_action")
+    READS = ("target", "last_action", "map_T_odom")
     WRITES = ("views",)
 
     def __init__(

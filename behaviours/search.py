@@ -10,7 +10,7 @@ from py_trees.common import Status
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import map_pose, thumbnail
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import se2_apply
+from pmnav_bt.geometry import se2_apply, wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose
 from pmnav_bt.planning.resolve import entity_position, step_entity
 from pmnav_bt.seams import CoarseChoice, Entity, EntityKind, View
@@ -32,6 +32,17 @@ def target_entity(b: PmNavBehaviour) -> Entity | None:
     if t is None or t.look_for is None:
         return None
     return step_entity(b.ctx.pm.building, t.look_for)
+
+
+def target_bearing(b: PmNavBehaviour) -> float:
+    """The current target's bearing by the map from the estimated pose, relative to the
+    heading (rad; 0 without a target or a pose estimate)."""
+    t, tf = b.get("target"), b.get("map_T_odom")
+    if t is None or tf is None:
+        return 0.0
+    est = map_pose(tf, b.ctx.base.pose())
+    x, y = float(t.position[0]), float(t.position[1])
+    return wrap_angle(math.atan2(y - est.y, x - est.x) - est.yaw)
 
 
 class CoarseDirection(PmNavBehaviour):

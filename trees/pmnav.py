@@ -13,7 +13,7 @@ from py_trees.behaviours import Failure as AlwaysFail
 from py_trees.composites import Parallel, Selector, Sequence
 from py_trees.decorators import FailureIsSuccess, Repeat, Retry
 
-from pmnav_bt.behaviours.capture import CaptureViews, search_yaws
+from pmnav_bt.behaviours.capture import CaptureViews, search_centre, search_yaws
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.decorators import ClockTimeout
@@ -41,6 +41,7 @@ from pmnav_bt.behaviours.search import (
     FineDirection,
     Ground,
     Verify,
+    target_bearing,
     target_entity,
 )
 from pmnav_bt.perception.read_range import search_settings
@@ -68,7 +69,8 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
             CaptureViews(
                 "SearchViews",
                 ctx,
-                lambda b: search_yaws(b.get("last_action")),
+                # the paper's views, centred on the target when the map puts it aside
+                lambda b: search_yaws(b.get("last_action"), search_centre(target_bearing(b))),
                 target_entity,
                 enough=lambda views: any(d.score >= 0.5 for d in views[-1].detections or ()),
             ),
