@@ -12,6 +12,7 @@ from pmnav_bt.behaviours.capture import (
     LOCALIZATION_YAWS_DEG,
     SEARCH_YAWS_DEG,
     CaptureViews,
+    search_centre,
     search_yaws,
     sweep_order,
 )
@@ -48,6 +49,17 @@ def test_search_yaws_leave_out_the_view_the_last_turn_rules_out(last, missing):
     got = [round(math.degrees(y)) for y in search_yaws(last)]
     assert got == [y for y in SEARCH_YAWS_DEG if y != missing]
     assert len(got) == (7 if missing is None else 6)
+
+
+def test_search_views_centre_on_a_target_off_to_a_side():
+    """Ahead (within 45 deg): the paper's views. Level with a door or past it, where its
+    sign (beside it) is out of the forward fan: the views centre on it, on the 30 deg grid."""
+    r = math.radians
+    assert search_centre(r(40)) == 0.0 and search_centre(r(-45)) == 0.0
+    assert search_centre(r(100)) == pytest.approx(r(90))
+    assert search_centre(r(-170)) == pytest.approx(r(-180))
+    got = [round(math.degrees(y)) for y in search_yaws(Action.TURN_LEFT, search_centre(r(80)))]
+    assert got == [90, 120, 60, 150, 30, 180]  # 90 + the paper's views, -90 left out
 
 
 def test_sweep_order_starts_at_the_nearer_extreme():
