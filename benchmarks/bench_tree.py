@@ -8,7 +8,7 @@ busy. Two worker modes are measured:
   worker renders pybullet frames, which hold Python's interpreter lock, so this is
   a pessimistic figure for the robot, whose worker decodes images and runs models.
 
-    python benchmarks/bench_tree.py [--episodes 3]
+    python benchmarks/bench_tree.py [--episodes 3] [--set grounder.backend=sim_gt]
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from pmnav_bt.config import load_config
 from pmnav_bt.experiments.evaluation import custom_episode
 
 
-def run(ep, deferred: bool) -> tuple[list[float], float, bool, int]:
+def run(ep, deferred: bool, overrides=()) -> tuple[list[float], float, bool, int]:
     from pmnav_bt.map.building import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.odometry import NoisyOdometry
@@ -29,7 +29,7 @@ def run(ep, deferred: bool) -> tuple[list[float], float, bool, int]:
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import make_context, run_tree
 
-    cfg = load_config()
+    cfg = load_config(None, list(overrides))
     b = load_building(ep.building)
     pm = parse_building(b)
     durations: list[float] = []
@@ -52,7 +52,11 @@ def pct(xs: list[float], q: float) -> float:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--episodes", type=int, default=3)
+    ap.add_argument("--set", action="append", default=[], help="config override key=value")
     args = ap.parse_args()
+    from pmnav_bt.registry import grounder_label
+
+    print(f"grounder: {grounder_label(load_config(None, args.set).grounder.backend)}")
     cases = [
         ("fig2_hospital", "room17", "22,0,0"),
         ("fig2_hospital", "room17", None),
@@ -65,7 +69,7 @@ def main() -> None:
     for building, goal, start in cases:
         ep = custom_episode(building, goal, start)
         for deferred in (True, False):
-            d, wall, ok, ticks = run(ep, deferred)
+            d, wall, ok, ticks = run(ep, deferred, args.set)
             ms = [1e3 * x for x in d]
             name = f"{building}:{goal} from {start or 'start'}"
             print(
