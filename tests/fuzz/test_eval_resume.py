@@ -37,6 +37,8 @@ def _cmd(out, *more):
         str(N),
         "--variants",
         "pmnav",
+        "--set",
+        "grounder.backend=sim_gt",  # the oracle: fast episodes
         "--jobs",
         "1",
         "--out",
