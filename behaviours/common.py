@@ -40,6 +40,12 @@ KEYS = (
     "recovering_from",  # Failure | None: what the recovery under way started from
     "belief",  # CorridorBelief | None: where on the corridors, while localizing
     "pose_tracker",  # PoseTracker: map_T_odom's uncertainty, for verification and snapping
+    # the map-less baseline (trees/mapless.py)
+    "goal_entity",  # Entity: the goal room, from the sign vocabulary
+    "grid",  # ExplorationGrid: what it has seen and where it has been (odometry frame)
+    "explore_over",  # bool: no frontier left, or exploring failed for good
+    "door_odom",  # (x, y): the goal door seen, odometry frame
+    "seen_from",  # (x, y): where the robot stood when it placed the door, odometry frame
 )
 
 

@@ -36,12 +36,12 @@ class Context:
     """Injected into every behaviour of one tree."""
 
     base: Base
-    pm: PrioriMap
+    pm: PrioriMap  # the map-less baseline: a SignsOnly (sign vocabulary, no geometry)
     config: Config
     grounder: Grounder
     coarse: CoarseDirection
     refiner: Refiner
-    planner: Planner
+    planner: Planner | None  # None: the map-less baseline
     worker: Worker
     odometer: Odometer = field(default_factory=Odometer)
     trace: list[TraceEvent] = field(default_factory=list)

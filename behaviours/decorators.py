@@ -49,3 +49,22 @@ class ClockTimeout(py_trees.decorators.Decorator):
             self.feedback_message = "timed out"
             return Status.FAILURE
         return self.decorated.status
+
+
+class RetryWhile(py_trees.decorators.Decorator):
+    """Run the child again after each FAILURE while ``again()`` is true (an exploration
+    loop that ends by a condition, not a count); SUCCESS when the child succeeds, FAILURE
+    once ``again()`` is false. The child writes the failure."""
+
+    def __init__(self, name: str, child: py_trees.behaviour.Behaviour, again: Callable[[], bool]):
+        super().__init__(name=name, child=child)
+        self.again = again
+
+    def update(self) -> Status:
+        if self.decorated.status == Status.FAILURE:
+            if self.again():
+                self.decorated.stop(Status.INVALID)
+                self.feedback_message = "again"
+                return Status.RUNNING
+            return Status.FAILURE
+        return self.decorated.status

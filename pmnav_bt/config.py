@@ -139,8 +139,10 @@ class VlmConfig(_Section):
 
 
 class TreeConfig(_Section):
-    variant: Literal["pmnav", "coarse_only"] = Field(
-        "pmnav", description="coarse_only: no grounding or refinement (paper Table 4)"
+    variant: Literal["pmnav", "coarse_only", "mapless"] = Field(
+        "pmnav",
+        description="coarse_only: no grounding or refinement (paper Table 4); mapless: the "
+        "map-less frontier-exploring baseline (docs/baseline.md)",
     )
     tick_hz: float = Field(
         10.0, ge=0.5, le=1000.0, description="tree ticks per second of the clock"

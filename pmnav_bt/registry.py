@@ -174,7 +174,7 @@ class Backends:
     grounder: Grounder
     coarse: CoarseDirection
     refiner: Refiner
-    planner: Planner
+    planner: Planner | None  # None: the map-less baseline plans nothing
 
 
 def build_backends(config: Config, pm: PrioriMap, *, on_robot: bool, seed: int = 0) -> Backends:
@@ -186,4 +186,17 @@ def build_backends(config: Config, pm: PrioriMap, *, on_robot: bool, seed: int =
         coarse=COARSE.build(config.coarse.backend, deps),
         refiner=REFINERS.build(config.refiner.backend, deps),
         planner=PLANNERS.build(config.planner.backend, deps),
+    )
+
+
+def build_perception(config: Config, pm: Any, *, on_robot: bool, seed: int = 0) -> Backends:
+    """The perception back ends only (grounder, coarse direction, refiner), no planner:
+    the map-less baseline's, with ``pm`` its sign vocabulary (``map.signs_only.SignsOnly``)."""
+    deps = BackendDeps(config=config, pm=pm, seed=seed, on_robot=on_robot)
+    deps.grounder = GROUNDERS.build(config.grounder.backend, deps)
+    return Backends(
+        grounder=deps.grounder,
+        coarse=COARSE.build(config.coarse.backend, deps),
+        refiner=REFINERS.build(config.refiner.backend, deps),
+        planner=None,
     )

@@ -69,7 +69,22 @@ def make_context(
     ``deferred_work``: background jobs start between ticks (simulation; see Worker).
     ``on_robot``: the observations carry no simulator labels (back ends that need them are
     refused). ``backends``: ready-made back ends instead (tests, test doubles).
+    ``tree.variant: mapless``: the map-less baseline's context, which keeps only the
+    building's sign vocabulary of ``pm`` (``trees.mapless.make_mapless_context``).
     """
+    if config.tree.variant == "mapless":  # the baseline gets the sign vocabulary only
+        from pmnav_bt.trees.mapless import make_mapless_context
+
+        return make_mapless_context(
+            base,
+            pm.building,
+            config,
+            seed,
+            budget,
+            deferred_work,
+            on_robot=on_robot,
+            backends=backends,
+        )
     if backends is None:
         backends = build_backends(config, pm, on_robot=on_robot, seed=seed)
     return Context(
@@ -83,6 +98,16 @@ def make_context(
         worker=Worker(deferred=deferred_work),
         budget_actions=budget if budget is not None else config.tree.budget_actions,
     )
+
+
+def build_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
+    """The tree of ``ctx.config.tree.variant``: PM-Nav (``pmnav``, ``coarse_only``) or the
+    map-less baseline (``mapless``)."""
+    if ctx.config.tree.variant == "mapless":
+        from pmnav_bt.trees.mapless import build_mapless_tree
+
+        return build_mapless_tree(ctx, goal)
+    return build_pmnav_tree(ctx, goal)
 
 
 def _blackboard(key: str):
@@ -104,7 +129,7 @@ def run_tree(
     ``tick_durations`` (optional) collects the wall time of every tick, in seconds.
     """
     py_trees.blackboard.Blackboard.clear()
-    tree = build_pmnav_tree(ctx, goal)
+    tree = build_tree(ctx, goal)
     if log is not None:
         tree.add_post_tick_handler(SnapshotLogger(tree, log, ctx.now))
     period = 1.0 / ctx.config.tree.tick_hz

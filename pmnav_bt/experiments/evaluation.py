@@ -22,7 +22,7 @@ from pmnav_bt.registry import grounder_label
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.sim.episodes import Episode
 
-VARIANT_NAMES = {"pmnav": "PM-Nav", "coarse_only": "coarse-only"}
+VARIANT_NAMES = {"pmnav": "PM-Nav", "coarse_only": "coarse-only", "mapless": "map-less baseline"}
 
 
 @dataclass

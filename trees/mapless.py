@@ -1,0 +1,137 @@
+"""The map-less baseline: the same body and perception as PM-Nav, no priori-map, no plan.
+
+The analogue of the paper's SG-Nav / InstructNav rows (Table 1: zero-shot navigators
+without a prior map) in functional buildings. It explores frontier-style on what depth
+shows (its own occupancy grid in the odometry frame: corridors seen, branches not yet
+looked down, where it has been), reads signs as it looks around and as it drives, and
+once the goal room's sign and door are seen it places the door by the refiner's range
+and approaches it with PM-Nav's drive and stop. It knows the building's sign vocabulary
+(which sign names which room: ``map.signs_only.SignsOnly``) and nothing of where.
+
+    Mission
+      StartExploring                       goal -> goal_entity, an empty grid
+      Explore (again while frontiers last)
+        SeenOrExplore
+          LookAround: Panorama (6 views, reading the goal's sign) -> RecordViews -> ChooseView
+          MoveOn: ExploreFrontier (stops when the sign shows) -> LookAgain (fail: loop)
+      ToTheDoor: Grounding -> PlaceDoor -> ApproachNear -> LookAtDoor -> PlaceAgain
+                 -> Approach -> Arrive
+    Monitor (action budget, body faults) in parallel
+"""
+
+from __future__ import annotations
+
+import py_trees
+from py_trees.behaviours import Failure as AlwaysFail
+from py_trees.common import Access
+from py_trees.composites import Parallel, Selector, Sequence
+
+from pmnav_bt.behaviours.common import NAMESPACE
+from pmnav_bt.behaviours.context import Context
+from pmnav_bt.behaviours.decorators import RetryWhile
+from pmnav_bt.behaviours.explore import (
+    ApproachDoor,
+    ChooseView,
+    ExploreFrontier,
+    LookAtDoor,
+    Panorama,
+    PlaceDoor,
+    RecordViews,
+    StartExploring,
+)
+from pmnav_bt.behaviours.monitor import Monitor
+from pmnav_bt.behaviours.motion import Arrive
+from pmnav_bt.behaviours.search import Ground
+from pmnav_bt.config import Config
+from pmnav_bt.map.building import Building
+from pmnav_bt.map.signs_only import SignsOnly
+from pmnav_bt.registry import Backends, build_perception
+from pmnav_bt.seams import Base
+from pmnav_bt.worker import Worker
+
+NEAR_M = 2.0  # the door is looked at again from this far before the final approach
+
+
+def make_mapless_context(
+    base: Base,
+    building: Building,
+    config: Config,
+    seed: int = 0,
+    budget: int | None = None,
+    deferred_work: bool = False,
+    *,
+    on_robot: bool = False,
+    backends: Backends | None = None,
+) -> Context:
+    """A Context whose ``pm`` is the building's sign vocabulary only (``SignsOnly``), with
+    the perception back ends the config names and no planner."""
+    signs = SignsOnly(building)
+    if backends is None:
+        backends = build_perception(config, signs, on_robot=on_robot, seed=seed)
+    return Context(
+        base=base,
+        pm=signs,  # type: ignore[arg-type] - a stand-in that refuses everything but signs
+        config=config,
+        grounder=backends.grounder,
+        coarse=backends.coarse,
+        refiner=backends.refiner,
+        planner=None,
+        worker=Worker(deferred=deferred_work),
+        budget_actions=budget if budget is not None else config.tree.budget_actions,
+    )
+
+
+def build_mapless_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
+    """The map-less baseline's tree for ``goal`` (a room as a person names it)."""
+    if not isinstance(ctx.pm, SignsOnly):
+        raise ValueError(
+            "the map-less tree runs on a map-free context (trees.mapless.make_mapless_context)"
+        )
+    over = py_trees.blackboard.Client(name="ExploreLoop", namespace=NAMESPACE)
+    over.register_key(key="explore_over", access=Access.READ)
+    look = Sequence(
+        "LookAround",
+        memory=True,
+        children=[
+            Panorama("Panorama", ctx),
+            RecordViews("RecordViews", ctx),
+            ChooseView("ChooseView", ctx),
+        ],
+    )
+    move_on = Sequence(
+        "MoveOn",
+        memory=True,
+        children=[ExploreFrontier("ExploreFrontier", ctx), AlwaysFail(name="LookAgain")],
+    )
+    explore = RetryWhile(
+        "Explore",
+        Selector("SeenOrExplore", memory=True, children=[look, move_on]),
+        again=lambda: not (over.exists("explore_over") and over.explore_over),
+    )
+    to_door = Sequence(
+        "ToTheDoor",
+        memory=True,
+        children=[
+            Ground("Grounding", ctx),
+            PlaceDoor("PlaceDoor", ctx),
+            ApproachDoor("ApproachNear", ctx, keep=NEAR_M),
+            LookAtDoor("LookAtDoor", ctx),
+            PlaceDoor("PlaceAgain", ctx),
+            ApproachDoor("Approach", ctx),
+            Arrive("Arrive", ctx),
+        ],
+    )
+    mission = Sequence(
+        "Mission",
+        memory=True,
+        children=[StartExploring("StartExploring", ctx), explore, to_door],
+    )
+    root = Parallel(
+        "Map-less",
+        policy=py_trees.common.ParallelPolicy.SuccessOnOne(),
+        children=[Monitor("Monitor", ctx), mission],
+    )
+    bb = py_trees.blackboard.Client(name="setup", namespace=NAMESPACE)
+    bb.register_key(key="goal", access=Access.WRITE)
+    bb.goal = goal
+    return py_trees.trees.BehaviourTree(root)
