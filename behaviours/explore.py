@@ -30,6 +30,7 @@ from pmnav_bt.seams import CoarseChoice, Entity, View
 LOOK_YAWS_DEG = (0, 60, 120, 180, 240, 300)
 SEEN_SCORE = 0.5
 MAX_BLOCKED = 6  # frontier drives blocked in a row before exploring gives up (BLOCKED)
+FRESH_STARTS = 1  # times the grid is forgotten when no frontier is left (odometry drift)
 
 
 def look_yaws(_b: PmNavBehaviour) -> list[float]:
@@ -139,6 +140,9 @@ class ExploreFrontier(DriveTo):
     marking where the robot goes as visited and adding what each watch frame's depth shows;
     stop early when the goal is seen on the way (SUCCESS: look around again).
 
+    With no reachable frontier left the grid is forgotten once (FRESH_STARTS: drift may
+    have closed them) and the robot looks again.
+
     Reads ``grid``, ``goal_entity``; writes ``explore_over``. A blocked drive marks its
     frontier failed and ends in SUCCESS (another frontier next), up to MAX_BLOCKED in a row.
     FAILURE (TARGET_NOT_FOUND, ``explore_over``) when no reachable frontier is left: the
@@ -183,6 +187,11 @@ class ExploreFrontier(DriveTo):
             if status is not None:  # the choice raised: a bug, reported
                 self.bb.set("explore_over", True)
                 return status
+            if choice is None and self._grid.fresh_starts < FRESH_STARTS:
+                self._grid.forget()
+                self.ctx.log("fresh_start", "")
+                self.feedback_message = "no frontier left: forgetting the grid, looking again"
+                return Status.SUCCESS
             if choice is None:
                 self.bb.set("explore_over", True)
                 seen = self._grid.known_fraction() * (2 * self._grid.half_extent) ** 2

@@ -59,6 +59,7 @@ class ExplorationGrid:
     visited: np.ndarray = field(init=False, repr=False)
     spent: list[tuple[float, float]] = field(default_factory=list)
     blocked_in_a_row: int = 0  # frontier drives blocked since the last one that arrived
+    fresh_starts: int = 0  # times what was seen was forgotten (``forget``)
 
     def __post_init__(self) -> None:
         n = int(round(2 * self.half_extent / self.cell))
@@ -124,6 +125,15 @@ class ExplorationGrid:
         """A frontier driven to (or found blocked): it and its neighbourhood are not chosen
         again (what was to be seen from there has been)."""
         self.spent.append((float(xy[0]), float(xy[1])))
+
+    def forget(self) -> None:
+        """Forget what was seen and the frontiers spent, keep where the robot has been: a
+        fresh start when odometry drift has drawn walls across corridors and closed
+        every frontier (the visited penalty still steers away from known ground)."""
+        self.state[:] = UNKNOWN
+        self.spent.clear()
+        self.blocked_in_a_row = 0
+        self.fresh_starts += 1
 
     def known_fraction(self) -> float:
         return float((self.state != UNKNOWN).mean())
