@@ -201,7 +201,7 @@ class ExploreFrontier(DriveTo):
                 )
             self._choice = choice
             self._route = list(choice.path)
-            self._start_leg()
+            _new_leg(self, self._route[0])
             self.ctx.log("frontier", "", target=list(choice.target), cost=choice.cost)
             self.feedback_message = f"frontier {choice.cost:.1f} m away"
         p = self.ctx.base.pose()
@@ -216,7 +216,7 @@ class ExploreFrontier(DriveTo):
                 self._grid.mark_spent(self._choice.target)
                 self._grid.blocked_in_a_row = 0
                 return Status.SUCCESS
-            self._start_leg()
+            _new_leg(self, self._route[0])
             return Status.RUNNING
         if status == Status.FAILURE:
             failure = self.get("failure")
@@ -227,11 +227,6 @@ class ExploreFrontier(DriveTo):
                     return Status.SUCCESS
             self.bb.set("explore_over", True)
         return status
-
-    def _start_leg(self) -> None:
-        self._goal = self._route[0]
-        self._best, self._best_t = math.inf, self.ctx.now()
-        self._bumps = 0
 
     def terminate(self, new_status: Status) -> None:
         if getattr(self, "_choice_job", None) is not None:
@@ -290,8 +285,8 @@ class PlaceDoor(PmNavBehaviour):
 
 class ApproachDoor(DriveTo):
     """Drive to the stop point ``goal_offset`` in front of the door (along the wall's
-    normal from the grid), or ``keep`` metres short of it on the way there.
-    Reads ``door_odom``, ``seen_from``, ``grid``."""
+    normal from the grid) on the grid's path there (round a desk or a corner), or until
+    ``keep`` metres from it. Reads ``door_odom``, ``seen_from``, ``grid``."""
 
     READS = DriveTo.READS + ("door_odom", "seen_from", "grid")
 
@@ -299,19 +294,56 @@ class ApproachDoor(DriveTo):
         super().__init__(name, ctx)
         self.keep = keep
 
-    def goal(self) -> tuple[float, float]:
+    def stop_point(self) -> tuple[float, float]:
         door, seen_from, grid = self.get("door_odom"), self.get("seen_from"), self.get("grid")
         nx, ny = grid.wall_normal(door, seen_from)
         off = self.ctx.config.tree.goal_offset
-        stop = np.array([door[0] + off * nx, door[1] + off * ny])
+        return door[0] + off * nx, door[1] + off * ny
+
+    def goal(self) -> tuple[float, float]:
+        if getattr(self, "_route", None):
+            return self._route[0]
         p = self.ctx.base.pose()
-        here = np.array([p.x, p.y])
-        d = float(np.linalg.norm(stop - here))
-        if d <= self.keep:
-            return p.x, p.y
-        if self.keep > 0.0:
-            stop = here + (stop - here) * (d - self.keep) / d
-        return float(stop[0]), float(stop[1])
+        return p.x, p.y
+
+    def initialise(self) -> None:
+        self._route: list[tuple[float, float]] = []
+        super().initialise()
+        self._stop = self.stop_point()
+        grid, p, stop = self.get("grid"), self.ctx.base.pose(), self._stop
+        self._path_job = self.ctx.worker.submit(lambda c: grid.path_to((p.x, p.y, p.yaw), stop))
+        self._planned = False
+
+    def update(self) -> Status:
+        if not self._planned:
+            status, path = self.poll(self._path_job, "planning the approach")
+            if status is not None:
+                return status
+            self._route = path or [self._stop]  # no known way: straight, watching depth
+            self._planned = True
+            _new_leg(self, self._route[0])
+        p = self.ctx.base.pose()
+        if self.keep > 0.0 and math.dist((p.x, p.y), self._stop) <= self.keep:
+            self.ctx.base.set_velocity(0.0, 0.0)
+            return Status.SUCCESS
+        status = super().update()
+        if status == Status.SUCCESS and len(self._route) > 1:
+            self._route.pop(0)
+            _new_leg(self, self._route[0])
+            return Status.RUNNING
+        return status
+
+    def terminate(self, new_status: Status) -> None:
+        if getattr(self, "_path_job", None) is not None:
+            self._path_job.cancel()
+        super().terminate(new_status)
+
+
+def _new_leg(drive: DriveTo, goal: tuple[float, float]) -> None:
+    """Point a DriveTo at the next waypoint of its route (progress watched afresh)."""
+    drive._goal = goal
+    drive._best, drive._best_t = math.inf, drive.ctx.now()
+    drive._bumps = 0
 
 
 class LookAtDoor(PmNavBehaviour):

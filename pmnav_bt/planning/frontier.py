@@ -35,6 +35,7 @@ VISITED_WEIGHT_M = 6.0  # cost (m) of a frontier in an area already driven throu
 VISITED_RADIUS_M = 0.6  # the robot marks cells this close to its path as visited
 SPENT_RADIUS_M = 1.5  # frontiers this close to one driven to are not chosen again
 WAYPOINT_SPACING = 4  # cells between the waypoints of a path (1 m)
+HIT, SCORE_MAX = 2, 6  # occupancy evidence of a ray's end (a pass through a cell: -1)
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,18 @@ class FrontierChoice:
     size: int
 
 
+@dataclass(frozen=True)
+class _Reach:
+    """Path costs from the robot over the crop [r0:r1, c0:c1] of the grid."""
+
+    r0: int
+    c0: int
+    r1: int
+    c1: int
+    mcp: MCP_Geometric
+    dist: np.ndarray
+
+
 @dataclass
 class ExplorationGrid:
     """An occupancy grid in the odometry frame, centred on ``origin`` (see module doc)."""
@@ -56,6 +69,7 @@ class ExplorationGrid:
     cell: float = CELL_M
     half_extent: float = HALF_EXTENT_M
     state: np.ndarray = field(init=False, repr=False)
+    score: np.ndarray = field(init=False, repr=False)  # occupancy evidence (integrate)
     visited: np.ndarray = field(init=False, repr=False)
     spent: list[tuple[float, float]] = field(default_factory=list)
     blocked_in_a_row: int = 0  # frontier drives blocked since the last one that arrived
@@ -64,6 +78,7 @@ class ExplorationGrid:
     def __post_init__(self) -> None:
         n = int(round(2 * self.half_extent / self.cell))
         self.state = np.zeros((n, n), np.int8)
+        self.score = np.zeros((n, n), np.int8)
         self.visited = np.zeros((n, n), bool)
 
     # -- frames ---------------------------------------------------------------------------
@@ -87,7 +102,10 @@ class ExplorationGrid:
     # -- recording ------------------------------------------------------------------------
 
     def integrate(self, scan: Scan) -> None:
-        """Free cells along every ray up to its range; an occupied cell where it ends."""
+        """Evidence from one scan: free along every ray up to its range, occupied where it
+        ends. Each cell keeps a score (a hit +HIT, a pass -1, clamped to +-SCORE_MAX), so
+        a wall drawn in the wrong place by odometry drift is cleared by later looks
+        through it, and a real wall is not by one grazing ray."""
         x0, y0, yaw = scan.pose
         ang = yaw + scan.bearings
         reach = np.where(np.isfinite(scan.ranges), scan.ranges, scan.max_range)
@@ -98,17 +116,23 @@ class ExplorationGrid:
         ok = t < (reach[:, None] - step)
         fx = x0 + t * np.cos(ang)[:, None]
         fy = y0 + t * np.sin(ang)[:, None]
-        r, c = self.to_cell(fx[ok], fy[ok])
-        inside = self._inside(r, c)
-        r, c = r[inside], c[inside]
-        unknown = self.state[r, c] == UNKNOWN
-        self.state[r[unknown], c[unknown]] = FREE
+        free = self._cells(fx[ok], fy[ok])
         hit = np.isfinite(scan.ranges)
         hx = x0 + scan.ranges[hit] * np.cos(ang[hit])
         hy = y0 + scan.ranges[hit] * np.sin(ang[hit])
-        r, c = self.to_cell(hx, hy)
+        hits = self._cells(hx, hy)
+        free = np.setdiff1d(free, hits, assume_unique=True)
+        score = self.score.reshape(-1)
+        score[free] = np.maximum(score[free] - 1, -SCORE_MAX)
+        score[hits] = np.minimum(score[hits] + HIT, SCORE_MAX)
+        touched = np.concatenate([free, hits])
+        self.state.reshape(-1)[touched] = np.where(score[touched] > 0, OCCUPIED, FREE)
+
+    def _cells(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """The distinct flat indices of the grid cells holding odometry points (x, y)."""
+        r, c = self.to_cell(x, y)
         inside = self._inside(r, c)
-        self.state[r[inside], c[inside]] = OCCUPIED
+        return np.unique(r[inside] * self.state.shape[1] + c[inside])
 
     def mark_visited(self, x: float, y: float) -> None:
         """The robot is at (x, y): cells within VISITED_RADIUS_M are visited (and free)."""
@@ -131,6 +155,7 @@ class ExplorationGrid:
         fresh start when odometry drift has drawn walls across corridors and closed
         every frontier (the visited penalty still steers away from known ground)."""
         self.state[:] = UNKNOWN
+        self.score[:] = 0
         self.spent.clear()
         self.blocked_in_a_row = 0
         self.fresh_starts += 1
@@ -148,9 +173,9 @@ class ExplorationGrid:
         )
         return (self.state == FREE) & near_unknown
 
-    def choose(self, pose: tuple[float, float, float]) -> FrontierChoice | None:
-        """The frontier to explore from ``pose`` (odometry x, y, yaw), with its path; None
-        when no reachable frontier is left (everything reachable has been seen)."""
+    def _reach(self, pose: tuple[float, float, float]) -> _Reach | None:
+        """Path costs from ``pose`` over the known part of the grid (None: nothing known,
+        or the robot outside the grid)."""
         known = np.argwhere(self.state != UNKNOWN)
         if len(known) == 0:
             return None
@@ -158,7 +183,6 @@ class ExplorationGrid:
         r0, c0 = np.maximum(known.min(axis=0) - pad, 0)
         r1, c1 = np.minimum(known.max(axis=0) + pad + 1, self.state.shape[0])
         state = self.state[r0:r1, c0:c1]
-        visited = self.visited[r0:r1, c0:c1]
         clearance = ndimage.distance_transform_edt(state != OCCUPIED) * self.cell
         passable = (state == FREE) & (clearance >= CLEARANCE_M)
         costs = np.where(passable, 1.0 + 2.0 * np.clip(CENTRE_M - clearance, 0.0, None), np.inf)
@@ -169,6 +193,49 @@ class ExplorationGrid:
         costs[sr, sc] = 1.0  # the robot's own cell, however near a wall it stands
         mcp = MCP_Geometric(costs)
         dist, _ = mcp.find_costs([(sr, sc)])
+        return _Reach(int(r0), int(c0), int(r1), int(c1), mcp, dist)
+
+    def _waypoints(self, reach: _Reach, r: int, c: int) -> list[tuple[float, float]]:
+        """Waypoints (odometry) along the path to the passable cell nearest crop cell
+        (r, c) within REACH_M, about 1 m apart, the last that cell."""
+        k = int(math.ceil(REACH_M / self.cell))
+        wr0, wc0 = max(r - k, 0), max(c - k, 0)
+        window = reach.dist[wr0 : r + k + 1, wc0 : c + k + 1]
+        er, ec = np.unravel_index(int(np.argmin(window)), window.shape)
+        cells_path = reach.mcp.traceback((int(er + wr0), int(ec + wc0)))
+        keep = cells_path[WAYPOINT_SPACING::WAYPOINT_SPACING]
+        if not keep or keep[-1] != cells_path[-1]:
+            keep.append(cells_path[-1])
+        return [self.to_xy(pr + reach.r0, pc + reach.c0) for pr, pc in keep]
+
+    def path_to(
+        self, pose: tuple[float, float, float], goal: tuple[float, float]
+    ) -> list[tuple[float, float]] | None:
+        """Waypoints from ``pose`` to ``goal`` over known free cells, ending at ``goal``;
+        None when the grid knows no way there."""
+        reach = self._reach(pose)
+        if reach is None:
+            return None
+        gr, gc = self.to_cell(goal[0], goal[1])
+        gr, gc = int(gr - reach.r0), int(gc - reach.c0)
+        k = int(math.ceil(REACH_M / self.cell))
+        h, w = reach.dist.shape
+        if not (-k <= gr < h + k and -k <= gc < w + k):
+            return None
+        gr, gc = min(max(gr, 0), h - 1), min(max(gc, 0), w - 1)
+        window = reach.dist[max(gr - k, 0) : gr + k + 1, max(gc - k, 0) : gc + k + 1]
+        if not np.isfinite(window).any():
+            return None
+        return self._waypoints(reach, gr, gc)[:-1] + [(float(goal[0]), float(goal[1]))]
+
+    def choose(self, pose: tuple[float, float, float]) -> FrontierChoice | None:
+        """The frontier to explore from ``pose`` (odometry x, y, yaw), with its path; None
+        when no reachable frontier is left (everything reachable has been seen)."""
+        got = self._reach(pose)
+        if got is None:
+            return None
+        r0, c0, r1, c1, dist = got.r0, got.c0, got.r1, got.c1, got.dist
+        visited = self.visited[r0:r1, c0:c1]
         # A frontier seen past a corner may lie nearer the wall than the robot may drive:
         # it is reached from the nearest passable cell within REACH_M.
         k = int(math.ceil(REACH_M / self.cell))
@@ -202,15 +269,7 @@ class ExplorationGrid:
         if best is None:
             return None
         cost, r, c, size = best
-        # the passable cell the frontier is reached from
-        wr0, wc0 = max(r - k, 0), max(c - k, 0)
-        window = dist[wr0 : r + k + 1, wc0 : c + k + 1]
-        er, ec = np.unravel_index(int(np.argmin(window)), window.shape)
-        cells_path = mcp.traceback((int(er + wr0), int(ec + wc0)))
-        keep = cells_path[WAYPOINT_SPACING::WAYPOINT_SPACING]
-        if not keep or keep[-1] != cells_path[-1]:
-            keep.append(cells_path[-1])
-        path = [self.to_xy(pr + r0, pc + c0) for pr, pc in keep]
+        path = self._waypoints(got, r, c)
         return FrontierChoice(self.to_xy(r + r0, c + c0), path, cost, size)
 
     def wall_normal(

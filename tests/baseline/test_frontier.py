@@ -66,3 +66,16 @@ def test_forgetting_keeps_where_the_robot_has_been():
     g.forget()
     assert (g.state == UNKNOWN).all() and g.spent == [] and g.visited.any()
     assert g.choose((0.0, 0.0, 0.0)) is None  # nothing seen: look around first
+
+
+def test_a_wall_drawn_by_drift_is_cleared_by_later_looks_through_it():
+    g = ExplorationGrid(half_extent=20.0)
+    one = np.zeros(1)
+    g.integrate(Scan(one, np.array([2.0]), 6.0, (0.0, 0.0, 0.0)))  # a wall 2 m ahead
+    assert g.state[g.to_cell(2.0, 0.0)] == OCCUPIED
+    clear = Scan(one, np.array([np.inf]), 6.0, (0.0, 0.0, 0.0))
+    g.integrate(clear)
+    assert g.state[g.to_cell(2.0, 0.0)] == OCCUPIED  # one look through is not enough
+    g.integrate(clear)
+    g.integrate(clear)
+    assert g.state[g.to_cell(2.0, 0.0)] == FREE
