@@ -48,8 +48,7 @@ def _build_tree(variant: str):
     from pmnav_bt.map.building import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.testing.doubles import FakeBase
-    from pmnav_bt.trees.pmnav import build_pmnav_tree
-    from pmnav_bt.trees.runner import make_context
+    from pmnav_bt.trees.runner import build_tree, make_context
 
     building = load_building(RENDER_BUILDING)
     config = load_config(overrides=[f"tree.variant={variant}"])
@@ -60,7 +59,7 @@ def _build_tree(variant: str):
 
     try:
         py_trees.blackboard.Blackboard.clear()
-        tree = build_pmnav_tree(ctx, building.rooms[0].id)
+        tree = build_tree(ctx, building.rooms[0].id)
     except BaseException:
         close()
         raise
@@ -69,7 +68,7 @@ def _build_tree(variant: str):
 
 @app.command()
 def render(
-    variant: str = typer.Option("pmnav", "--variant", help="Tree variant: pmnav or coarse_only."),
+    variant: str = typer.Option("pmnav", "--variant", help="pmnav, coarse_only, mapless."),
     out: Path = typer.Option(Path("."), "--out", help="Folder for the pictures."),
     name: str | None = typer.Option(None, "--name", help="File name stem [default: the variant]."),
     formats: str = typer.Option(
@@ -119,8 +118,9 @@ def render(
     else:
         from pmnav_bt.trees.pmnav import VARIANTS
 
-        if variant not in VARIANTS:
-            raise PmNavError(f"--variant {variant!r}: choose from {', '.join(VARIANTS)}")
+        variants = (*VARIANTS, "mapless")
+        if variant not in variants:
+            raise PmNavError(f"--variant {variant!r}: choose from {', '.join(variants)}")
         tree, close = _build_tree(variant)
         try:
             written = render_tree(
