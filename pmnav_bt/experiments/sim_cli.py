@@ -284,7 +284,7 @@ def eval_(
     variants: str = typer.Option(
         "pmnav,coarse_only,pmnav_oracle",
         "--variants",
-        help="Comma-separated evaluation variants (pmnav, coarse_only, pmnav_oracle, mapless, ...).",
+        help="Comma-separated evaluation variants (pmnav, coarse_only, pmnav_oracle, mapless).",
     ),
     jobs: int | None = typer.Option(
         None, "--jobs", help="Episodes run in parallel [default: 2, at most the CPUs]."

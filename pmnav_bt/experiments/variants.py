@@ -61,6 +61,8 @@ VARIANTS: dict[str, Variant] = {
             oracle=True,
             tables=("4",),
         ),
+        # the paper's SG-Nav/InstructNav rows: no priori-map, no plan (docs/baseline.md)
+        Variant("mapless", "map-less baseline", (("tree.variant", "mapless"),), tables=("1",)),
     )
 }
 
