@@ -94,6 +94,12 @@ class CoarseConfig(_Section):
 class RefinerConfig(_Section):
     backend: str = Field("geometric", description="goal pixel -> bearing (and range)")
     _check_backend = _registered("refiner")
+    weights: str = Field(
+        "", description="pixelnav: a .safetensors (its .json beside it); empty: the shipped model"
+    )
+    regrounding: int = Field(
+        8, ge=1, le=64, description="pixelnav: policy steps between re-groundings of the goal"
+    )
 
 
 class PlannerConfig(_Section):

@@ -147,6 +147,11 @@ REFINERS = Registry(
             "pmnav_bt.perception.refiners.geometric:build",
             "goal pixel -> bearing from the intrinsics, range from depth",
         ),
+        BackendSpec(
+            "pixelnav",
+            "pmnav_bt.pixelnav.policy:build",
+            "PixelNav policy (torch, shipped weights) drives the approach to the goal pixel",
+        ),
     ],
 )
 PLANNERS = Registry(

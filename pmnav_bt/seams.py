@@ -310,6 +310,33 @@ class Refiner(Protocol):
 
 
 @dataclass(frozen=True)
+class PolicyStep:
+    """One decision of a pixel-goal policy: the action, where it tracks the goal pixel in
+    this frame (pixels of the observation; None when it reckons the goal behind), and how
+    many steps it expects to need."""
+
+    action: DiscreteAction
+    goal_pixel: tuple[float, float] | None
+    steps_to_goal: float
+
+
+@runtime_checkable
+class PixelGoalPolicy(Protocol):
+    """Closed-loop navigation to a goal pixel (PixelNav): ``reset`` with a frame and the
+    grounded goal in it, then one ``act`` per new frame until it answers STOP.
+
+    Stateful (it keeps the frame history) and slow (a network): call from the worker.
+    ``max_steps``: the actions the policy was trained to reach its goal within.
+    """
+
+    max_steps: int
+
+    def reset(self, obs: Observation, goal: Detection) -> None: ...
+
+    def act(self, obs: Observation) -> PolicyStep: ...
+
+
+@dataclass(frozen=True)
 class PlanConstraints:
     """What a replan must avoid: landmarks that failed, corridor segments found blocked."""
 

@@ -2,8 +2,9 @@
 verification -> target update", with re-search, replanning and a budget.
 
 Variants (paper, Table 4; ``tree.variant``): ``pmnav`` refines the coarse direction with
-grounding and the refiner back end (``refiner.backend``); ``coarse_only`` keeps the coarse
-view direction and uses no refiner at all.
+grounding and the refiner back end (``refiner.backend``; a pixel-goal policy such as
+``pixelnav`` also drives the approach to the goal door in closed loop); ``coarse_only`` keeps
+the coarse view direction and uses no refiner at all.
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from pmnav_bt.behaviours.planning import (
     TargetIs,
     UpdateTarget,
 )
+from pmnav_bt.behaviours.policy_approach import PolicyApproach
 from pmnav_bt.behaviours.pose import CorrectHeading, SnapToCorridor
 from pmnav_bt.behaviours.search import (
     CoarseDirection,
@@ -45,6 +47,7 @@ from pmnav_bt.behaviours.search import (
     target_entity,
 )
 from pmnav_bt.perception.read_range import search_settings
+from pmnav_bt.seams import PixelGoalPolicy
 from pmnav_bt.trees.localize import active_localize_subtree, recovery_subtree
 
 VARIANTS = ("pmnav", "coarse_only")
@@ -62,6 +65,8 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
     cfg = ctx.config.tree
     ranges = search_settings(ctx.config)  # from the reader's range unless set
     coarse_only = cfg.variant == "coarse_only"
+    # A pixel-goal policy (refiner.backend=pixelnav) drives the approach in closed loop.
+    closed_loop = not coarse_only and isinstance(ctx.refiner, PixelGoalPolicy)
     search_once = Sequence(
         "SearchOnce",
         memory=True,
@@ -103,7 +108,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
                 Selector("SearchOrMoveOn", memory=True, children=[search_once, research]),
                 num_failures=cfg.search_attempts,
             ),
-            Approach("Approach", ctx),
+            (PolicyApproach if closed_loop else Approach)("Approach", ctx),
         ],
     )
     unseen = Sequence(

@@ -1,6 +1,7 @@
 """The ``pmnav`` program: the core commands (``pmnav_bt.cli``) with the simulator's
-(``pmnav sim``), the tree's (``pmnav tree``) and planning's (``pmnav plan``: a route, and
-the Table 2 evaluation over the simulator's episodes) mounted on them.
+(``pmnav sim``), the tree's (``pmnav tree``), planning's (``pmnav plan``: a route, and
+the Table 2 evaluation over the simulator's episodes) and PixelNav's (``pmnav pixelnav``:
+data, training, the skill's evaluation) mounted on them.
 
 This is where the command line joins simulator, tree and metrics, so it lives in the
 experiments layer; the core CLI knows neither. Each sub-app imports only typer at module
@@ -13,6 +14,7 @@ import sys
 
 from pmnav_bt.cli import app
 from pmnav_bt.cli import main as _run
+from pmnav_bt.experiments.pixelnav_cli import app as pixelnav_app
 from pmnav_bt.experiments.plan_cli import app as plan_app
 from pmnav_bt.experiments.report import report
 from pmnav_bt.experiments.sim_cli import app as sim_app
@@ -21,6 +23,7 @@ from pmnav_bt.trees.cli import app as tree_app
 app.add_typer(plan_app, name="plan")
 app.add_typer(sim_app, name="sim")
 app.add_typer(tree_app, name="tree")
+app.add_typer(pixelnav_app, name="pixelnav")
 app.command("report")(report)
 
 

@@ -1,0 +1,129 @@
+"""``pmnav pixelnav``: make the training data in the simulator, train the PixelNav policy,
+export it, evaluate the skill against the geometric refiner."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import typer
+
+from pmnav_bt import cli_values
+from pmnav_bt.loading import check_output_dir, check_output_file
+
+app = typer.Typer(
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    no_args_is_help=True,
+    help="PixelNav: the pixel-goal policy that drives the approach (refiner.backend=pixelnav).",
+)
+
+
+@app.callback()
+def _group() -> None:
+    """PixelNav: the pixel-goal policy that drives the approach (refiner.backend=pixelnav)."""
+
+
+@app.command()
+def gen(
+    out: Path = typer.Option(Path("out/pixelnav/data"), "--out", help="Folder for the shards."),
+    shards: int = typer.Option(80, "--shards", min=1, help="Shards (one building each)."),
+    episodes: int = typer.Option(50, "--episodes", min=1, help="Episodes per shard."),
+    seed: int = typer.Option(0, "--seed"),
+    noise: float = typer.Option(0.1, "--noise", min=0.0, max=1.0, help="Random-move chance."),
+) -> None:
+    """Expert rollouts to goal pixels on generated buildings, as resumable .npz shards."""
+    from pmnav_bt.experiments.pixelnav_data import DataConfig, generate
+
+    cli_values.seed(seed)
+    check_output_dir(out)
+    cfg = DataConfig(seed=seed, shards=shards, episodes_per_shard=episodes, noise=noise)
+    paths = generate(cfg, out)
+    steps = sum(int(len(_np_load(p)["actions"])) for p in paths)
+    typer.echo(f"{len(paths)} shards, {shards * episodes} episodes, {steps} frames in {out}")
+
+
+def _np_load(path: Path):
+    import numpy as np
+
+    return np.load(path)
+
+
+@app.command()
+def train(
+    data: Path = typer.Option(Path("out/pixelnav/data"), "--data", help="gen's folder."),
+    out: Path = typer.Option(Path("out/pixelnav/train"), "--out", help="Checkpoints, curves."),
+    model: str = typer.Option("small", "--model", help="tiny, small (CPU) or large (GPU)."),
+    steps: int = typer.Option(4000, "--steps", min=1),
+    batch: int = typer.Option(32, "--batch", min=1),
+    lr: float = typer.Option(1e-3, "--lr", min=0.0),
+    seed: int = typer.Option(0, "--seed"),
+    threads: int = typer.Option(1, "--threads", min=1, help="CPU threads for torch."),
+    eval_every: int = typer.Option(250, "--eval-every", min=1),
+) -> None:
+    """Imitation training (resumes from --out's checkpoint); curves.png beside it."""
+    from pmnav_bt.pixelnav.train import TrainConfig, preset
+    from pmnav_bt.pixelnav.train import train as run
+
+    cli_values.seed(seed)
+    check_output_dir(out)
+    cfg = TrainConfig(
+        model=preset(model),
+        steps=steps,
+        batch=batch,
+        lr=lr,
+        seed=seed,
+        threads=threads,
+        eval_every=eval_every,
+    )
+    state = run(data, out, cfg)
+    last = state["history"][-1] if state["history"] else {}
+    typer.echo(
+        f"{state['step']} steps in {state['seconds'] / 60:.1f} min; val loss "
+        f"{last.get('val_loss', float('nan')):.3f}, val action accuracy "
+        f"{last.get('val_acc', float('nan')):.3f}; {out / 'curves.png'}"
+    )
+
+
+@app.command()
+def export(
+    run_dir: Path = typer.Option(Path("out/pixelnav/train"), "--run", help="train's folder."),
+    dest: Path = typer.Option(
+        Path("pmnav_bt/pixelnav/weights/pixelnav_small.safetensors"),
+        "--dest",
+        help="The .safetensors to write (its .json beside it).",
+    ),
+) -> None:
+    """Write a trained model as safetensors + JSON config (what refiner.weights loads)."""
+    from pmnav_bt.pixelnav.train import export as run
+
+    check_output_file(dest, "--dest", (".safetensors",))
+    w, j = run(run_dir, dest)
+    typer.echo(f"{w} ({w.stat().st_size / 1e6:.1f} MB), {j}")
+
+
+@app.command("eval")
+def eval_(
+    weights: str = typer.Option("", "--weights", help="A .safetensors; default: shipped."),
+    buildings: int = typer.Option(8, "--buildings", min=1, help="Held-out generated buildings."),
+    n: int = typer.Option(25, "-n", min=1, help="Goals per building."),
+    seed: int = typer.Option(0, "--seed"),
+    out: Path = typer.Option(Path("out/pixelnav/eval"), "--out", help="Folder for results."),
+) -> None:
+    """The skill alone: PixelNav vs the geometric refiner on the same held-out goals
+    (success: stopped within 1 m of the goal point within 64 steps)."""
+    from pmnav_bt.experiments.pixelnav_eval import evaluate, format_table, table, trials_json
+    from pmnav_bt.pixelnav.policy import PixelNavPolicy
+
+    cli_values.count(n, "-n")
+    cli_values.seed(seed)
+    check_output_dir(out)
+    policy = PixelNavPolicy.load(weights or None)
+    trials = evaluate(policy, buildings, n, seed=seed)
+    rows = table(trials)
+    text = format_table(rows)
+    (out / "skill.json").write_text(
+        json.dumps({"rows": rows, "trials": trials_json(trials)}, indent=1), encoding="utf-8"
+    )
+    (out / "skill.txt").write_text(text + "\n", encoding="utf-8")
+    typer.echo(text)

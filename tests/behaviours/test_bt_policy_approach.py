@@ -1,0 +1,108 @@
+"""PolicyApproach against the simulator, with a scripted pixel-goal policy: the policy's
+actions drive the body step by step, grounding and acting run in the worker, and the
+map approach takes over for other targets and for a policy that never stops."""
+
+from __future__ import annotations
+
+import math
+import threading
+
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.policy_approach import PolicyApproach
+from pmnav_bt.geometry import Action
+from pmnav_bt.seams import (
+    CoarseChoice,
+    DiscreteAction,
+    Entity,
+    PixelGoalPolicy,
+    PolicyStep,
+    Pose2D,
+    Refinement,
+    View,
+)
+
+SOUTH = math.radians(-90)
+# 2.8 m from room4's door (1.2, 22), facing it: its sign is readable from here
+START = Pose2D(0.0, 24.5, math.atan2(22.0 - 24.5, 1.2))
+
+
+class ScriptedPolicy:
+    """Plays ``script`` (then STOP, or forever its last action); records its calls."""
+
+    gives_range = False
+
+    def __init__(self, script, max_steps=64, forever=False):
+        self.script, self.max_steps, self.forever = list(script), max_steps, forever
+        self.resets, self.acts, self.threads = [], 0, set()
+
+    def refine(self, obs, goal):
+        return Refinement(0.0)
+
+    def reset(self, obs, goal):
+        self.resets.append((obs.pose, goal))
+        self.threads.add(threading.current_thread().name)
+
+    def act(self, obs):
+        self.threads.add(threading.current_thread().name)
+        i = self.acts
+        self.acts += 1
+        if i < len(self.script):
+            a = self.script[i]
+        else:
+            a = self.script[-1] if self.forever else DiscreteAction.STOP
+        return PolicyStep(a, None, 0.0)
+
+
+def grounded(rig, goal="room4"):
+    """The goal step and a choice grounded in the frame from the body's pose."""
+    step = rig.plan(f"0,24.5,{math.degrees(START.yaw)}", goal).steps[-1]
+    assert step.action == Action.ARRIVE
+    obs = rig.base.observe()
+    dets = rig.ctx.grounder.detect(obs, Entity.room(goal))
+    assert dets and dets[0].mask is not None
+    return step, CoarseChoice(View(0.0, obs, tuple(dets)), dets[0])
+
+
+def test_the_policy_drives_the_approach_step_by_step_until_it_stops(make_rig):
+    rig = make_rig(START)
+    policy = ScriptedPolicy([DiscreteAction.FORWARD] * 3 + [DiscreteAction.TURN_LEFT])
+    assert isinstance(policy, PixelGoalPolicy)
+    rig.ctx.refiner = policy
+    step, choice = grounded(rig)
+    rig.set(target=step, choice=choice)
+    seen = rig.run(PolicyApproach("Approach", rig.ctx), max_ticks=200)
+    rig.expect(seen, Status.SUCCESS)
+    p = rig.true_pose()
+    ahead = (0.75 * math.cos(START.yaw), 24.5 + 0.75 * math.sin(START.yaw))
+    assert math.dist((p.x, p.y), ahead) < 1e-6  # three 0.25 m steps towards the door
+    assert math.isclose(p.yaw, START.yaw + math.radians(30), abs_tol=1e-6)  # one turn left
+    assert policy.acts == 5  # four moves, then STOP
+    assert rig.stopped()
+    # re-grounded in the current frame at the start (regrounding: every 8 steps)
+    assert len(policy.resets) == 1 and policy.resets[0][1].mask is not None
+    assert all(name.startswith("pmnav-worker") for name in policy.threads)
+
+
+def test_a_landmark_on_the_way_is_approached_on_the_map_not_by_the_policy(make_rig):
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+    policy = ScriptedPolicy([DiscreteAction.TURN_LEFT])
+    rig.ctx.refiner = policy
+    step = rig.plan("0,29,-90", "room3").steps[0]  # {room4: go straight}
+    rig.set(target=step)
+    rig.expect(rig.run(PolicyApproach("Approach", rig.ctx), max_ticks=400), Status.SUCCESS)
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), (0.0, 22.0)) < 0.2  # its node on the centre line
+    assert policy.acts == 0
+
+
+def test_a_policy_that_never_stops_hands_over_to_the_map_approach(make_rig):
+    rig = make_rig(START)
+    policy = ScriptedPolicy([DiscreteAction.TURN_RIGHT], max_steps=4, forever=True)
+    rig.ctx.refiner = policy
+    step, choice = grounded(rig)
+    rig.set(target=step, choice=choice)
+    rig.expect(rig.run(PolicyApproach("Approach", rig.ctx), max_ticks=600), Status.SUCCESS)
+    assert policy.acts == 4
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), (1.2 - 0.6, 22.0)) < 0.2  # the map's stop point
