@@ -4,8 +4,9 @@ A sample is one window of up to ``history`` frames of an expert episode with its
 frame; every frame of the window is supervised (the transformer is causal). The goal
 frame is the episode's first frame, or (``reseat``) a later frame with the goal pixel
 where the expert saw it then, as after a re-grounding. Frames are flipped left-right
-(turns swapped) and jittered in brightness. Loss: cross-entropy on the action, squared
-error on the temporal distance, smooth L1 on the goal track (where the goal is ahead).
+(turns swapped), jittered in brightness and sometimes slightly blurred. Loss:
+cross-entropy on the action, squared error on the temporal distance, smooth L1 on the
+goal track (where the goal is ahead).
 
 Seeded and resumable: batch ``i`` is drawn from ``rng([seed, i])``, so a resumed run
 draws the same batches as one that never stopped. Validation uses the shards of the last
@@ -20,6 +21,7 @@ import math
 import time
 from pathlib import Path
 
+import cv2
 import numpy as np
 import torch
 from pydantic import BaseModel, ConfigDict, Field
@@ -57,6 +59,7 @@ class TrainConfig(BaseModel):
     eval_every: int = Field(250, ge=1)
     reseat: float = Field(0.3, ge=0.0, le=1.0, description="goal frame from a later step")
     flip: float = Field(0.5, ge=0.0, le=1.0)
+    blur: float = Field(0.3, ge=0.0, le=1.0, description="chance of a slight blur")
     stop_weight: float = Field(2.0, gt=0.0, description="cross-entropy weight of STOP")
     tdist_weight: float = Field(0.5, ge=0.0)
     track_weight: float = Field(1.0, ge=0.0)
@@ -119,8 +122,13 @@ class Sampler:
             if rng.random() < self.cfg.flip:
                 flip(out, b, w)
             gain = rng.uniform(0.8, 1.2)
+            soft = rng.random() < self.cfg.blur
             for key in ("goal_frame", "frames"):
                 out[key][b] = np.clip(out[key][b] * gain, 0, 255).astype(np.uint8)
+            if soft:  # like a large camera frame area-shrunk (the tree's), not rendered small
+                out["goal_frame"][b] = cv2.GaussianBlur(out["goal_frame"][b], (3, 3), 0.6)
+                for i in range(m):
+                    out["frames"][b, i] = cv2.GaussianBlur(out["frames"][b, i], (3, 3), 0.6)
         return out
 
 

@@ -106,3 +106,22 @@ def test_a_policy_that_never_stops_hands_over_to_the_map_approach(make_rig):
     assert policy.acts == 4
     p = rig.true_pose()
     assert math.dist((p.x, p.y), (1.2 - 0.6, 22.0)) < 0.2  # the map's stop point
+
+
+def test_the_tree_approaches_with_the_policy_only_when_the_refiner_is_one(make_rig):
+    from pmnav_bt.behaviours.motion import Approach
+    from pmnav_bt.trees.pmnav import build_pmnav_tree
+
+    def approaches(ctx):
+        tree = build_pmnav_tree(ctx, "room4")
+        return {type(n) for n in tree.root.iterate() if isinstance(n, Approach)}
+
+    rig = make_rig(START)
+    assert approaches(rig.ctx) == {Approach}  # geometric
+    rig.ctx.refiner = ScriptedPolicy([DiscreteAction.STOP])
+    assert approaches(rig.ctx) == {PolicyApproach}
+    coarse = rig.ctx.config.model_copy(
+        update={"tree": rig.ctx.config.tree.model_copy(update={"variant": "coarse_only"})}
+    )
+    rig.ctx.config = coarse
+    assert approaches(rig.ctx) == {Approach}  # coarse-only: no refiner, no policy
