@@ -9,8 +9,10 @@ It is both seams the tree uses for a grounded target:
 
 The goal token is computed once per goal and each frame's token once, so a step costs one
 frame encoding and one pass of the small transformer over the last ``history`` tokens.
-When the history is full the goal is re-seated on the current frame at the tracked pixel
-(training shows the network such re-seated goals), so the transformer's window can slide.
+When the history is full the goal is re-seated on the last frame at the pixel where the
+policy tracked it there (training shows the network such re-seated goals), and the
+history starts afresh after it; a goal tracked out of view keeps the old goal and the
+window slides.
 Weights: safetensors plus a JSON of the model config; the shipped small model is the
 default. Call from the worker: a step takes milliseconds, and the policy keeps state.
 """
@@ -59,6 +61,7 @@ class PixelNavPolicy:
         self._goal_tok = None
         self._tokens: list = []
         self._last_track = (0.0, 0.0)
+        self._last_frame = None
 
     @classmethod
     def load(cls, weights: str | Path | None = None, device: str | None = None) -> PixelNavPolicy:
@@ -130,11 +133,12 @@ class PixelNavPolicy:
         with self._lock, torch.inference_mode():
             frame = self._frame(obs)
             if len(self._tokens) >= cfg.history:
-                u, v = self._last_track
+                u, v = self._last_track  # where the last frame showed the goal
                 if 0 <= u < cfg.width and 0 <= v < cfg.height:
-                    self._seat(frame, (u, v))
+                    self._seat(self._last_frame, (u, v))
                 else:
                     self._tokens = self._tokens[-(cfg.history - 1) :]
+            self._last_frame = frame
             self._tokens.append(self.net.encode_frames(frame.view(1, 1, *frame.shape))[:, 0])
             out = self.net.decode(self._goal_tok, torch.stack(self._tokens, dim=1))
             logits = out["action"][0, -1]
