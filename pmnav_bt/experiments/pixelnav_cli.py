@@ -93,12 +93,15 @@ def export(
         "--dest",
         help="The .safetensors to write (its .json beside it).",
     ),
+    stop_threshold: float = typer.Option(
+        0.5, "--stop-threshold", min=0.0, max=1.0, help="STOP once its probability is this."
+    ),
 ) -> None:
     """Write a trained model as safetensors + JSON config (what refiner.weights loads)."""
     from pmnav_bt.pixelnav.train import export as run
 
     check_output_file(dest, "--dest", (".safetensors",))
-    w, j = run(run_dir, dest)
+    w, j = run(run_dir, dest, stop_threshold)
     typer.echo(f"{w} ({w.stat().st_size / 1e6:.1f} MB), {j}")
 
 
@@ -109,17 +112,31 @@ def eval_(
     n: int = typer.Option(25, "-n", min=1, help="Goals per building."),
     seed: int = typer.Option(0, "--seed"),
     out: Path = typer.Option(Path("out/pixelnav/eval"), "--out", help="Folder for results."),
+    validation: bool = typer.Option(
+        False,
+        "--validation",
+        help="On the validation buildings of gen's seed-0 shards 73-79 (to choose "
+        "--stop-threshold), not the held-out ones.",
+    ),
+    stop_threshold: float | None = typer.Option(
+        None, "--stop-threshold", min=0.0, max=1.0, help="Override the weights' threshold."
+    ),
 ) -> None:
     """The skill alone: PixelNav vs the geometric refiner on the same held-out goals
     (success: stopped within 1 m of the goal point within 64 steps)."""
+    import torch
+
     from pmnav_bt.experiments.pixelnav_eval import evaluate, format_table, table, trials_json
     from pmnav_bt.pixelnav.policy import PixelNavPolicy
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
     check_output_dir(out)
+    torch.set_num_threads(1)  # small steps: one thread is as fast and shares the machine
     policy = PixelNavPolicy.load(weights or None)
-    trials = evaluate(policy, buildings, n, seed=seed)
+    if stop_threshold is not None:
+        policy.stop_threshold = stop_threshold
+    trials = evaluate(policy, buildings, n, seed=seed, validation=validation)
     rows = table(trials)
     text = format_table(rows)
     (out / "skill.json").write_text(

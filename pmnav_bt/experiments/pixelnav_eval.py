@@ -110,17 +110,29 @@ def run_geometric(roller: Roller, start: Pose2D, obs0: Observation, det: Detecti
     return False, MAX_STEPS, reached
 
 
-def evaluate(policy, n_buildings: int, per_building: int, seed: int = 0, progress: bool = True):
-    """Trials of both methods on the same goals of held-out buildings."""
+VALIDATION_SHARDS = 73  # seed 0: shards 73-79 were the shipped model's validation split (74 shards)
+
+
+def evaluate(
+    policy,
+    n_buildings: int,
+    per_building: int,
+    seed: int = 0,
+    progress: bool = True,
+    validation: bool = False,
+):
+    """Trials of both methods on the same goals of held-out buildings (``validation``:
+    of the buildings of training's validation shards instead, for calibration)."""
     from tqdm import tqdm
 
     from pmnav_bt.sim.world import SimWorld
 
-    cfg = DataConfig(seed=seed, heldout=True, noise=0.0)
+    cfg = DataConfig(seed=0 if validation else seed, heldout=not validation, noise=0.0)
+    first = VALIDATION_SHARDS if validation else 0
     trials: list[Trial] = []
     bar = tqdm(total=n_buildings * per_building, unit="goal", disable=not progress)
     for b in range(n_buildings):
-        bseed = building_seed(cfg, b)
+        bseed = building_seed(cfg, first + b)
         rng = np.random.default_rng([seed, b, 99])
         with SimWorld(make_building(bseed)) as world:
             roller = Roller(world, cfg)

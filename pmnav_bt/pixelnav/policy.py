@@ -6,6 +6,8 @@ It is both seams the tree uses for a grounded target:
   as the ``geometric`` refiner measures them (PixelNav gives actions, not metres);
 - ``PixelGoalPolicy``: ``reset`` on a grounded frame, then ``act`` per frame: stop,
   forward 0.25 m or turn 30 deg, the goal pixel tracked in the frame, the steps left.
+  STOP when its probability reaches ``stop_threshold`` (from the weights' JSON, chosen
+  on validation buildings in closed loop), else the likeliest move.
 
 The goal token is computed once per goal and each frame's token once, so a step costs one
 frame encoding and one pass of the small transformer over the last ``history`` tokens.
@@ -29,7 +31,7 @@ import numpy as np
 
 from pmnav_bt.errors import BackendError
 from pmnav_bt.perception.refiners.geometric import GeometricRefiner
-from pmnav_bt.pixelnav.dataset import ACTIONS, MAX_STEPS
+from pmnav_bt.pixelnav.dataset import ACTIONS, MAX_STEPS, STOP
 from pmnav_bt.pixelnav.frames import scale_pixel, shrink
 from pmnav_bt.seams import Detection, Observation, PolicyStep, Refinement
 
@@ -50,10 +52,11 @@ class PixelNavPolicy:
     gives_range = True
     max_steps = MAX_STEPS
 
-    def __init__(self, net, device=None):
+    def __init__(self, net, device=None, stop_threshold: float = 0.5):
         import torch
 
         self.net = net.eval()
+        self.stop_threshold = stop_threshold
         self.cfg = net.cfg
         self.device = device or torch.device("cpu")
         self._geometric = GeometricRefiner()
@@ -80,8 +83,10 @@ class PixelNavPolicy:
                 "`pmnav pixelnav train` and `pmnav pixelnav export`"
             )
         try:
-            cfg = ModelConfig.model_validate(json.loads(meta.read_text(encoding="utf-8"))["model"])
-        except (ValueError, KeyError) as err:
+            info = json.loads(meta.read_text(encoding="utf-8"))
+            cfg = ModelConfig.model_validate(info["model"])
+            stop = float(info.get("stop_threshold", 0.5))
+        except (ValueError, KeyError, TypeError) as err:
             raise BackendError(f"{meta}: not a PixelNav model config ({err})") from None
         dev = torch.device(device) if device else torch.device("cpu")
         net = PixelNavNet(cfg)
@@ -91,7 +96,7 @@ class PixelNavPolicy:
             raise BackendError(
                 f"{w}: weights do not fit the config in {meta.name}: {err}"
             ) from None
-        return cls(net.to(dev), dev)
+        return cls(net.to(dev), dev, stop)
 
     # -- Refiner ------------------------------------------------------------------------------
 
@@ -141,7 +146,7 @@ class PixelNavPolicy:
             self._last_frame = frame
             self._tokens.append(self.net.encode_frames(frame.view(1, 1, *frame.shape))[:, 0])
             out = self.net.decode(self._goal_tok, torch.stack(self._tokens, dim=1))
-            logits = out["action"][0, -1]
+            probs = out["action"][0, -1].softmax(-1)
             # the training targets' range: -1..2 frame widths/heights
             track = np.clip(out["track"][0, -1].cpu().numpy(), -1.0, 2.0) * (cfg.width, cfg.height)
             steps = float(out["tdist"][0, -1]) * _tdist_scale()
@@ -149,7 +154,13 @@ class PixelNavPolicy:
         k = obs.intrinsics
         u = (track[0] + 0.5) * k.width / cfg.width - 0.5
         v = (track[1] + 0.5) * k.height / cfg.height - 0.5
-        return PolicyStep(ACTIONS[int(logits.argmax())], (float(u), float(v)), max(0.0, steps))
+        # STOP once it is likely enough (the threshold is calibrated on validation
+        # buildings and kept in the weights' JSON), else the likeliest move.
+        if float(probs[STOP]) >= self.stop_threshold:
+            action = ACTIONS[STOP]
+        else:
+            action = ACTIONS[int(probs[STOP + 1 :].argmax()) + STOP + 1]
+        return PolicyStep(action, (float(u), float(v)), max(0.0, steps))
 
 
 def _tdist_scale() -> float:

@@ -318,8 +318,11 @@ def save_checkpoint(net: PixelNavNet, opt, state: dict, out: Path) -> None:
     tmp.replace(out / STATE_FILE)
 
 
-def export(train_dir: str | Path, dest: str | Path) -> tuple[Path, Path]:
-    """The trained model as ``dest.safetensors`` + ``dest.json`` (its model config)."""
+def export(
+    train_dir: str | Path, dest: str | Path, stop_threshold: float = 0.5
+) -> tuple[Path, Path]:
+    """The trained model as ``dest.safetensors`` + ``dest.json`` (its model config and
+    the policy's STOP probability threshold)."""
     train_dir, dest = Path(train_dir), Path(dest)
     state = json.loads((train_dir / STATE_FILE).read_text(encoding="utf-8"))
     sd = load_file(str(train_dir / MODEL_FILE))
@@ -329,6 +332,7 @@ def export(train_dir: str | Path, dest: str | Path) -> tuple[Path, Path]:
     save_file(sd, str(w), metadata={"format": "pt"})
     meta = {
         "model": state["config"]["model"],
+        "stop_threshold": stop_threshold,
         "trained_steps": state["step"],
         "train_seconds": round(state.get("seconds", 0.0), 1),
         "data": state.get("data", {}),

@@ -100,3 +100,23 @@ def test_the_registry_builds_pixelnav_with_the_shipped_weights():
 def test_missing_weights_name_the_setting(tmp_path):
     with pytest.raises(BackendError, match="refiner.weights"):
         PixelNavPolicy.load(tmp_path / "none.safetensors")
+
+
+def test_the_stop_threshold_decides_when_to_stop(policy):
+    policy.reset(obs(0), goal())
+    policy.stop_threshold = 0.0
+    assert policy.act(obs(1)).action == DiscreteAction.STOP
+    policy.stop_threshold = 1.01
+    moves = {policy.act(obs(i)).action for i in range(6)}
+    assert DiscreteAction.STOP not in moves
+
+
+def test_export_keeps_the_stop_threshold(tmp_path):
+    from pmnav_bt.pixelnav.train import TrainConfig, export, save_checkpoint
+
+    torch.manual_seed(0)
+    m = PixelNavNet(TINY)
+    state = {"step": 1, "history": [], "config": TrainConfig(model=TINY).model_dump(mode="json")}
+    save_checkpoint(m, torch.optim.AdamW(m.parameters()), state, tmp_path)
+    w, _ = export(tmp_path, tmp_path / "w.safetensors", stop_threshold=0.25)
+    assert PixelNavPolicy.load(w).stop_threshold == 0.25
