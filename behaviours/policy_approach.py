@@ -13,7 +13,8 @@ from pmnav_bt.seams import DiscreteAction, MotionStatus, PixelGoalPolicy
 
 class PolicyApproach(Approach):
     """Approach the goal room's door with the context's pixel-goal policy, one discrete
-    step per frame, until the policy stops (the paper's fine-grained actions).
+    step per frame, until the policy stops (the paper's fine-grained actions). It first
+    turns to face the door where it was grounded (the search may have turned away since).
 
     Reads ``target``, ``choice`` (the grounded detection), ``map_T_odom``. The goal pixel
     is the grounder's mask centre: re-grounded in the current frame at the start and every
@@ -41,6 +42,10 @@ class PolicyApproach(Approach):
         self._job = None
         self._steps = 0
         self._policy_bumps = 0
+        self._facing = False
+        if self._closed_loop:  # face the goal first: the policy starts from its frame
+            obs, det = choice.view.observation, choice.detection
+            self._goal_yaw = obs.pose.yaw + obs.intrinsics.pixel_bearing(det.centre[0])
 
     def update(self) -> Status:
         if not self._closed_loop:
@@ -51,6 +56,10 @@ class PolicyApproach(Approach):
             return self.fail(FailureCode.BASE_FAULT, "the base reports a fault")
         if st == MotionStatus.MOVING:
             return Status.RUNNING
+        if not self._facing:
+            if not self.face(self._goal_yaw):
+                return Status.RUNNING
+            self._facing = True
         if self._job is None:
             if st == MotionStatus.BLOCKED:
                 base.stop()  # acknowledged: IDLE again

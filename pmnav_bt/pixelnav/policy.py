@@ -7,7 +7,8 @@ It is both seams the tree uses for a grounded target:
 - ``PixelGoalPolicy``: ``reset`` on a grounded frame, then ``act`` per frame: stop,
   forward 0.25 m or turn 30 deg, the goal pixel tracked in the frame, the steps left.
   STOP when its probability reaches ``stop_threshold`` (from the weights' JSON, chosen
-  on validation buildings in closed loop), else the likeliest move.
+  on validation buildings in closed loop), else the likeliest move; with ``no_reversal``
+  a turn never directly undoes the turn before it (imitation policies dither there).
 
 The goal token is computed once per goal and each frame's token once, so a step costs one
 frame encoding and one pass of the small transformer over the last ``history`` tokens.
@@ -31,7 +32,7 @@ import numpy as np
 
 from pmnav_bt.errors import BackendError
 from pmnav_bt.perception.refiners.geometric import GeometricRefiner
-from pmnav_bt.pixelnav.dataset import ACTIONS, MAX_STEPS, STOP
+from pmnav_bt.pixelnav.dataset import ACTIONS, LEFT, MAX_STEPS, RIGHT, STOP
 from pmnav_bt.pixelnav.frames import scale_pixel, shrink
 from pmnav_bt.seams import Detection, Observation, PolicyStep, Refinement
 
@@ -52,11 +53,13 @@ class PixelNavPolicy:
     gives_range = True
     max_steps = MAX_STEPS
 
-    def __init__(self, net, device=None, stop_threshold: float = 0.5):
+    def __init__(self, net, device=None, stop_threshold: float = 0.5, no_reversal: bool = True):
         import torch
 
         self.net = net.eval()
         self.stop_threshold = stop_threshold
+        self.no_reversal = no_reversal
+        self._last_action = STOP
         self.cfg = net.cfg
         self.device = device or torch.device("cpu")
         self._geometric = GeometricRefiner()
@@ -86,6 +89,7 @@ class PixelNavPolicy:
             info = json.loads(meta.read_text(encoding="utf-8"))
             cfg = ModelConfig.model_validate(info["model"])
             stop = float(info.get("stop_threshold", 0.5))
+            no_reversal = bool(info.get("no_reversal", True))
         except (ValueError, KeyError, TypeError) as err:
             raise BackendError(f"{meta}: not a PixelNav model config ({err})") from None
         dev = torch.device(device) if device else torch.device("cpu")
@@ -96,7 +100,7 @@ class PixelNavPolicy:
             raise BackendError(
                 f"{w}: weights do not fit the config in {meta.name}: {err}"
             ) from None
-        return cls(net.to(dev), dev, stop)
+        return cls(net.to(dev), dev, stop, no_reversal)
 
     # -- Refiner ------------------------------------------------------------------------------
 
@@ -119,6 +123,7 @@ class PixelNavPolicy:
         self._goal_tok = self.net.encode_goal(frame.unsqueeze(0), gp)
         self._tokens = []
         self._last_track = px
+        self._last_action = STOP
 
     def reset(self, obs: Observation, goal: Detection) -> None:
         """Start a new approach to ``goal`` (its mask centre) as seen in ``obs``."""
@@ -159,7 +164,12 @@ class PixelNavPolicy:
         if float(probs[STOP]) >= self.stop_threshold:
             action = ACTIONS[STOP]
         else:
-            action = ACTIONS[int(probs[STOP + 1 :].argmax()) + STOP + 1]
+            moves = probs.clone()
+            moves[STOP] = -1.0
+            if self.no_reversal and self._last_action in (LEFT, RIGHT):
+                moves[RIGHT if self._last_action == LEFT else LEFT] = -1.0  # no dithering
+            action = ACTIONS[int(moves.argmax())]
+        self._last_action = ACTIONS.index(action)
         return PolicyStep(action, (float(u), float(v)), max(0.0, steps))
 
 
