@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 
 W, H = 560, 300
-PAD_L, PAD_R, PAD_T, PAD_B = 58, 14, 30, 40
+PAD_L, PAD_R, PAD_T, PAD_B = 58, 14, 48, 40
 COLOURS = [(200, 90, 30), (40, 40, 220), (40, 160, 40), (150, 60, 150)]  # BGR
 
 
@@ -47,7 +47,7 @@ def _panel(
             img, f"{x:.0f}", (u - 12, H - PAD_B + 16), font, 0.38, (0, 0, 0), 1, cv2.LINE_AA
         )
     cv2.putText(img, title, (PAD_L, 20), font, 0.5, (0, 0, 0), 1, cv2.LINE_AA)
-    cv2.putText(img, ylabel, (2, PAD_T - 8), font, 0.38, (0, 0, 0), 1, cv2.LINE_AA)
+    cv2.putText(img, ylabel, (2, PAD_T - 10), font, 0.38, (0, 0, 0), 1, cv2.LINE_AA)
     cv2.putText(img, "step", (W - 50, H - 8), font, 0.4, (0, 0, 0), 1, cv2.LINE_AA)
     for i, (name, (x, y)) in enumerate(series.items()):
         if not len(x):
@@ -56,7 +56,7 @@ def _panel(
         cv2.polylines(
             img, [px(np.asarray(x, float), np.asarray(y, float))], False, c, 2, cv2.LINE_AA
         )
-        cv2.putText(img, name, (W - 200, PAD_T + 18 + 16 * i), font, 0.42, c, 1, cv2.LINE_AA)
+        cv2.putText(img, name, (PAD_L + 165 * i, PAD_T - 10), font, 0.42, c, 1, cv2.LINE_AA)
     return img
 
 
@@ -78,7 +78,7 @@ def save_curves(history: list[dict], path: str | Path) -> Path:
             "val stop recall": (steps, col("val_stop_recall")),
             "train action acc": (steps, col("train_acc")),
         },
-        "validation (held-out buildings) action accuracy",
+        "action accuracy; validation: buildings never trained on",
         "fraction",
     )
     path = Path(path)

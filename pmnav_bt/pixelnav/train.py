@@ -330,6 +330,7 @@ def export(
     j = dest.with_suffix(".json")
     w.parent.mkdir(parents=True, exist_ok=True)
     save_file(sd, str(w), metadata={"format": "pt"})
+    w.chmod(0o644)  # package data: readable by every user
     meta = {
         "model": state["config"]["model"],
         "stop_threshold": stop_threshold,
