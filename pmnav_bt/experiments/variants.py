@@ -55,6 +55,12 @@ VARIANTS: dict[str, Variant] = {
         Variant("pmnav", "PM-Nav", (("tree.variant", "pmnav"),)),
         Variant("coarse_only", "coarse-only", (("tree.variant", "coarse_only"),)),
         Variant(
+            "pmnav_pixelnav",
+            "PM-Nav, fine: PixelNav",
+            (("tree.variant", "pmnav"), ("refiner.backend", "pixelnav")),
+            tables=("4",),
+        ),
+        Variant(
             "pmnav_oracle",
             "PM-Nav",
             (("tree.variant", "pmnav"), ("grounder.backend", "sim_gt")),
