@@ -236,11 +236,14 @@ class FollowLead(PmNavBehaviour):
         base, now = self.ctx.base, self.ctx.now()
         pose = base.pose()
         if self._backing is not None:  # off the wall it ran into, then done
-            x, y, t = self._backing
-            if math.hypot(pose.x - x, pose.y - y) >= BACKUP_LIMIT_M - 0.01 or now - t > 5.0:
+            x, y, t, sent = self._backing
+            refused = sent and base.motion_status() == MotionStatus.BLOCKED  # backup limit
+            backed = math.hypot(pose.x - x, pose.y - y) >= BACKUP_LIMIT_M - 0.01
+            if refused or backed or now - t > 5.0:
                 base.set_velocity(0.0, 0.0)
                 return Status.SUCCESS
             base.set_velocity(-0.1, 0.0)
+            self._backing = (x, y, t, True)
             return Status.RUNNING
         self._poll_walls()
         if not self._driving:
@@ -278,7 +281,7 @@ class FollowLead(PmNavBehaviour):
             if belief is not None and done_m >= MIN_BLOCKED_DRIVE_M:
                 belief.pending_blocked = self._heading  # not just a brush with a side wall
             self.feedback_message = f"blocked after {done_m:.1f} m: the corridor ends or turns"
-            self._backing = (pose.x, pose.y, now)
+            self._backing = (pose.x, pose.y, now, False)
             return Status.RUNNING
         if self._job is None and now - self._next_check > WALL_CHECK_S:
             self._check_walls()

@@ -1,9 +1,10 @@
 """Recoveries like Nav2's: back up, spin to look (or to the corridor axis), wait.
 
 Each is a small leaf; the tree picks them by the failure that triggered the recovery
-(``trees.recovery``). Backing up stays within ``BACKUP_LIMIT_M``: the Create 3 has no
-cliff sensors at the back, and with its default ``safety_override: none`` it refuses to
-reverse far (hazard BACKUP_LIMIT), so a recovery never asks for more.
+(``trees.localize.recovery_subtree``). Backing up stays within ``BACKUP_LIMIT_M``, the
+Create 3's backup limit (0.15 m): it has no cliff sensors at the back, and with its
+default ``safety_override: none`` it reverses only that far over floor it has just
+driven forward over (hazard BACKUP_LIMIT), so a recovery never asks for more.
 """
 
 from __future__ import annotations
@@ -16,9 +17,9 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.seams import MotionStatus
+from pmnav_bt.seams import CREATE3_BACKUP_LIMIT_M, MotionStatus
 
-BACKUP_LIMIT_M = 0.3  # the most a recovery reverses (well inside the Create 3's limit)
+BACKUP_LIMIT_M = CREATE3_BACKUP_LIMIT_M  # the most a recovery reverses
 BACKUP_SPEED = 0.1  # m/s
 BACKUP_TIME_S = 8.0  # clock seconds before a backup that does not move gives up
 
@@ -54,6 +55,7 @@ class BackUp(PmNavBehaviour):
         p = self.ctx.base.pose()
         self._start = (p.x, p.y)
         self._t0 = self.ctx.now()
+        self._sent = False  # BLOCKED before the first command is the failure that led here
 
     def update(self) -> Status:
         base = self.ctx.base
@@ -64,12 +66,13 @@ class BackUp(PmNavBehaviour):
             self.feedback_message = f"backed up {moved:.2f} m"
             return Status.SUCCESS
         if (
-            base.motion_status() == MotionStatus.BLOCKED and moved > 0.0
+            self._sent and base.motion_status() == MotionStatus.BLOCKED
         ) or self.ctx.now() - self._t0 > BACKUP_TIME_S:
             base.stop()
             self.feedback_message = f"backed up {moved:.2f} m (could not reverse further)"
             return Status.SUCCESS
         base.set_velocity(-BACKUP_SPEED, 0.0)
+        self._sent = True
         return Status.RUNNING
 
     def terminate(self, new_status: Status) -> None:

@@ -15,14 +15,16 @@ Topics (names configurable in ``Create3Options``):
 - optional ``hazard_detection`` (irobot_create_msgs/HazardDetectionVector) when that
   package can be imported: a bump ends the motion as BLOCKED.
 
-Safety: velocities are clipped to the Create 3's limits and linear speed is never
-negative (reversing is limited by the robot's backup safety limit, so PM-Nav never
-plans on it). The command is replaced by a stop while odometry is stale
-(``odom_timeout``, 0.3 s) or the camera is silent (``camera_timeout``, 2 s), on
-``stop()``, ``close()`` and interpreter exit. A short odometry gap only pauses the
-robot: ``motion_status()`` turns FAULT, and ``fault()`` reports SENSOR_TIMEOUT (the
-tree's Monitor ends the mission with it), once odometry has been missing for
-``odom_fault_s`` (1 s) or the camera for ``camera_timeout``.
+Safety: velocities are clipped to the Create 3's limits. Reversing is allowed only
+within the robot's backup limit (``backup_limit.BackupBuffer``: with ``safety_override:
+none`` it reverses at most 0.15 m, over floor it has just driven forward over); a
+reverse command beyond it ends the motion as BLOCKED instead of being sent. The command
+is replaced by a stop while odometry is stale (``odom_timeout``, 0.3 s) or the camera
+is silent (``camera_timeout``, 2 s), on ``stop()``, ``close()`` and interpreter exit.
+A short odometry gap only pauses the robot: ``motion_status()`` turns FAULT, and
+``fault()`` reports SENSOR_TIMEOUT (the tree's Monitor ends the mission with it), once
+odometry has been missing for ``odom_fault_s`` (1 s) or the camera for
+``camera_timeout``.
 
 Discrete steps (forward 0.25 m, turn 30 deg) are closed on odometry in the
 heartbeat thread. A motion that makes no progress for ``stall_s`` ends as BLOCKED.
@@ -49,6 +51,7 @@ from pmnav_bt.errors import PmNavError, SensorError
 from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.hardware import qos
+from pmnav_bt.hardware.backup_limit import BackupBuffer
 from pmnav_bt.hardware.clock import RosClock
 from pmnav_bt.hardware.messages import (
     depth_from_image,
@@ -181,6 +184,7 @@ class Create3Base:
         self._status = MotionStatus.IDLE
         self._zero_left = 0
         self._progress: tuple[Pose2D, float] | None = None
+        self.backup = BackupBuffer()  # how far the robot may still reverse
         self._stale: str | None = "odometry"
         self._stale_since: float | None = None
         self._warned = False
@@ -316,9 +320,10 @@ class Create3Base:
         self._wake.set()
 
     def set_velocity(self, linear: float, angular: float) -> None:
-        """Command a body velocity: linear clipped to [0, max_linear] (never backwards),
-        angular to +-max_angular. Holds until changed; republished at ``cmd_rate_hz``."""
-        v = min(self.options.max_linear, max(0.0, float(linear)))
+        """Command a body velocity: linear clipped to +-max_linear (backwards only within
+        the backup limit: beyond it the motion ends BLOCKED), angular to +-max_angular.
+        Holds until changed; republished at ``cmd_rate_hz``."""
+        v = min(self.options.max_linear, max(-self.options.max_linear, float(linear)))
         w = max(-self.options.max_angular, min(self.options.max_angular, float(angular)))
         if not (math.isfinite(v) and math.isfinite(w)):
             v = w = 0.0
@@ -436,6 +441,7 @@ class Create3Base:
             if self._odom and t < self._odom[-1][0]:
                 self._odom.clear()  # time went backwards (a restarted robot or bag)
             self._odom.append((t, pose))
+            self.backup.update(pose)
             if self._odom_arrival is not None:
                 self.max_odom_gap = max(self.max_odom_gap, now - self._odom_arrival)
             self._odom_arrival = now
@@ -622,6 +628,9 @@ class Create3Base:
                 cmd = self._step_command(now)
             else:
                 cmd = self._cmd
+                if not self.backup.allows(cmd[0]):
+                    self._block(f"backup limit ({self.backup.limit:.2f} m) reached")
+                    cmd = self._cmd
                 if cmd != (0.0, 0.0):
                     self._check_stall(now)
                     cmd = self._cmd
@@ -640,7 +649,7 @@ class Create3Base:
             self._progress = (pose, now)
             return
         ref, t0 = self._progress
-        driving = v >= 0.05
+        driving = abs(v) >= 0.05
         turning = not driving and abs(w) >= 0.2
         moved = math.hypot(pose.x - ref.x, pose.y - ref.y)
         turned = abs(wrap_angle(pose.yaw - ref.yaw))

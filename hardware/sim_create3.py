@@ -6,7 +6,8 @@ call. It speaks the robot's topics, so ``pmnav-ros`` runs against it exactly as
 against a Create 3:
 
 - in ``cmd_vel`` (geometry_msgs/Twist); like the robot it stops ``cmd_timeout``
-  (0.5 s) after the last command;
+  (0.5 s) after the last command, and with ``safety_override: none`` reverses at most
+  its backup limit (0.15 m, refilled by driving forward; ``backup_limit.py``);
 - out ``odom`` (nav_msgs/Odometry, ``odom_rate_hz``): odom -> base_link; with
   ``odom_at_origin`` (default) the odometry frame starts at the start pose, as a
   Create 3's does where it boots;
@@ -33,6 +34,7 @@ import time
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
+from pmnav_bt.hardware.backup_limit import BackupBuffer
 from pmnav_bt.seams import CAMERA_HEIGHT_M, Pose2D
 
 PARAMETERS = {
@@ -106,6 +108,7 @@ class SimCreate3:
             segmentation=bool(p["publish_segmentation"]),
         )
         self.base = NoisyOdometry(self.inner, float(p["odometry_noise"]), seed=int(p["seed"]))
+        self.backup = BackupBuffer()
         self._odom_T_map = (
             se2_inverse((start.x, start.y, start.yaw)) if p["odom_at_origin"] else (0.0, 0.0, 0.0)
         )
@@ -147,7 +150,10 @@ class SimCreate3:
         with self._lock:
             self._physics_locked()
             self._last_cmd = time.monotonic()
-            self.inner.set_velocity(float(msg.linear.x), float(msg.angular.z))
+            v, w = float(msg.linear.x), float(msg.angular.z)
+            if not self.backup.allows(v):
+                v = w = 0.0  # the robot refuses to reverse beyond its backup limit
+            self.inner.set_velocity(v, w)
 
     def _physics(self) -> None:
         with self._lock:
@@ -164,6 +170,10 @@ class SimCreate3:
         if stale and self.inner.velocity_command != (0.0, 0.0):
             self.inner.stop()
             self.log.info("cmd_vel timeout: stopping")
+        self.backup.update(self.base.pose())
+        if not self.backup.allows(self.inner.velocity_command[0]):
+            self.inner.stop()
+            self.log.warn("reached the backup limit: stopping")
 
     def odom_pose(self) -> Pose2D:
         q = self.base.pose()

@@ -29,6 +29,7 @@ TURN_STEP_RAD = math.radians(30.0)
 # The iRobot Create 3's speed limits (safety_override none), used by every body and the tree.
 CREATE3_MAX_LINEAR = 0.306  # m/s
 CREATE3_MAX_ANGULAR = 1.9  # rad/s
+CREATE3_BACKUP_LIMIT_M = 0.15  # reverse allowed after driving forward (safety_override none)
 CREATE3_RADIUS_M = 0.17  # body radius (342 mm across), for collisions and shortest paths
 CAMERA_HEIGHT_M = 1.6  # camera above the floor (paper), for every body and the simulator
 

@@ -302,9 +302,11 @@ def test_faults_over_dds(probe, domain_id, tmp_path):
 
 def test_create3_base_over_dds(domain_id, tmp_path):
     """The Base seam itself, in this process, against the simulated Create 3: discrete
-    steps closed on odometry, clipping, observations, and a clear error without frames."""
+    steps closed on odometry, clipping, the backup limit, observations, and a clear error
+    without frames."""
     from rclpy.node import Node
 
+    from pmnav_bt.hardware.backup_limit import BACKUP_LIMIT_M
     from pmnav_bt.hardware.create3 import Create3Base, Create3Options, SensorTimeoutError
     from pmnav_bt.hardware.runtime import RosRuntime
     from pmnav_bt.hardware.testing import Probe
@@ -354,7 +356,20 @@ def test_create3_base_over_dds(domain_id, tmp_path):
         )
         assert turned == pytest.approx(30.0, abs=3.0)
 
-        base.set_velocity(-0.2, 5.0)  # never backwards; angular clipped
+        # Backwards within the Create 3's backup limit (refilled by the forward step), then
+        # BLOCKED: the robot would refuse to reverse further.
+        p2 = base.pose()
+        base.set_velocity(-0.5, 0.0)
+        assert base.velocity_command == (-0.306, 0.0)
+        assert settle() == MotionStatus.BLOCKED
+        time.sleep(0.3)
+        p3 = base.pose()
+        back = math.cos(p2.yaw) * (p2.x - p3.x) + math.sin(p2.yaw) * (p2.y - p3.y)
+        assert 0.1 <= back <= BACKUP_LIMIT_M + 0.05
+        base.set_velocity(-0.1, 0.0)  # the buffer is empty: refused at once
+        assert settle(2.0) == MotionStatus.BLOCKED
+        assert math.dist((base.pose().x, base.pose().y), (p3.x, p3.y)) < 0.02
+        base.set_velocity(0.0, 5.0)  # angular clipped
         assert base.velocity_command == (0.0, 1.9)
         base.set_velocity(0.5, -5.0)
         assert base.velocity_command == (0.306, -1.9)
