@@ -14,6 +14,7 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
+from pmnav_bt.behaviours.pose import keep_on_axis, measure_walls
 from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
@@ -31,11 +32,14 @@ OBSTACLE_RANGE = 2.0
 class DriveTo(PmNavBehaviour):
     """Drive to a map point; subclasses choose the point and may refine it on the way.
 
-    Reads ``map_T_odom``, ``target``. FAILURE (BLOCKED) on repeated collisions, no
+    Every watch frame's corridor wall keeps the estimate's heading and position across
+    the corridor true (``keep_on_axis``). Reads ``map_T_odom``, ``target``; writes
+    ``map_T_odom``, ``pose_tracker``. FAILURE (BLOCKED) on repeated collisions, no
     progress, or an obstacle closer than the goal.
     """
 
-    READS = ("map_T_odom", "target", "plan")
+    READS = ("map_T_odom", "target", "plan", "pose_tracker")
+    WRITES = ("map_T_odom", "pose_tracker")
 
     def goal(self) -> tuple[float, float]:
         raise NotImplementedError
@@ -102,7 +106,9 @@ class DriveTo(PmNavBehaviour):
                 def watch(cancelled):
                     obs = base.observe()
                     est = map_pose(tf, obs.pose)
-                    return obs, _free_ahead(obs, est, goal), self.inspect(obs, est, target)
+                    found = self.inspect(obs, est, target)
+                    found["walls"] = measure_walls(self.ctx.grounder, obs)
+                    return obs, _free_ahead(obs, est, goal), found
 
                 self._watch_job = self.ctx.worker.submit(watch)
             return None
@@ -113,6 +119,8 @@ class DriveTo(PmNavBehaviour):
         if status is not None:
             return status
         obs, free, found = watched
+        if found.get("walls") is not None:
+            keep_on_axis(self, obs.pose, found["walls"])
         self.on_watch(found, obs)
         if free is not None:
             self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)

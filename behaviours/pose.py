@@ -13,7 +13,15 @@ from pmnav_bt.behaviours.context import map_pose
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.snap import OffMapError, snap_to_corridor
-from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, heading_correction, wall_points
+from pmnav_bt.pose.walls import (
+    WallLine,
+    axis_in_odom,
+    fit_wall_angle,
+    fit_wall_line,
+    heading_correction,
+    wall_points,
+)
+from pmnav_bt.seams import Pose2D
 
 MAX_WALL_CORRECTION = math.radians(15.0)  # larger: a side corridor's wall, not drift
 
@@ -112,3 +120,49 @@ class CorrectHeading(PmNavBehaviour):
     def terminate(self, new_status) -> None:
         if getattr(self, "_job", None) is not None and new_status.name == "INVALID":
             self._job.cancel()
+
+
+# -- keeping to the corridor while driving -------------------------------------------------
+
+AXIS_MAX_TURN = math.radians(10.0)  # a wall more oblique than this is not the corridor's
+AXIS_GAIN = 0.5  # share of the measured heading and lateral error removed per frame
+MIN_WALL_LENGTH_M = 1.5  # a wall line this long, not a door frame or a pillar
+MAX_SHIFT_M = 0.5  # the most one frame moves the estimate across the corridor
+
+
+def measure_walls(grounder, obs) -> WallLine | None:
+    """The strongest wall line in a frame (worker only)."""
+    mask = wall_mask(grounder, obs)
+    line = None if mask is None else fit_wall_line(wall_points(obs, mask))
+    return line if line is not None and line.length >= MIN_WALL_LENGTH_M else None
+
+
+def keep_on_axis(b: PmNavBehaviour, odom: Pose2D, line: WallLine) -> str | None:
+    """Correct ``map_T_odom`` with a corridor wall seen while driving (from odometry pose
+    ``odom``): its direction gives the heading relative to the corridor axis, its distance
+    the position across the corridor. Writes ``map_T_odom`` and ``pose_tracker``; returns
+    what it did (None: the wall is not the corridor's, nothing changed)."""
+    if b.get("map_T_odom") is None:
+        return None
+    tracker = tracker_of(b)
+    est = map_pose(tracker.map_T_odom, odom)
+    seg = b.ctx.pm.locate(est.x, est.y).segment
+    turn = heading_correction(odom.yaw + line.angle, tracker.map_T_odom[2], seg.heading)
+    if abs(turn) > AXIS_MAX_TURN or not 0.1 < abs(line.offset) < seg.width:
+        return None
+    tracker.rotate(AXIS_GAIN * turn, (odom.x, odom.y))
+    est = map_pose(tracker.map_T_odom, odom)
+    a = b.ctx.pm.node_xy(seg.a)
+    u = (math.cos(seg.heading), math.sin(seg.heading))
+    n = (-u[1], u[0])  # the corridor's left
+    lateral = n[0] * (est.x - a[0]) + n[1] * (est.y - a[1])
+    # The line's left normal (body) is the corridor's left, or its right.
+    side = 1.0 if math.cos(est.yaw + line.angle - seg.heading) >= 0.0 else -1.0
+    wall = side * line.offset  # the wall relative to the robot, across the corridor
+    true_lateral = (seg.width / 2.0 if wall > 0.0 else -seg.width / 2.0) - wall
+    shift = max(-MAX_SHIFT_M, min(MAX_SHIFT_M, AXIS_GAIN * (true_lateral - lateral)))
+    x, y, yaw = tracker.map_T_odom
+    tracker.map_T_odom = (x + shift * n[0], y + shift * n[1], yaw)
+    b.bb.set("map_T_odom", tracker.map_T_odom)
+    b.bb.set("pose_tracker", tracker)
+    return f"walls: heading {math.degrees(AXIS_GAIN * turn):+.1f} deg, across {shift:+.2f} m"

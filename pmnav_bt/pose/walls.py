@@ -10,6 +10,7 @@ everywhere in a functional building.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -38,6 +39,24 @@ def wall_points(obs: Observation, wall: np.ndarray, stride: int = 2) -> np.ndarr
 def fit_wall_angle(points: np.ndarray, seed: int = 0) -> tuple[float, int] | None:
     """The direction (rad, in (-pi/2, pi/2], body frame) of the best line through ``points``
     and its inlier count, or None when no line has ``MIN_INLIERS`` points."""
+    line = fit_wall_line(points, seed)
+    return None if line is None else (line.angle, line.inliers)
+
+
+@dataclass(frozen=True)
+class WallLine:
+    """A wall line in the body frame: its direction (rad, mod pi), its signed distance
+    from the robot (m, positive: on the left), its inlier count and length along it (m)."""
+
+    angle: float
+    offset: float
+    inliers: int
+    length: float
+
+
+def fit_wall_line(points: np.ndarray, seed: int = 0) -> WallLine | None:
+    """The best line through the floor-plane ``points`` (RANSAC, then least squares on its
+    inliers), or None when no line has ``MIN_INLIERS`` points."""
     n = len(points)
     if n < MIN_INLIERS:
         return None
@@ -56,10 +75,16 @@ def fit_wall_angle(points: np.ndarray, seed: int = 0) -> tuple[float, int] | Non
     if best_in is None or best_in.sum() < MIN_INLIERS:
         return None
     p = points[best_in]
-    p = p - p.mean(axis=0)
-    _, _, vt = np.linalg.svd(p, full_matrices=False)
-    a = math.atan2(vt[0, 1], vt[0, 0])
-    return wrap_angle(2.0 * a) / 2.0, int(best_in.sum())
+    mean = p.mean(axis=0)
+    _, _, vt = np.linalg.svd(p - mean, full_matrices=False)
+    d = vt[0]
+    a = math.atan2(d[1], d[0])
+    along = (p - mean) @ d
+    # Signed distance of the line from the origin: the left normal of d, flipped to face
+    # the line's side of the robot when d points backwards.
+    normal = np.array([-d[1], d[0]]) if d[0] >= 0 else np.array([d[1], -d[0]])
+    offset = float(mean @ normal)
+    return WallLine(wrap_angle(2.0 * a) / 2.0, offset, int(best_in.sum()), float(np.ptp(along)))
 
 
 def wall_angle(obs: Observation, wall: np.ndarray) -> float | None:
