@@ -44,10 +44,14 @@ MIN_BLIND_GLIMPSES = 4  # glimpses before a fix from the corridors' shape alone
 BLIND_SPREAD_M = 0.75  # ... and how tight the belief must be for it
 LOOK_SPACING_M = 6.0  # look round at least this far beyond an earlier look in the same way
 NEAR_WALL_M = 2.0  # depth: a wall closer than this ahead of a view ...
-OPEN_M = 5.0  # ... or free floor farther than this
+MAX_RAY_M = 8.0  # free floor seen in depth is checked along the view up to this far
+RAY_SLACK_M = 0.4  # ... short of where it ends, and this far outside the corridors
 P_DEPTH = 0.1  # a hypothesis that disagrees with one such depth reading
 JUNCTION_REACH_M = 1.0  # side corridors of a junction this close are the robot's
 CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
+DIFFUSE_MASS = 0.3  # below this (best cluster), the belief is diffuse: look close by first
+NEAR_JUNCTION_M = 6.0  # ... at a junction or corridor end this close (its shape tells much)
+SWITCH_COST_RATIO = 2.0  # turn back when the other way is expected this much shorter
 
 
 @dataclass(frozen=True)
@@ -87,6 +91,8 @@ class CorridorBelief:
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm, self.read_range)
+        self._floor = shapely.buffer(self.vis.corridors, RAY_SLACK_M)  # a little tolerance
+        shapely.prepare(self._floor)
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs
@@ -218,19 +224,22 @@ class CorridorBelief:
             )
             pn, poff = self.vis.nearest_many(probe)
             self.logw += np.where(poff <= half[pn], math.log(P_THROUGH_WALL), 0.0)
-        # Depth: a wall close ahead of a view must be a wall on the map; far free floor, floor.
+        # Depth: a wall close ahead of a view must be a wall on the map; the free floor seen
+        # along each view (the whole ray, e.g. into a side corridor) must be floor on it.
+        here_xy = _apply_many(tfs, (g.odom.x, g.odom.y))
         for yaw, free in g.free:
             c, s_ = math.cos(yaw), math.sin(yaw)
             if free < NEAR_WALL_M:
-                d, inside = free + 0.5, False
-            elif free > OPEN_M:
-                d, inside = OPEN_M - 1.0, True
-            else:
-                continue
-            probe = _apply_many(tfs, (g.odom.x + d * c, g.odom.y + d * s_))
-            pn, poff = self.vis.nearest_many(probe)
-            wrong = (poff <= half[pn]) if not inside else (poff > half[pn] + OFF_CORRIDOR_M)
-            self.logw += np.where(wrong, math.log(P_DEPTH), 0.0)
+                d = free + 0.5
+                probe = _apply_many(tfs, (g.odom.x + d * c, g.odom.y + d * s_))
+                pn, poff = self.vis.nearest_many(probe)
+                self.logw += np.where(poff <= half[pn], math.log(P_DEPTH), 0.0)
+            reach = min(free, MAX_RAY_M) - RAY_SLACK_M
+            if reach > 1.0:
+                end = _apply_many(tfs, (g.odom.x + reach * c, g.odom.y + reach * s_))
+                rays = shapely.linestrings(np.stack([here_xy, end], 1))
+                floor = shapely.covers(self._floor, rays)
+                self.logw += np.where(floor, 0.0, math.log(P_DEPTH))
         # What the map says is readable at each hypothesis's position for this glimpse.
         readable = [self.vis.lattice_points[j].readable for j in near]
         seen = g.seen.keys()
@@ -351,10 +360,27 @@ class CorridorBelief:
         # except at a junction, where the way is chosen afresh.
         cross = CROSS_WAY_MASS if side_mass < CROSS_WAY_MASS else KEEP_WAY_MASS
         need = np.array([KEEP_WAY_MASS, cross, KEEP_WAY_MASS, cross])
+        ends = np.full(4, np.inf)  # weighted median distance to the next junction or end
+        for j, r in enumerate(run):
+            if r:
+                ends[j] = _weighted_median(*np.array(r).T)
+        ok = np.nonzero(open_mass >= need)[0]
         k = self._last_way
-        if k is None or open_mass[k] < need[k] or side_mass >= CROSS_WAY_MASS:
-            ok = np.nonzero(open_mass >= need)[0]
-            k = int(ok[np.argmin(cost[ok])]) if len(ok) else int(np.argmax(open_mass[::2]) * 2)
+        if k is not None and open_mass[k] >= need[k] and side_mass < CROSS_WAY_MASS:
+            # Keep the way, unless the other way is expected much shorter (after what was
+            # seen on this one): a search that doubles back instead of going on forever.
+            back = (k + 2) % 4
+            if back in ok and SWITCH_COST_RATIO * cost[back] < cost[k]:
+                k = back
+        elif len(ok):
+            k = int(ok[np.argmin(cost[ok])])
+            _, mass = self.best_cluster()
+            near = [j for j in ok if ends[j] <= NEAR_JUNCTION_M]
+            if mass < DIFFUSE_MASS and near and len(self.glimpses) <= 1:
+                # Nothing tells the ways apart yet: first the junction or end close by.
+                k = int(min(near, key=lambda j: ends[j]))
+        else:
+            k = int(np.argmax(open_mass[::2]) * 2)
         self._last_way = k
         go = float(np.clip(cost[k] + 1.0, 1.0, max_distance)) if np.isfinite(cost[k]) else 1.0
         # Drive past the places already looked round from in that direction.
@@ -382,6 +408,12 @@ class CorridorBelief:
     def _axis(self) -> float:
         """The corridor axis in odometry, as seen at the reference."""
         return 0.0 if self.ref is None else self.ref.yaw - self.axis_offset
+
+
+def _weighted_median(w: np.ndarray, x: np.ndarray) -> float:
+    order = np.argsort(x)
+    c = np.cumsum(w[order])
+    return float(x[order][min(len(x) - 1, int(np.searchsorted(c, c[-1] / 2.0)))])
 
 
 def _apply_many(tfs: np.ndarray, p) -> np.ndarray:
