@@ -135,3 +135,21 @@ def test_from_a_bare_stretch_following_the_lead_finds_signs_and_a_fix():
             np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=tol)
             fixed += 1
     assert fixed >= 0.9 * len(starts), (fixed, len(starts))
+
+
+def test_free_floor_seen_into_a_side_corridor_points_the_first_lead_at_the_junction():
+    # sign_sparse_0: 2.4 m north of branch2 (30, 30), facing north up a 27 m bare
+    # corridor. The views back over the shoulders look into the side corridors of the
+    # junction (long free floor); only hypotheses near such a junction explain that, so
+    # the first drive goes back to it, not on into the bare corridor.
+    pm = parse_building(generate_sign_sparse(0))
+    true = (30.0, 32.4, math.pi / 2)
+    odom = se2_compose(ODOM_T_MAP, true)
+    free = tuple(
+        (true[2] + a + ODOM_T_MAP[2], _free(pm, true, true[2] + a))
+        for a in np.radians([30, 90, 150, 210, 270, 330])
+    )
+    b = CorridorBelief(pm)
+    b.observe(Glimpse(Pose2D(*odom), {}, None, free), axis_odom=odom[2])
+    lead = b.lead(Pose2D(*odom), 16.0)
+    assert abs(math.remainder(lead.heading - (odom[2] + math.pi), 2 * math.pi)) < 0.1
