@@ -19,7 +19,7 @@ from pmnav_bt.perception.read_range import sign_visible_range
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.visibility import entity_xy
-from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, heading_correction, wall_points
+from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
 from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation
 
 NO_PROGRESS_S = 6.0  # clock seconds without moving 0.1 m: the drive is blocked
@@ -28,7 +28,6 @@ SIGN_APPROACH_M = 3.0  # with a sign in view ahead, drive this much further, the
 WALL_CHECK_S = 1.0  # clock seconds between wall checks while driving along the corridor
 STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
-MAX_FIX_TURN = math.radians(30.0)  # a fix's heading is lined up with the walls within this
 
 
 def wall_mask(grounder: Grounder, obs: Observation):
@@ -89,7 +88,6 @@ class UpdateBelief(PmNavBehaviour):
         for s in sightings:
             seen.setdefault(s.entity, s.odom_xy)
         belief.observe(Glimpse(odom, seen, free=free), axis_odom=axis)
-        belief.last_axis = axis  # the fix lines its heading up with these walls
         self.bb.set("belief", belief)
         _, mass = belief.best_cluster()
         self.feedback_message = (
@@ -139,9 +137,6 @@ class FixFromBelief(PmNavBehaviour):
                 )
             tf, spread = got
             sigma, how = 0.3 + spread, f"the corridor belief ({len(belief.glimpses)} glimpses)"
-        tf, turn = self._line_up(tf, belief.last_axis)
-        if turn:
-            how += f", heading {math.degrees(turn):+.0f} deg from the walls"
         self.bb.set("map_T_odom", tf)
         self.bb.set(
             "pose_tracker",
@@ -160,23 +155,6 @@ class FixFromBelief(PmNavBehaviour):
         )
         self.feedback_message = f"at ({est_x:.1f}, {est_y:.1f}) from {how}"
         return Status.SUCCESS
-
-    def _line_up(self, tf, axis: float | None):
-        """``tf`` turned about the robot so that the walls of the panorama run along the
-        corridor it puts the robot in (signs seen from views far apart in the turn carry
-        the odometry's rotation error), and the turn; unchanged when no wall line was
-        measured or the walls are too far off (a cross wall)."""
-        if axis is None:
-            return tf, 0.0
-        odom = self.ctx.base.pose()
-        x, y = _map_xy(tf, odom)
-        seg = self.ctx.pm.locate(x, y).segment
-        turn = heading_correction(axis, tf[2], seg.heading)
-        if abs(turn) > MAX_FIX_TURN:
-            return tf, 0.0
-        t = PoseTracker(map_T_odom=tf)
-        t.rotate(turn, (odom.x, odom.y))
-        return t.map_T_odom, turn
 
 
 def _map_xy(tf, pose) -> tuple[float, float]:

@@ -27,7 +27,6 @@ WATCH_PERIOD_S = 1.0  # clock seconds between obstacle checks from depth
 MAX_BUMPS = 3  # collisions before a drive gives up as blocked
 # Depth is checked this far ahead: a 1 m box leaves the 1.6 m camera's view 1.4 m away.
 OBSTACLE_RANGE = 2.0
-REJUDGE_TURN = math.radians(1.5)  # the walls turned the estimate this much: judge anew
 
 
 class DriveTo(PmNavBehaviour):
@@ -121,9 +120,7 @@ class DriveTo(PmNavBehaviour):
             return status
         obs, free, found = watched
         if found.get("walls") is not None:
-            kept = keep_on_axis(self, obs.pose, found["walls"])
-            if kept is not None and abs(kept[0]) > REJUDGE_TURN:
-                free = None  # judged along a heading the walls just corrected: look again
+            keep_on_axis(self, obs.pose, found["walls"])
         self.on_watch(found, obs)
         if free is not None:
             self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)

@@ -124,7 +124,7 @@ class CorrectHeading(PmNavBehaviour):
 
 # -- keeping to the corridor while driving -------------------------------------------------
 
-AXIS_MAX_TURN = math.radians(25.0)  # a wall more oblique than this is not the corridor's
+AXIS_MAX_TURN = math.radians(10.0)  # a wall more oblique than this is not the corridor's
 AXIS_GAIN = 0.5  # share of the measured heading and lateral error removed per frame
 MIN_WALL_LENGTH_M = 1.5  # a wall line this long, not a door frame or a pillar
 MAX_SHIFT_M = 0.5  # the most one frame moves the estimate across the corridor
@@ -137,12 +137,11 @@ def measure_walls(grounder, obs) -> WallLine | None:
     return line if line is not None and line.length >= MIN_WALL_LENGTH_M else None
 
 
-def keep_on_axis(b: PmNavBehaviour, odom: Pose2D, line: WallLine) -> tuple[float, float] | None:
+def keep_on_axis(b: PmNavBehaviour, odom: Pose2D, line: WallLine) -> str | None:
     """Correct ``map_T_odom`` with a corridor wall seen while driving (from odometry pose
     ``odom``): its direction gives the heading relative to the corridor axis, its distance
     the position across the corridor. Writes ``map_T_odom`` and ``pose_tracker``; returns
-    the turn (rad) and shift across the corridor (m) applied (None: the wall is not the
-    corridor's, nothing changed)."""
+    what it did (None: the wall is not the corridor's, nothing changed)."""
     if b.get("map_T_odom") is None:
         return None
     tracker = tracker_of(b)
@@ -166,4 +165,4 @@ def keep_on_axis(b: PmNavBehaviour, odom: Pose2D, line: WallLine) -> tuple[float
     tracker.map_T_odom = (x + shift * n[0], y + shift * n[1], yaw)
     b.bb.set("map_T_odom", tracker.map_T_odom)
     b.bb.set("pose_tracker", tracker)
-    return AXIS_GAIN * turn, shift
+    return f"walls: heading {math.degrees(AXIS_GAIN * turn):+.1f} deg, across {shift:+.2f} m"

@@ -85,7 +85,6 @@ class CorridorBelief:
     # A prior from an earlier estimate: map_T_odom and its position uncertainty (m).
     prior: tuple[tuple[float, float, float], float] | None = None
     pending_blocked: float | None = None  # a drive was blocked heading this way (odometry)
-    last_axis: float | None = None  # corridor axis (odometry, mod pi) at the last glimpse
     _last_way: int | None = None  # the way (0-3 from the axis) the last lead chose
     _drift: float = 0.0  # odometry heading drift since the reference, from the walls
     read_range: float | None = None  # m, signs are read to (None: visibility.READ_RANGE_M)

@@ -21,7 +21,6 @@ MAX_RANGE_M = 6.0  # wall points farther than this are too noisy
 MIN_INLIERS = 60
 INLIER_M = 0.05
 ITERATIONS = 60
-LATER_VIEW_WEIGHT = 0.5  # weight of each view's wall axis relative to the view before
 
 
 def wall_points(obs: Observation, wall: np.ndarray, stride: int = 2) -> np.ndarray:
@@ -97,15 +96,10 @@ def wall_angle(obs: Observation, wall: np.ndarray) -> float | None:
 def axis_in_odom(angles: list[tuple[float, float, int]]) -> float | None:
     """Combine (view odometry yaw, wall angle in that view, inliers) into one corridor axis
     in the odometry frame (mod pi): the inlier-weighted circular mean of the doubled angles,
-    over the views that agree with the strongest one (walls of side corridors disagree).
-    Views are in the order taken: each later one carries more of the odometry's rotation
-    error (5 % of a full turn is 18 deg), so each counts half as much as the one before."""
+    over the views that agree with the strongest one (walls of side corridors disagree)."""
     if not angles:
         return None
-    dirs = [
-        (wrap_angle(2.0 * (yaw + a)), n * LATER_VIEW_WEIGHT**i)
-        for i, (yaw, a, n) in enumerate(angles)
-    ]
+    dirs = [(wrap_angle(2.0 * (yaw + a)), n) for yaw, a, n in angles]
     ref = max(dirs, key=lambda d: d[1])[0]
     agree = [(d, n) for d, n in dirs if abs(wrap_angle(d - ref)) < math.radians(30.0)]
     s = sum(n * math.sin(d) for d, n in agree)
