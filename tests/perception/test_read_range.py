@@ -63,7 +63,7 @@ def test_the_built_tree_uses_them(fig2_map):
     from pmnav_bt.trees.pmnav import step_subtree
 
     def keeps(cfg) -> dict[str, tuple[float, float]]:
-        root = step_subtree(SimpleNamespace(config=cfg, now=lambda: 0.0))
+        root = step_subtree(SimpleNamespace(config=cfg, now=lambda: 0.0, refiner=None))
         return {
             b.name: (b.keep, b.distance)
             for b in root.iterate()
