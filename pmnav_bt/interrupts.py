@@ -35,6 +35,10 @@ class Interrupted(BaseException):
         return EXIT_CODES.get(self.signame, 1)
 
 
+_deferring = 0  # > 0 inside signals_deferred()
+_pending: list[str] = []  # a stop that arrived while deferring
+
+
 @contextmanager
 def stop_signals() -> Iterator[None]:
     """Within the block, SIGINT and SIGTERM raise Interrupted in the main thread."""
@@ -46,7 +50,11 @@ def stop_signals() -> Iterator[None]:
         # Once is enough: a second signal while cleaning up must not break the cleanup.
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        raise Interrupted(signal.Signals(signum).name)
+        name = signal.Signals(signum).name
+        if _deferring:
+            _pending.append(name)
+            return
+        raise Interrupted(name)
 
     old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
@@ -54,6 +62,22 @@ def stop_signals() -> Iterator[None]:
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+
+
+@contextmanager
+def signals_deferred() -> Iterator[None]:
+    """Within the block, a stop from ``stop_signals`` waits and is raised as the block
+    ends: a result row is written and counted whole, or not at all."""
+    global _deferring
+    _deferring += 1
+    try:
+        yield
+    finally:
+        _deferring -= 1
+    if not _deferring and _pending:
+        name = _pending.pop()
+        _pending.clear()
+        raise Interrupted(name)
 
 
 def quiet_worker() -> None:

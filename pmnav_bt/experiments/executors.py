@@ -133,7 +133,10 @@ def _ray(fn, tasks, jobs, address) -> Iterator[tuple[int, Any]]:
                 row = i, TaskCrash(f"{type(err).__name__}: {str(err).splitlines()[0]}")
             yield row
     finally:
-        for r in pending:
-            ray.cancel(r, force=True)
-        if started:
+        if started:  # our own runtime: shutting it down stops its workers
             ray.shutdown()
+        else:  # a cluster's: ask it to drop what is left of this run
+            # (no force: killing workers while their tasks complete can abort the
+            # driver in Ray's task manager, seen on Ctrl-C with a local runtime)
+            for r in pending:
+                ray.cancel(r)

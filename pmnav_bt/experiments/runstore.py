@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.interrupts import signals_deferred
 
 
 class ResumeError(PmNavError):
@@ -149,11 +150,12 @@ class ResultStore:
             "config_sha": e.config_sha,
             **row,
         }
-        self._f.write(json.dumps(full) + "\n")
-        self._f.flush()
-        os.fsync(self._f.fileno())
-        self.done[key] = full
-        self.count += 1
+        with signals_deferred():  # Ctrl-C between the line and its count would miscount
+            self._f.write(json.dumps(full) + "\n")
+            self._f.flush()
+            os.fsync(self._f.fileno())
+            self.done[key] = full
+            self.count += 1
         return full
 
     def close(self) -> None:
