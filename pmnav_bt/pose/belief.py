@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import networkx as nx
 import numpy as np
 import shapely
 
@@ -52,6 +53,12 @@ CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
 DIFFUSE_MASS = 0.3  # below this (best cluster), the belief is diffuse: look close by first
 NEAR_JUNCTION_M = 6.0  # ... at a junction or corridor end this close (its shape tells much)
 SWITCH_COST_RATIO = 2.0  # turn back when the other way is expected this much shorter
+TELLING_MIN_WEIGHT = 0.05  # hypotheses this likely (of the best) must be told apart ...
+TELLING_MAX_MODES = 4  # ... when they form at most this many clusters ...
+TELLING_COVER = 0.8  # ... holding this much of the belief between them
+TELLING_REACH_M = 60.0  # look for a telling place this far along the corridors
+LEG_OFF_LINE_M = 0.25  # ... and this much more: the robot is beside a path's run
+TELLING_LOOKED_M = 1.5  # a place this close to an earlier glimpse was looked from
 
 
 @dataclass(frozen=True)
@@ -316,6 +323,9 @@ class CorridorBelief:
         dist, _ = self.vis.towards_signs
         if not dist:
             return None
+        telling = self._telling_lead(odom, max_distance)
+        if telling is not None:
+            return telling
         w = self.weights()
         tfs = self._map_T_odom()
         live = np.nonzero(w > 1e-4 * w.max())[0]
@@ -404,6 +414,126 @@ class CorridorBelief:
                 go = to_junction
         heading = wrap_angle(h + self._drift)  # back to odometry
         return Lead(heading, go, float(open_mass[k]))
+
+    def _modes(self, idx: np.ndarray) -> list[list[int]]:
+        """Hypotheses ``idx`` (best first) grouped greedily into clusters."""
+        modes: list[list[int]] = []
+        for i in idx:
+            for m in modes:
+                j = m[0]
+                if (
+                    np.linalg.norm(self.xy[i] - self.xy[j]) <= CLUSTER_M
+                    and abs(wrap_angle(self.yaw[i] - self.yaw[j])) < 0.5
+                ):
+                    m.append(int(i))
+                    break
+            else:
+                modes.append([int(i)])
+        return modes
+
+    def _telling_lead(self, odom: Pose2D, max_distance: float) -> Lead | None:
+        """Towards the nearest place where the few likely hypotheses predict different
+        signs (the most information per metre driven), when the belief is split between
+        a few clusters, e.g. the mirror images of a symmetric corridor: a glimpse there
+        tells them apart, where driving towards signs that every hypothesis puts alike
+        (both ends of the corridor) cannot. The first leg of the way there, along or
+        across the axis; None when no such place is in reach or the belief is not split."""
+        if self.ref is None:
+            return None
+        w = self.weights()
+        idx = np.argsort(-w)
+        idx = idx[w[idx] >= TELLING_MIN_WEIGHT * w[idx[0]]]
+        modes = self._modes(idx)
+        mass = np.array([w[m].sum() for m in modes])
+        if (
+            len(modes) < 2
+            or len(modes) > TELLING_MAX_MODES
+            or mass.sum() < TELLING_COVER
+            or mass.max() >= FIX_MASS * mass.sum()
+        ):
+            return None
+        tfs = self._map_T_odom()
+        best = int(idx[0])
+        p = self._straighten((odom.x, odom.y))
+        here = _apply_many(tfs[[best]], (p[0], p[1]))[0]
+        start, _ = self.vis.nearest_many(here[None])
+        g = self.vis.lattice_graph
+        reach, paths = nx.single_source_dijkstra(
+            g, int(start[0]), cutoff=TELLING_REACH_M, weight="length"
+        )
+        cand = np.array(sorted(reach, key=reach.get), dtype=int)
+        inv = se2_inverse(tuple(tfs[best]))
+        q = np.array([se2_apply(inv, xy) for xy in self.vis.lattice_xy[cand]])  # odom places
+        looked = np.array([[g_.odom.x, g_.odom.y] for g_ in self.glimpses])
+        fresh = np.linalg.norm(q[:, None, :] - looked[None], axis=2).min(1) > TELLING_LOOKED_M
+        half = np.array([s.width / 2.0 for s in self.pm.segments])
+        pts = self.vis.lattice_points
+        hyp = np.array([m[int(np.argmax(w[m]))] for m in modes])  # one per cluster
+        preds = []  # per cluster: the signs readable at each candidate (None: a wall)
+        for i in hyp:
+            c, s_ = math.cos(tfs[i][2]), math.sin(tfs[i][2])
+            there = np.stack(
+                [tfs[i][0] + c * q[:, 0] - s_ * q[:, 1], tfs[i][1] + s_ * q[:, 0] + c * q[:, 1]], 1
+            )
+            near, off = self.vis.nearest_many(there)
+            preds.append(
+                [
+                    pts[n].readable if o <= half[pts[n].segment - 1] else None
+                    for n, o in zip(near, off, strict=True)
+                ]
+            )
+        for c_i, m in enumerate(cand):
+            if not fresh[c_i] or reach[int(m)] < 1.0:
+                continue
+            seen = [pr[c_i] for pr in preds]
+            if any(r is None for r in seen):
+                continue  # a wall under some hypothesis: no safe place to look from
+            groups: dict[frozenset, float] = {}
+            for r, ms in zip(seen, mass, strict=True):
+                groups[r] = groups.get(r, 0.0) + float(ms)
+            if max(groups.values()) >= FIX_MASS * mass.sum():
+                continue
+            return self._leg_towards(
+                here, paths[int(m)], tfs[best], float(mass.sum()), max_distance
+            )
+        return None
+
+    def _leg_towards(self, here, path, tf, support: float, max_distance: float) -> Lead | None:
+        """The first straight leg from ``here`` (map) along a lattice path: the first
+        straight run of the path that does not end within a metre of ``here``, driven
+        along from beside it (a junction this close is the robot's, as in ``lead``), or
+        towards its start when the robot is off its line; as a way along or across the
+        axis in odometry, and its length."""
+        pts = self.vis.lattice_xy[list(path)]
+        runs: list[tuple[np.ndarray, np.ndarray, float]] = []  # start, direction, length
+        for p0, p1 in zip(pts, pts[1:], strict=False):
+            v = p1 - p0
+            n = float(np.linalg.norm(v))
+            if n < 1e-3:
+                continue
+            u = v / n
+            if runs and float(runs[-1][1] @ u) > 0.95:
+                runs[-1] = (runs[-1][0], runs[-1][1], runs[-1][2] + n)
+            else:
+                runs.append((p0, u, n))
+        here = np.asarray(here)
+        for a, u, n in runs:
+            end = a + u * n
+            if np.linalg.norm(end - here) < 1.0:
+                continue
+            rel = here - a
+            if abs(rel[0] * u[1] - rel[1] * u[0]) <= JUNCTION_REACH_M + LEG_OFF_LINE_M:
+                go = float((end - here) @ u)
+            else:
+                u = -rel / float(np.linalg.norm(rel))
+                go = float(np.linalg.norm(rel))
+            axis = self._axis()
+            h0 = math.atan2(u[1], u[0])
+            k = int(round(wrap_angle(h0 - tf[2] - axis) / (math.pi / 2))) % 4
+            self._last_way = k
+            heading = wrap_angle(axis + k * math.pi / 2 + self._drift)
+            return Lead(heading, float(np.clip(go, 1.0, 2.0 * max_distance)), support)
+        return None
 
     def _axis(self) -> float:
         """The corridor axis in odometry, as seen at the reference."""

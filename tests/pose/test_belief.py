@@ -153,3 +153,43 @@ def test_free_floor_seen_into_a_side_corridor_points_the_first_lead_at_the_junct
     b.observe(Glimpse(Pose2D(*odom), {}, None, free), axis_odom=odom[2])
     lead = b.lead(Pose2D(*odom), 16.0)
     assert abs(math.remainder(lead.heading - (odom[2] + math.pi), 2 * math.pi)) < 0.1
+
+
+def _drive_straight(pm, xy, map_heading: float, distance: float):
+    """Move ``distance`` straight on (a robot that keeps its heading, off the centre line
+    too) until 0.3 m from a wall."""
+    floor = shapely.buffer(Visibility.of(pm).corridors, -0.3)
+    u = np.array([math.cos(map_heading), math.sin(map_heading)])
+    p = np.asarray(xy, dtype=float)
+    for _ in range(int(distance / 0.25)):
+        if not floor.covers(shapely.Point(*(p + 0.25 * u))):
+            break
+        p = p + 0.25 * u
+    return p
+
+
+@pytest.mark.parametrize("start_y", [37.9, 21.95])
+def test_a_mirror_symmetric_corridor_is_told_apart_by_looking_into_a_side_corridor(start_y):
+    # sign_sparse_2: the central corridor (branch2 at (30, 30) between two bare 30 m dead
+    # ends) looks the same from either end; only the wings differ (room7-9 readable 12 m
+    # or more west of branch2, nothing as far east). Driving end to end keeps the two
+    # mirror hypotheses 50/50; the lead must go where they predict different signs.
+    # The starts are two of the hard tier's (37.9 shuttled end to end before).
+    pm = parse_building(generate_sign_sparse(2))
+    vis = Visibility.of(pm)
+    xy, yaw = np.array([30.0, start_y]), math.pi / 2
+    b = CorridorBelief(pm)
+    blocked = None
+    for _ in range(14):
+        g = glimpse(pm, (*xy, yaw), vis.readable_from(xy), blocked, depth=True)
+        b.observe(g, axis_odom=g.odom.yaw)
+        if b.fix() is not None:
+            break
+        lead = b.lead(g.odom)
+        yaw = lead.heading - ODOM_T_MAP[2]
+        moved = _drive_straight(pm, xy, yaw, lead.distance)
+        blocked = lead.heading if np.linalg.norm(moved - xy) < lead.distance - 0.3 else None
+        xy = moved
+    fix = b.fix()
+    assert fix is not None
+    np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=1.0)
