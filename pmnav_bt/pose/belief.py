@@ -11,7 +11,9 @@ against it, and a sign the map says is readable but was not read is a likely mis
 
 ``fix`` gives ``map_T_odom`` once one hypothesis cluster dominates; ``lead`` says which
 way to drive along the corridor, in odometry, towards the nearest stretch where the map
-says at least two signs are readable.
+says at least two signs are readable, or, when the belief is split between a few
+clusters (a symmetric corridor's mirror images), to the nearest place where they predict
+different signs.
 """
 
 from __future__ import annotations
