@@ -19,6 +19,10 @@ from pmnav_bt.loading import InputFileError, load_yaml, parse_yaml_value
 from pmnav_bt.planning.graph_planner import MAX_GAP_M
 from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR
 
+# The pixel-goal policy's reliable range (m): its skill eval (docs/pixelnav.md) gives SR 100 %
+# at 1-2 m, 90 % at 2-3 m, 84.6 % at 3-4 m and 64 % at 4-5 m from the door.
+POLICY_RANGE_M = 4.0
+
 
 class _Section(BaseModel):
     # strict: "1" or true is not a number; ranges keep a run finite in time and memory.
@@ -99,6 +103,13 @@ class RefinerConfig(_Section):
     )
     regrounding: int = Field(
         8, ge=1, le=64, description="pixelnav: policy steps between re-groundings of the goal"
+    )
+    policy_range: float = Field(
+        POLICY_RANGE_M,
+        gt=0.0,
+        le=100.0,
+        description="pixelnav: the policy approaches a door at most this far (m) on the map "
+        "when grounded; farther, the map approach (its skill eval: SR >= 84.6 % up to 4 m)",
     )
 
 

@@ -25,6 +25,8 @@ from pmnav_bt.seams import (
 SOUTH = math.radians(-90)
 # 2.8 m from room4's door (1.2, 22), facing it: its sign is readable from here
 START = Pose2D(0.0, 24.5, math.atan2(22.0 - 24.5, 1.2))
+# 1.6 m from the same door on the same line: four steps bring the body to 0.6 m of it
+NEAR = Pose2D(1.2 - 1.6 * math.cos(START.yaw), 22.0 - 1.6 * math.sin(START.yaw), START.yaw)
 
 
 class ScriptedPolicy:
@@ -65,8 +67,8 @@ def grounded(rig, goal="room4"):
 
 
 def test_the_policy_drives_the_approach_step_by_step_until_it_stops(make_rig):
-    rig = make_rig(START)
-    policy = ScriptedPolicy([DiscreteAction.FORWARD] * 3 + [DiscreteAction.TURN_LEFT])
+    rig = make_rig(NEAR)
+    policy = ScriptedPolicy([DiscreteAction.FORWARD] * 4 + [DiscreteAction.TURN_LEFT])
     assert isinstance(policy, PixelGoalPolicy)
     rig.ctx.refiner = policy
     step, choice = grounded(rig)
@@ -74,14 +76,27 @@ def test_the_policy_drives_the_approach_step_by_step_until_it_stops(make_rig):
     seen = rig.run(PolicyApproach("Approach", rig.ctx), max_ticks=200)
     rig.expect(seen, Status.SUCCESS)
     p = rig.true_pose()
-    ahead = (0.75 * math.cos(START.yaw), 24.5 + 0.75 * math.sin(START.yaw))
-    assert math.dist((p.x, p.y), ahead) < 1e-6  # three 0.25 m steps towards the door
-    assert math.isclose(p.yaw, START.yaw + math.radians(30), abs_tol=1e-6)  # one turn left
-    assert policy.acts == 5  # four moves, then STOP
+    ahead = (NEAR.x + 1.0 * math.cos(NEAR.yaw), NEAR.y + 1.0 * math.sin(NEAR.yaw))
+    # four 0.25 m steps towards the door (after facing the grounded mask's centre), one turn
+    assert math.dist((p.x, p.y), ahead) < 0.05
+    assert math.isclose(p.yaw, NEAR.yaw + math.radians(30), abs_tol=math.radians(3))
+    assert policy.acts == 6  # five moves, then STOP: 0.6 m from the door, accepted
     assert rig.stopped()
     # re-grounded in the current frame at the start (regrounding: every 8 steps)
     assert len(policy.resets) == 1 and policy.resets[0][1].mask is not None
     assert all(name.startswith("pmnav-worker") for name in policy.threads)
+
+
+def test_a_stop_short_of_the_door_is_finished_by_the_map_approach(make_rig):
+    rig = make_rig(START)  # 2.8 m from the door; the policy stops after three steps
+    policy = ScriptedPolicy([DiscreteAction.FORWARD] * 3)
+    rig.ctx.refiner = policy
+    step, choice = grounded(rig)
+    rig.set(target=step, choice=choice)
+    rig.expect(rig.run(PolicyApproach("Approach", rig.ctx), max_ticks=600), Status.SUCCESS)
+    assert policy.acts == 4
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), (1.2 - 0.6, 22.0)) < 0.2  # the map's stop point
 
 
 def test_a_landmark_on_the_way_is_approached_on_the_map_not_by_the_policy(make_rig):
@@ -125,3 +140,45 @@ def test_the_tree_approaches_with_the_policy_only_when_the_refiner_is_one(make_r
     )
     rig.ctx.config = coarse
     assert approaches(rig.ctx) == {Approach}  # coarse-only: no refiner, no policy
+
+
+def test_it_turns_to_face_the_door_before_the_policy_drives(make_rig):
+    # The search left the body turned away from where the door was grounded: the turn
+    # is a velocity command (MOVING until face() stops it), so it must not wait on it.
+    rig = make_rig(START)
+    policy = ScriptedPolicy([DiscreteAction.FORWARD])
+    rig.ctx.refiner = policy
+    step, choice = grounded(rig)
+    rig.body.set_pose(Pose2D(START.x, START.y, START.yaw + math.radians(70)))
+    rig.set(target=step, choice=choice)
+    seen = rig.run(PolicyApproach("Approach", rig.ctx), max_ticks=300, until=lambda: policy.acts)
+    assert seen[-1] == Status.RUNNING and policy.acts == 1
+    assert abs(rig.true_pose().yaw - START.yaw) < math.radians(5)  # faced the door first
+
+
+def test_a_door_beyond_the_policy_range_is_approached_on_the_map(make_rig):
+    rig = make_rig(START)  # 2.8 m from the door
+    policy = ScriptedPolicy([DiscreteAction.TURN_LEFT])
+    rig.ctx.refiner = policy
+    cfg = rig.ctx.config
+    refiner = cfg.refiner.model_copy(update={"policy_range": 2.0})
+    rig.ctx.config = cfg.model_copy(update={"refiner": refiner})
+    step, choice = grounded(rig)
+    rig.set(target=step, choice=choice)
+    rig.expect(rig.run(PolicyApproach("Approach", rig.ctx), max_ticks=600), Status.SUCCESS)
+    assert policy.acts == 0
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), (1.2 - 0.6, 22.0)) < 0.2  # the map's stop point
+
+
+def test_a_policy_blocked_at_the_door_has_arrived(make_rig):
+    # Stepping on into the wall by the door: as near as the body gets, not a failure.
+    rig = make_rig(NEAR)
+    policy = ScriptedPolicy([DiscreteAction.FORWARD], forever=True)
+    rig.ctx.refiner = policy
+    step, choice = grounded(rig)
+    rig.set(target=step, choice=choice)
+    rig.expect(rig.run(PolicyApproach("Approach", rig.ctx), max_ticks=600), Status.SUCCESS)
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), (1.2, 22.0)) < 0.8
+    assert rig.body.stats.collisions >= 1
