@@ -47,6 +47,25 @@ class Context:
     trace: list[TraceEvent] = field(default_factory=list)
     budget_actions: int = 500
 
+    @classmethod
+    def wired(
+        cls, base: Base, pm: Any, config: Config, backends: Any, budget: int | None,
+        deferred_work: bool,
+    ) -> Context:  # fmt: skip
+        """The back ends ``backends`` (a ``registry.Backends``) wired to ``base`` and ``pm``,
+        with a fresh Worker and the config's action budget unless ``budget`` is given."""
+        return cls(
+            base=base,
+            pm=pm,
+            config=config,
+            grounder=backends.grounder,
+            coarse=backends.coarse,
+            refiner=backends.refiner,
+            planner=backends.planner,
+            worker=Worker(deferred=deferred_work),
+            budget_actions=budget if budget is not None else config.tree.budget_actions,
+        )
+
     @property
     def limits(self) -> Limits:
         return Limits(self.config.tree.max_linear, self.config.tree.max_angular)

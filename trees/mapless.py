@@ -21,6 +21,8 @@ and approaches it with PM-Nav's drive and stop. It knows the building's sign voc
 
 from __future__ import annotations
 
+import dataclasses
+
 import py_trees
 from py_trees.behaviours import Failure as AlwaysFail
 from py_trees.common import Access
@@ -47,7 +49,6 @@ from pmnav_bt.map.building import Building
 from pmnav_bt.map.signs_only import SignsOnly
 from pmnav_bt.registry import Backends, build_perception
 from pmnav_bt.seams import Base
-from pmnav_bt.worker import Worker
 
 NEAR_M = 2.0  # the door is looked at again from this far before the final approach
 
@@ -68,17 +69,9 @@ def make_mapless_context(
     signs = SignsOnly(building)
     if backends is None:
         backends = build_perception(config, signs, on_robot=on_robot, seed=seed)
-    return Context(
-        base=base,
-        pm=signs,  # type: ignore[arg-type] - a stand-in that refuses everything but signs
-        config=config,
-        grounder=backends.grounder,
-        coarse=backends.coarse,
-        refiner=backends.refiner,
-        planner=None,
-        worker=Worker(deferred=deferred_work),
-        budget_actions=budget if budget is not None else config.tree.budget_actions,
-    )
+    # pm: a stand-in that refuses everything but signs; no planner, even if given one
+    backends = dataclasses.replace(backends, planner=None)
+    return Context.wired(base, signs, config, backends, budget, deferred_work)
 
 
 def build_mapless_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:

@@ -25,7 +25,6 @@ from pmnav_bt.registry import Backends, build_backends
 from pmnav_bt.seams import Base
 from pmnav_bt.trees.pmnav import build_pmnav_tree
 from pmnav_bt.trees.snapshots import SnapshotLogger
-from pmnav_bt.worker import Worker
 
 
 @dataclass
@@ -87,17 +86,7 @@ def make_context(
         )
     if backends is None:
         backends = build_backends(config, pm, on_robot=on_robot, seed=seed)
-    return Context(
-        base=base,
-        pm=pm,
-        config=config,
-        grounder=backends.grounder,
-        coarse=backends.coarse,
-        refiner=backends.refiner,
-        planner=backends.planner,
-        worker=Worker(deferred=deferred_work),
-        budget_actions=budget if budget is not None else config.tree.budget_actions,
-    )
+    return Context.wired(base, pm, config, backends, budget, deferred_work)
 
 
 def build_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
