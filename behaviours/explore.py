@@ -347,9 +347,9 @@ def _new_leg(drive: DriveTo, goal: tuple[float, float]) -> None:
 
 
 class LookAtDoor(PmNavBehaviour):
-    """Face the placed door and ground the goal in a fresh frame; a detection with a mask
-    becomes the ``choice`` (else the old one stands). Reads ``door_odom``, ``goal_entity``;
-    writes ``choice``."""
+    """Face the placed door and ground the goal in a fresh frame; its best detection
+    scoring at least ``SEEN_SCORE`` becomes the ``choice`` (else the old one stands).
+    Reads ``door_odom``, ``goal_entity``; writes ``choice``."""
 
     READS = ("door_odom", "goal_entity")
     WRITES = ("choice",)
