@@ -65,6 +65,7 @@ class UpdateBelief(PmNavBehaviour):
 
     READS = ("views", "belief", "map_T_odom", "pose_tracker")
     WRITES = ("belief",)
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         ctx, views = self.ctx, self.get("views") or []
@@ -94,10 +95,6 @@ class UpdateBelief(PmNavBehaviour):
             f"{len(seen)} sign(s) read, {len(belief.glimpses)} glimpse(s); best {mass:.0%}"
         )
         return Status.SUCCESS
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
 
 
 class FixFromBelief(PmNavBehaviour):
@@ -175,6 +172,8 @@ class FollowLead(PmNavBehaviour):
     """
 
     READS = ("belief", "views")
+    JOBS = ("_job",)
+    STOPS_BASE = True
 
     def __init__(self, name: str, ctx: Context, max_distance: float):
         super().__init__(name, ctx)
@@ -290,10 +289,3 @@ class FollowLead(PmNavBehaviour):
         lim = self.ctx.limits
         base.set_velocity(lim.linear, max(-lim.angular, min(lim.angular, 2.0 * err)))
         return Status.RUNNING
-
-    def terminate(self, new_status: Status) -> None:
-        if getattr(self, "_job", None) is not None:
-            self._job.cancel()
-            self._job = None
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()

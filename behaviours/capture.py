@@ -68,6 +68,8 @@ class CaptureViews(PmNavBehaviour):
 
     READS = ("target", "last_action", "map_T_odom")
     WRITES = ("views",)
+    JOBS = ("_job",)
+    STOPS_BASE = True
 
     def __init__(
         self,
@@ -125,10 +127,3 @@ class CaptureViews(PmNavBehaviour):
             f"view {len(self._views) + 1}: {math.degrees(self._todo[0]):+.0f} deg"
         )
         return Status.RUNNING
-
-    def terminate(self, new_status: Status) -> None:
-        if self._job is not None:
-            self._job.cancel()
-            self._job = None
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()

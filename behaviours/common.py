@@ -53,11 +53,18 @@ class PmNavBehaviour(py_trees.behaviour.Behaviour):
     """A leaf with the shared Context and a blackboard client.
 
     Subclasses list the keys they read and write in READS and WRITES (and in their
-    docstrings); reading an unset key returns None.
+    docstrings); reading an unset key returns None. ``terminate`` is declarative: JOBS
+    names the attributes holding worker jobs, STOPS_BASE says the leaf drives the body.
     """
 
     READS: tuple[str, ...] = ()
     WRITES: tuple[str, ...] = ()
+    # Attributes holding this leaf's Worker jobs: cancelled (and cleared) whenever it ends,
+    # so no result is computed for a behaviour that will not read it.
+    JOBS: tuple[str, ...] = ()
+    # The leaf commands the body: stop it when interrupted (INVALID); a leaf that ends
+    # with SUCCESS or FAILURE has already stopped the body where it had to.
+    STOPS_BASE: bool = False
 
     def __init__(self, name: str, ctx: Context):
         super().__init__(name)
@@ -71,6 +78,16 @@ class PmNavBehaviour(py_trees.behaviour.Behaviour):
             self.bb.register_key(key="failure", access=Access.WRITE)
         if "recovering_from" not in self.WRITES:
             self.bb.register_key(key="recovering_from", access=Access.READ)
+
+    def terminate(self, new_status: Status) -> None:
+        """Cancel the leaf's jobs (``JOBS``); stop the body if interrupted (``STOPS_BASE``)."""
+        for attr in self.JOBS:
+            job = getattr(self, attr, None)
+            if job is not None:
+                job.cancel()
+                setattr(self, attr, None)
+        if self.STOPS_BASE and new_status == Status.INVALID:
+            self.ctx.base.stop()
 
     def get(self, key: str, default=None):
         """A blackboard value, or ``default`` when unset."""

@@ -82,6 +82,7 @@ class RecordViews(PmNavBehaviour):
     Reads ``views``, ``grid``."""
 
     READS = ("views", "grid")
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         views, grid = list(self.get("views") or ()), self.get("grid")
@@ -103,10 +104,6 @@ class RecordViews(PmNavBehaviour):
             return status
         return Status.SUCCESS
 
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
-
 
 class ChooseView(PmNavBehaviour):
     """The coarse-direction back end picks the view that shows the goal (in the worker).
@@ -115,6 +112,7 @@ class ChooseView(PmNavBehaviour):
 
     READS = ("views", "goal_entity")
     WRITES = ("choice",)
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         views, target, coarse = tuple(self.get("views") or ()), goal_entity(self), self.ctx.coarse
@@ -129,10 +127,6 @@ class ChooseView(PmNavBehaviour):
         self.bb.set("choice", choice)
         self.feedback_message = str(choice)
         return Status.SUCCESS
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
 
 
 class ExploreFrontier(DriveTo):
@@ -152,6 +146,7 @@ class ExploreFrontier(DriveTo):
 
     READS = DriveTo.READS + ("grid", "goal_entity")
     WRITES = ("explore_over",)
+    JOBS = DriveTo.JOBS + ("_choice_job",)
 
     def goal(self) -> tuple[float, float]:
         if getattr(self, "_route", None):
@@ -228,11 +223,6 @@ class ExploreFrontier(DriveTo):
             self.bb.set("explore_over", True)
         return status
 
-    def terminate(self, new_status: Status) -> None:
-        if getattr(self, "_choice_job", None) is not None:
-            self._choice_job.cancel()
-        super().terminate(new_status)
-
 
 class PlaceDoor(PmNavBehaviour):
     """Where the goal's door is, in the odometry frame: the refiner's bearing and range
@@ -243,6 +233,7 @@ class PlaceDoor(PmNavBehaviour):
 
     READS = ("choice",)
     WRITES = ("door_odom", "seen_from")
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         choice: CoarseChoice = self.get("choice")
@@ -278,10 +269,6 @@ class PlaceDoor(PmNavBehaviour):
         self.feedback_message = f"door {rng:.1f} m away at {math.degrees(b):+.0f} deg"
         return Status.SUCCESS
 
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
-
 
 class ApproachDoor(DriveTo):
     """Drive to the stop point ``goal_offset`` in front of the door (along the wall's
@@ -289,6 +276,7 @@ class ApproachDoor(DriveTo):
     ``keep`` metres from it. Reads ``door_odom``, ``seen_from``, ``grid``."""
 
     READS = DriveTo.READS + ("door_odom", "seen_from", "grid")
+    JOBS = DriveTo.JOBS + ("_path_job",)
 
     def __init__(self, name: str, ctx: Context, keep: float = 0.0):
         super().__init__(name, ctx)
@@ -333,11 +321,6 @@ class ApproachDoor(DriveTo):
             return Status.RUNNING
         return status
 
-    def terminate(self, new_status: Status) -> None:
-        if getattr(self, "_path_job", None) is not None:
-            self._path_job.cancel()
-        super().terminate(new_status)
-
 
 def _new_leg(drive: DriveTo, goal: tuple[float, float]) -> None:
     """Point a DriveTo at the next waypoint of its route (progress watched afresh)."""
@@ -353,6 +336,8 @@ class LookAtDoor(PmNavBehaviour):
 
     READS = ("door_odom", "goal_entity")
     WRITES = ("choice",)
+    JOBS = ("_job",)
+    STOPS_BASE = True
 
     def initialise(self) -> None:
         p, door = self.ctx.base.pose(), self.get("door_odom")
@@ -380,9 +365,3 @@ class LookAtDoor(PmNavBehaviour):
         else:
             self.feedback_message = "not in the fresh frame: keeping the first placement"
         return Status.SUCCESS
-
-    def terminate(self, new_status: Status) -> None:
-        if getattr(self, "_job", None) is not None:
-            self._job.cancel()
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()

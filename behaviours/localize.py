@@ -58,6 +58,7 @@ class FixPosition(PmNavBehaviour):
 
     READS = ("views", "fix_attempts")
     WRITES = ("map_T_odom", "fix_attempts", "recent_sightings")
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         pm, views = self.ctx.pm, self.get("views") or []
@@ -106,10 +107,6 @@ class FixPosition(PmNavBehaviour):
         )
         return Status.SUCCESS
 
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
-
 
 class Explore(PmNavBehaviour):
     """Explore along the corridor: turn to the most open direction of the last panorama
@@ -120,6 +117,7 @@ class Explore(PmNavBehaviour):
     """
 
     READS = ("views",)
+    STOPS_BASE = True
 
     def __init__(self, name: str, ctx: Context, distance: float):
         super().__init__(name, ctx)
@@ -157,7 +155,3 @@ class Explore(PmNavBehaviour):
             return Status.SUCCESS
         base.set_velocity(v, w)
         return Status.RUNNING
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()

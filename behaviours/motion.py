@@ -40,6 +40,8 @@ class DriveTo(PmNavBehaviour):
 
     READS = ("map_T_odom", "target", "plan", "pose_tracker")
     WRITES = ("map_T_odom", "pose_tracker")
+    JOBS = ("_watch_job",)
+    STOPS_BASE = True
 
     def goal(self) -> tuple[float, float]:
         raise NotImplementedError
@@ -126,13 +128,6 @@ class DriveTo(PmNavBehaviour):
             self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)
             return self.fail(FailureCode.BLOCKED, f"obstacle {free:.1f} m ahead")
         return None
-
-    def terminate(self, new_status: Status) -> None:
-        if getattr(self, "_watch_job", None) is not None:
-            self._watch_job.cancel()
-            self._watch_job = None
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()
 
 
 def _free_ahead(obs, est, goal) -> float | None:
@@ -238,6 +233,7 @@ class TurnOnto(PmNavBehaviour):
     """
 
     READS = ("target", "plan", "map_T_odom")
+    STOPS_BASE = True
 
     def initialise(self) -> None:
         self._heading = out_heading(self.get("plan"), self.get("target"))
@@ -250,10 +246,6 @@ class TurnOnto(PmNavBehaviour):
         self.ctx.log("turn", t.landmark, action=t.action.value)
         return Status.SUCCESS
 
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()
-
 
 class CheckOpening(PmNavBehaviour):
     """Fork choice / turn check: the way now ahead is an open corridor (floor in the band).
@@ -262,6 +254,7 @@ class CheckOpening(PmNavBehaviour):
     """
 
     READS = ("target",)
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         base, grounder = self.ctx.base, self.ctx.grounder
@@ -285,10 +278,6 @@ class CheckOpening(PmNavBehaviour):
             )
         self.feedback_message = f"open (floor {ratios.floor:.2f})"
         return Status.SUCCESS
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
 
 
 class Arrive(PmNavBehaviour):

@@ -27,6 +27,7 @@ class MakePlan(PmNavBehaviour):
 
     READS = ("goal", "map_T_odom", "avoid_landmarks", "blocked_segments")
     WRITES = ("plan", "step_index", "last_action", "target", "recovering_from")
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         self.bb.set("target", None)  # a planning failure belongs to no step
@@ -66,10 +67,6 @@ class MakePlan(PmNavBehaviour):
         if isinstance(err, (PlanningError, UnknownNameError)):
             return Failure(FailureCode.PLANNING_FAILED, str(err))
         return None
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
 
 
 class CheckGoal(PmNavBehaviour):

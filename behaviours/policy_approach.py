@@ -41,6 +41,7 @@ class PolicyApproach(Approach):
     """
 
     READS = (*Approach.READS, "choice")
+    JOBS = Approach.JOBS + ("_job",)
 
     def initialise(self) -> None:
         super().initialise()
@@ -147,9 +148,3 @@ class PolicyApproach(Approach):
             return policy.act(obs)
 
         return job
-
-    def terminate(self, new_status: Status) -> None:
-        if getattr(self, "_job", None) is not None:
-            self._job.cancel()
-            self._job = None
-        super().terminate(new_status)

@@ -81,6 +81,7 @@ class CorrectHeading(PmNavBehaviour):
 
     READS = ("views", "map_T_odom", "pose_tracker")
     WRITES = ("map_T_odom", "pose_tracker")
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         views, grounder = self.get("views") or [], self.ctx.grounder
@@ -116,10 +117,6 @@ class CorrectHeading(PmNavBehaviour):
         self.bb.set("pose_tracker", tracker)
         self.feedback_message = f"heading {math.degrees(turn):+.1f} deg from the walls"
         return Status.SUCCESS
-
-    def terminate(self, new_status) -> None:
-        if getattr(self, "_job", None) is not None and new_status.name == "INVALID":
-            self._job.cancel()
 
 
 # -- keeping to the corridor while driving -------------------------------------------------

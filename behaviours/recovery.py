@@ -47,6 +47,8 @@ class BackUp(PmNavBehaviour):
     an obstacle. SUCCESS when covered, or when the body cannot reverse further (best effort).
     """
 
+    STOPS_BASE = True
+
     def __init__(self, name: str, ctx: Context, distance: float = BACKUP_LIMIT_M):
         super().__init__(name, ctx)
         self.distance = min(distance, BACKUP_LIMIT_M)
@@ -75,13 +77,11 @@ class BackUp(PmNavBehaviour):
         self._sent = True
         return Status.RUNNING
 
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()
-
 
 class Spin(PmNavBehaviour):
     """Turn on the spot by ``angle`` (rad, counter-clockwise positive): look round."""
+
+    STOPS_BASE = True
 
     def __init__(self, name: str, ctx: Context, angle: float):
         super().__init__(name, ctx)
@@ -95,10 +95,6 @@ class Spin(PmNavBehaviour):
 
     def update(self) -> Status:
         return Status.SUCCESS if self.face(self._goal) else Status.RUNNING
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()
 
 
 class FaceCorridor(Spin):

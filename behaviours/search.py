@@ -56,6 +56,7 @@ class CoarseDirection(PmNavBehaviour):
 
     READS = ("views", "target")
     WRITES = ("choice",)
+    JOBS = ("_job",)
 
     def initialise(self) -> None:
         views, target, coarse = tuple(self.get("views") or ()), target_entity(self), self.ctx.coarse
@@ -85,10 +86,6 @@ class CoarseDirection(PmNavBehaviour):
         )
         return Status.SUCCESS
 
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
-
 
 class Ground(PmNavBehaviour):
     """Grounding: face the coarse direction and ground the target in a fresh frame.
@@ -101,6 +98,8 @@ class Ground(PmNavBehaviour):
 
     READS = ("choice", "target")
     WRITES = ("choice",)
+    JOBS = ("_job",)
+    STOPS_BASE = True
 
     def initialise(self) -> None:
         choice: CoarseChoice = self.get("choice")
@@ -137,12 +136,6 @@ class Ground(PmNavBehaviour):
             self.feedback_message = "not in the fresh frame: keeping the coarse view's detection"
         return Status.SUCCESS
 
-    def terminate(self, new_status: Status) -> None:
-        if getattr(self, "_job", None) is not None:
-            self._job.cancel()
-        if new_status == Status.INVALID:
-            self.ctx.base.stop()
-
 
 class FineDirection(PmNavBehaviour):
     """Refine the bearing to the target and place it in the odometry frame.
@@ -158,6 +151,7 @@ class FineDirection(PmNavBehaviour):
 
     READS = ("choice", "target", "map_T_odom")
     WRITES = ("bearing", "sighting")
+    JOBS = ("_job",)
 
     def __init__(self, name: str, ctx, refine: bool = True):
         super().__init__(name, ctx)
@@ -197,10 +191,6 @@ class FineDirection(PmNavBehaviour):
         )
         self.feedback_message = f"{t.look_for} at {math.degrees(bearing):+.1f} deg"
         return Status.SUCCESS
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and getattr(self, "_job", None) is not None:
-            self._job.cancel()
 
 
 class Verify(PmNavBehaviour):
