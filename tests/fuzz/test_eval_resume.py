@@ -4,15 +4,13 @@ one line when the config changed."""
 
 from __future__ import annotations
 
-import contextlib
-import json
 import os
 import signal
 import subprocess
 import sys
-import time
 
 import pytest
+from evalproc import eval_argv, rows, running, wait_for_rows
 
 pytestmark = [
     pytest.mark.timeout(240),
@@ -22,59 +20,16 @@ pytestmark = [
 N = 5
 
 
-def _cmd(out, *more):
-    return [
-        sys.executable,
-        "-m",
-        "pmnav_bt.experiments.cli",
-        "sim",
-        "eval",
-        "--building",
-        "straight_office",
-        "--tier",
-        "easy",
-        "-n",
-        str(N),
-        "--variants",
-        "pmnav",
-        "--set",
-        "grounder.backend=sim_gt",  # the oracle: fast episodes
-        "--jobs",
-        "1",
-        "--out",
-        str(out),
-        *more,
-    ]
-
-
 def _keys(path) -> list[str]:
-    try:
-        text = path.read_text()
-    except OSError:
-        return []
-    keys = []
-    for line in text.splitlines():
-        with contextlib.suppress(ValueError):  # the torn tail
-            keys.append(json.loads(line)["key"])
-    return keys
+    return [r["key"] for r in rows(path)]
 
 
 def test_sigint_keeps_a_partial_table_and_resume_runs_only_the_rest(tmp_path):
     out = tmp_path / "eval"
-    proc = subprocess.Popen(
-        _cmd(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        start_new_session=True,
-    )  # fmt: skip
-    try:
-        deadline = time.monotonic() + 120
-        while len(_keys(out / "results.jsonl")) < 2 and time.monotonic() < deadline:
-            assert proc.poll() is None, proc.communicate()
-            time.sleep(0.1)
+    with running(eval_argv(out, N, 1)) as proc:
+        wait_for_rows(proc, out / "results.jsonl", 2)
         os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C: the whole process group
         _, err = proc.communicate(timeout=60)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
     assert proc.returncode == 130 and "Traceback" not in err
     first = _keys(out / "results.jsonl")
     assert 2 <= len(first) < N and len(set(first)) == len(first)
@@ -83,7 +38,9 @@ def test_sigint_keeps_a_partial_table_and_resume_runs_only_the_rest(tmp_path):
     assert f"partial: stopped by SIGINT, {len(first)} of {N} runs" in table
     assert "| easy |" in table
 
-    done = subprocess.run(_cmd(out, "--resume"), capture_output=True, text=True, timeout=180)
+    done = subprocess.run(
+        eval_argv(out, N, 1, "--resume"), capture_output=True, text=True, timeout=180
+    )
     assert done.returncode == 0, done.stderr
     assert f"{len(first)} of {N} runs done" in done.stderr
     keys = _keys(out / "results.jsonl")
@@ -91,7 +48,7 @@ def test_sigint_keeps_a_partial_table_and_resume_runs_only_the_rest(tmp_path):
     assert "partial" not in (out / "results.md").read_text()
 
     changed = subprocess.run(
-        _cmd(out, "--resume", "--set", "sim.width=200"), capture_output=True, text=True
+        eval_argv(out, N, 1, "--resume", "--set", "sim.width=200"), capture_output=True, text=True
     )
     assert changed.returncode == 2
     assert len(changed.stderr.strip().splitlines()) == 1
