@@ -8,6 +8,7 @@ import math
 import sys
 import time
 from pathlib import Path
+from typing import NoReturn
 
 import typer
 
@@ -327,25 +328,15 @@ def eval_(
     header = eval_header(building, tier, n, seed, cfg, configs)
     results = {k: v for k, v in run.results.items() if v}
     if run.stopped_by:
-        if results:
-            save_evaluation(
-                results,
-                out,
-                header.replace(
-                    "# PM-Nav evaluation",
-                    "# PM-Nav evaluation "
-                    f"(partial: stopped by {run.stopped_by}, {sum(map(len, results.values()))} of "
-                    f"{run.total} runs)",
-                    1,
-                ),
-            )
-            typer.echo(comparison_markdown(results), err=True)
-        typer.echo(
-            f"pmnav: stopped by {run.stopped_by} after {run.resumed + run.new} of {run.total} "
-            f"episodes; finished ones are in {out / 'results.jsonl'} (go on with --resume)",
-            err=True,
-        )
-        raise typer.Exit(run.exit_code)
+
+        def keep_partial() -> str:
+            done = sum(map(len, results.values()))
+            note = f"(partial: stopped by {run.stopped_by}, {done} of {run.total} runs)"
+            title = "# PM-Nav evaluation"
+            save_evaluation(results, out, header.replace(title, f"{title} {note}", 1))
+            return comparison_markdown(results)
+
+        _stopped(run, out, run.resumed + run.new, "episodes", keep_partial if results else None)
     md = save_evaluation(results, out, header)
     typer.echo(comparison_markdown(results))
     typer.echo(f"wrote {md} and {out / 'results.json'}")
@@ -359,6 +350,20 @@ def eval_(
             err=True,
         )
         raise typer.Exit(1)
+
+
+def _stopped(run, out: Path, done: int, unit: str, keep_partial) -> NoReturn:
+    """End a run stopped by a signal: save and show the partial table (``keep_partial``
+    writes it and returns its text; None when nothing finished), say where the finished
+    rows are and how to go on, and exit with the signal's status (130, 143)."""
+    if keep_partial is not None:
+        typer.echo(keep_partial(), err=True)
+    typer.echo(
+        f"pmnav: stopped by {run.stopped_by} after {done} of {run.total} {unit}; finished "
+        f"ones are in {out / 'results.jsonl'} (go on with --resume)",
+        err=True,
+    )
+    raise typer.Exit(run.exit_code)
 
 
 @app.command("table3")
@@ -416,15 +421,12 @@ def table3(
         "of the truth. SDF = S * 2 / max(2, d), d = panoramas taken."
     )
     if run.stopped_by:
-        if results:
+
+        def keep_partial() -> str:
             save(results, out, header + f"\n\nPARTIAL: stopped by {run.stopped_by}.")
-            typer.echo(table(results), err=True)
-        typer.echo(
-            f"pmnav: stopped by {run.stopped_by} after {len(results)} of {run.total} runs; "
-            f"finished ones are in {out / 'results.jsonl'} (go on with --resume)",
-            err=True,
-        )
-        raise typer.Exit(run.exit_code)
+            return table(results)
+
+        _stopped(run, out, len(results), "runs", keep_partial if results else None)
     md = save(results, out, header)
     typer.echo(header)
     typer.echo(table(results))

@@ -59,3 +59,25 @@ def test_eval_interrupted_keeps_finished_episodes(tmp_path, signame, jobs):
     assert len(saved["pmnav"]) == len(done)
     time.sleep(0.5)
     assert _session(proc.pid) == [], "processes left behind"
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="process groups")
+def test_table3_interrupted_keeps_a_partial_table(tmp_path):
+    TRIED["sim table3: interrupted mid-run"] += 1
+    out = tmp_path / "t3"
+    argv = [
+        sys.executable, "-m", "pmnav_bt.experiments.cli", "sim", "table3",
+        "--building", "straight_office", "-n", "3", "--set", "grounder.backend=sim_gt",
+        "--out", str(out),
+    ]  # fmt: skip
+    with running(argv) as proc:
+        wait_for_rows(proc, out / "results.jsonl", 1)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in err
+    done = rows(out / "results.jsonl")
+    last = err.strip().splitlines()[-1]
+    assert f"stopped by SIGINT after {len(done)} of " in last and "--resume" in last
+    total = int(last.split(" of ")[1].split()[0])
+    assert 1 <= len(done) < total
+    assert "PARTIAL: stopped by SIGINT" in (out / "results.md").read_text()
