@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 
 import py_trees
 import pytest
-from py_trees.common import Access, Status
+from blackboard_kit import BlackboardAccess, cleared, writer
+from py_trees.common import Status
 
-from pmnav_bt.behaviours.common import KEYS, NAMESPACE
 from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.config import load_config
 from pmnav_bt.geometry import wrap_angle
@@ -34,7 +34,7 @@ PARK = Pose2D(-500.0, -500.0, 0.0)  # where a finished test's body is left, out 
 
 
 @dataclass
-class Rig:
+class Rig(BlackboardAccess):
     """One behaviour under test, against the real simulator."""
 
     world: SimWorld
@@ -46,17 +46,6 @@ class Rig:
     obstacles: list[int] = field(default_factory=list)
 
     # -- blackboard -------------------------------------------------------------------------
-
-    def set(self, **values) -> None:
-        for k, v in values.items():
-            self.bb.set(k, v)
-
-    def get(self, key: str):
-        return self.bb.get(key) if self.bb.exists(key) else None
-
-    @property
-    def failure(self):
-        return self.get("failure")
 
     # -- time -------------------------------------------------------------------------------
 
@@ -143,9 +132,7 @@ def pm(world):
 
 @pytest.fixture(autouse=True)
 def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
+    yield from cleared()
 
 
 @pytest.fixture
@@ -168,9 +155,7 @@ def make_rig(world, pm, clean_blackboard):
         body = SimBase(world, pose=pose, width=width, height=height, segmentation=segmentation)
         base = body if noise is None else NoisyOdometry(body, noise, seed=seed)
         ctx = make_context(base, pm, load_config(overrides=[ORACLE, *overrides]), seed, budget)
-        bb = py_trees.blackboard.Client(name="test", namespace=NAMESPACE)
-        for key in KEYS:
-            bb.register_key(key=key, access=Access.WRITE)
+        bb = writer()
         rig = Rig(world, body, base, ctx, pm, bb)
         made.append(rig)
         return rig

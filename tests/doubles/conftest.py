@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 
 import py_trees
 import pytest
-from py_trees.common import Access, Status
+from blackboard_kit import BlackboardAccess, cleared, writer
+from py_trees.common import Status
 
-from pmnav_bt.behaviours.common import KEYS, NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.config import load_config
 from pmnav_bt.map.building import load_building
@@ -35,7 +35,7 @@ PERIOD = 0.1
 
 
 @dataclass
-class DoubleRig:
+class DoubleRig(BlackboardAccess):
     base: FakeBase
     pm: PrioriMap
     ctx: Context
@@ -45,17 +45,6 @@ class DoubleRig:
     refiner: FakeRefiner
     planner: FakePlanner
     seen: list[Status] = field(default_factory=list)
-
-    def set(self, **values) -> None:
-        for k, v in values.items():
-            self.bb.set(k, v)
-
-    def get(self, key: str):
-        return self.bb.get(key) if self.bb.exists(key) else None
-
-    @property
-    def failure(self):
-        return self.get("failure")
 
     def run(self, b: py_trees.behaviour.Behaviour, max_ticks: int = 2000) -> list[Status]:
         """Tick ``b`` until it ends: the status after each tick (the runner's loop)."""
@@ -81,9 +70,7 @@ def priori_map(name: str) -> PrioriMap:
 
 @pytest.fixture(autouse=True)
 def clean_blackboard():
-    py_trees.blackboard.Blackboard.clear()
-    yield
-    py_trees.blackboard.Blackboard.clear()
+    yield from cleared()
 
 
 @pytest.fixture
@@ -111,9 +98,7 @@ def rig():
         )
         cfg = load_config(overrides=[ORACLE, *overrides])
         ctx = make_context(base, pm, cfg, deferred_work=deferred, backends=backends)
-        bb = py_trees.blackboard.Client(name="test", namespace=NAMESPACE)
-        for key in KEYS:
-            bb.register_key(key=key, access=Access.WRITE)
+        bb = writer()
         r = DoubleRig(
             base,
             pm,
