@@ -129,7 +129,35 @@ class ChooseView(PmNavBehaviour):
         return Status.SUCCESS
 
 
-class ExploreFrontier(DriveTo):
+class RouteDrive(DriveTo):
+    """A DriveTo along a route of waypoints (odometry frame), one leg at a time: a
+    subclass hands the route to ``follow`` and calls ``next_leg`` when a leg succeeds."""
+
+    def goal(self) -> tuple[float, float]:
+        if getattr(self, "_route", None):
+            return self._route[0]
+        p = self.ctx.base.pose()
+        return p.x, p.y
+
+    def initialise(self) -> None:
+        self._route: list[tuple[float, float]] = []
+        super().initialise()
+
+    def follow(self, route) -> None:
+        """Drive along ``route`` (at least one waypoint) from its first waypoint."""
+        self._route = list(route)
+        self.aim_at(self._route[0])
+
+    def next_leg(self) -> bool:
+        """Drop the waypoint reached and aim at the next; False when the route is done."""
+        self._route.pop(0)
+        if not self._route:
+            return False
+        self.aim_at(self._route[0])
+        return True
+
+
+class ExploreFrontier(RouteDrive):
     """Drive to the best frontier of the grid (``ExplorationGrid.choose``) along its path,
     marking where the robot goes as visited and adding what each watch frame's depth shows;
     stop early when the goal is seen on the way (SUCCESS: look around again).
@@ -146,16 +174,9 @@ class ExploreFrontier(DriveTo):
 
     READS = DriveTo.READS + ("grid", "goal_entity")
     WRITES = ("explore_over",)
-    JOBS = DriveTo.JOBS + ("_choice_job",)
-
-    def goal(self) -> tuple[float, float]:
-        if getattr(self, "_route", None):
-            return self._route[0]
-        p = self.ctx.base.pose()
-        return p.x, p.y
+    JOBS = RouteDrive.JOBS + ("_choice_job",)
 
     def initialise(self) -> None:
-        self._route: list[tuple[float, float]] = []
         super().initialise()
         grid: ExplorationGrid = self.get("grid")
         p = self.ctx.base.pose()
@@ -195,8 +216,7 @@ class ExploreFrontier(DriveTo):
                     f"{self._entity} never seen: no frontier left to explore ({seen:.0f} m2 seen)",
                 )
             self._choice = choice
-            self._route = list(choice.path)
-            _new_leg(self, self._route[0])
+            self.follow(choice.path)
             self.ctx.log("frontier", "", target=list(choice.target), cost=choice.cost)
             self.feedback_message = f"frontier {choice.cost:.1f} m away"
         p = self.ctx.base.pose()
@@ -206,13 +226,11 @@ class ExploreFrontier(DriveTo):
             return Status.SUCCESS
         status = super().update()
         if status == Status.SUCCESS:
-            self._route.pop(0)
-            if not self._route:
-                self._grid.mark_spent(self._choice.target)
-                self._grid.blocked_in_a_row = 0
-                return Status.SUCCESS
-            _new_leg(self, self._route[0])
-            return Status.RUNNING
+            if self.next_leg():
+                return Status.RUNNING
+            self._grid.mark_spent(self._choice.target)
+            self._grid.blocked_in_a_row = 0
+            return Status.SUCCESS
         if status == Status.FAILURE:
             failure = self.get("failure")
             if failure is not None and failure.code == FailureCode.BLOCKED:
@@ -270,13 +288,13 @@ class PlaceDoor(PmNavBehaviour):
         return Status.SUCCESS
 
 
-class ApproachDoor(DriveTo):
+class ApproachDoor(RouteDrive):
     """Drive to the stop point ``goal_offset`` in front of the door (along the wall's
     normal from the grid) on the grid's path there (round a desk or a corner), or until
     ``keep`` metres from it. Reads ``door_odom``, ``seen_from``, ``grid``."""
 
     READS = DriveTo.READS + ("door_odom", "seen_from", "grid")
-    JOBS = DriveTo.JOBS + ("_path_job",)
+    JOBS = RouteDrive.JOBS + ("_path_job",)
 
     def __init__(self, name: str, ctx: Context, keep: float = 0.0):
         super().__init__(name, ctx)
@@ -288,14 +306,7 @@ class ApproachDoor(DriveTo):
         off = self.ctx.config.tree.goal_offset
         return door[0] + off * nx, door[1] + off * ny
 
-    def goal(self) -> tuple[float, float]:
-        if getattr(self, "_route", None):
-            return self._route[0]
-        p = self.ctx.base.pose()
-        return p.x, p.y
-
     def initialise(self) -> None:
-        self._route: list[tuple[float, float]] = []
         super().initialise()
         self._stop = self.stop_point()
         grid, p, stop = self.get("grid"), self.ctx.base.pose(), self._stop
@@ -307,26 +318,16 @@ class ApproachDoor(DriveTo):
             status, path = self.poll(self._path_job, "planning the approach")
             if status is not None:
                 return status
-            self._route = path or [self._stop]  # no known way: straight, watching depth
+            self.follow(path or [self._stop])  # no known way: straight, watching depth
             self._planned = True
-            _new_leg(self, self._route[0])
         p = self.ctx.base.pose()
         if self.keep > 0.0 and math.dist((p.x, p.y), self._stop) <= self.keep:
             self.ctx.base.set_velocity(0.0, 0.0)
             return Status.SUCCESS
         status = super().update()
-        if status == Status.SUCCESS and len(self._route) > 1:
-            self._route.pop(0)
-            _new_leg(self, self._route[0])
+        if status == Status.SUCCESS and self.next_leg():
             return Status.RUNNING
         return status
-
-
-def _new_leg(drive: DriveTo, goal: tuple[float, float]) -> None:
-    """Point a DriveTo at the next waypoint of its route (progress watched afresh)."""
-    drive._goal = goal
-    drive._best, drive._best_t = math.inf, drive.ctx.now()
-    drive._bumps = 0
 
 
 class LookAtDoor(PmNavBehaviour):

@@ -61,6 +61,12 @@ class DriveTo(PmNavBehaviour):
         self._watch_job = None
         self._watch_t = -math.inf
 
+    def aim_at(self, goal: tuple[float, float]) -> None:
+        """Drive to ``goal`` from here on, progress watched afresh (a route's next leg)."""
+        self._goal = goal
+        self._best, self._best_t = math.inf, self.ctx.now()
+        self._bumps = 0
+
     def estimate(self):
         return map_pose(self.get("map_T_odom"), self.ctx.base.pose())
 
