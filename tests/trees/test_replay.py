@@ -8,6 +8,7 @@ import math
 
 import py_trees
 import pytest
+from countdown import Countdown
 from py_trees.common import Status
 from rich.console import Console
 from typer.testing import CliRunner
@@ -15,25 +16,6 @@ from typer.testing import CliRunner
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.trees.cli import app, load_replay, print_ticks
 from pmnav_bt.trees.snapshots import Replay, SnapshotLogger
-
-
-class Countdown(py_trees.behaviour.Behaviour):
-    """RUNNING ``n`` ticks ("k to go"), then SUCCESS ("done")."""
-
-    def __init__(self, name: str, n: int):
-        super().__init__(name)
-        self.n = n
-
-    def initialise(self) -> None:
-        self.left = self.n
-
-    def update(self) -> Status:
-        if self.left == 0:
-            self.feedback_message = "done"
-            return Status.SUCCESS
-        self.feedback_message = f"{self.left} to go"
-        self.left -= 1
-        return Status.RUNNING
 
 
 def small_tree() -> py_trees.trees.BehaviourTree:
