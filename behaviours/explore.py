@@ -16,6 +16,7 @@ from pmnav_bt.behaviours.capture import CaptureViews
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, thumbnail
 from pmnav_bt.behaviours.motion import DriveTo
+from pmnav_bt.behaviours.search import FaceAndGround
 from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import heading, se2_apply
@@ -330,39 +331,18 @@ class ApproachDoor(RouteDrive):
         return status
 
 
-class LookAtDoor(PmNavBehaviour):
+class LookAtDoor(FaceAndGround):
     """Face the placed door and ground the goal in a fresh frame; its best detection
     scoring at least ``SEEN_SCORE`` becomes the ``choice`` (else the old one stands).
     Reads ``door_odom``, ``goal_entity``; writes ``choice``."""
 
     READS = ("door_odom", "goal_entity")
-    WRITES = ("choice",)
-    JOBS = ("_job",)
-    STOPS_BASE = True
+    ACTIVITY = "looking at the door"
+    KEPT = "not in the fresh frame: keeping the first placement"
 
-    def initialise(self) -> None:
-        p, door = self.ctx.base.pose(), self.get("door_odom")
-        self._yaw = heading((p.x, p.y), door)
-        self._job = None
+    def aim(self) -> tuple[float, Entity | None]:
+        p = self.ctx.base.pose()
+        return heading((p.x, p.y), self.get("door_odom")), goal_entity(self)
 
-    def update(self) -> Status:
-        if self._job is None:
-            if not self.face(self._yaw):
-                return Status.RUNNING
-            base, grounder, target = self.ctx.base, self.ctx.grounder, goal_entity(self)
-            self._job = self.ctx.worker.submit(
-                lambda c: (lambda obs: (obs, tuple(grounder.detect(obs, target))))(base.observe())
-            )
-            return Status.RUNNING
-        status, taken = self.poll(self._job, "looking at the door")
-        if status is not None:
-            return status
-        obs, dets = taken
-        seen = [d for d in dets if d.score >= SEEN_SCORE]
-        if seen:
-            best = max(seen, key=lambda d: d.score)
-            self.bb.set("choice", CoarseChoice(View(0.0, obs, dets), best))
-            self.feedback_message = f"seen again, score {best.score:.2f}"
-        else:
-            self.feedback_message = "not in the fresh frame: keeping the first placement"
-        return Status.SUCCESS
+    def accept(self, detection) -> bool:
+        return detection.score >= SEEN_SCORE

@@ -87,33 +87,37 @@ class CoarseDirection(PmNavBehaviour):
         return Status.SUCCESS
 
 
-class Ground(PmNavBehaviour):
-    """Grounding: face the coarse direction and ground the target in a fresh frame.
+class FaceAndGround(PmNavBehaviour):
+    """Face a heading, then ground a target in a fresh frame (in the worker, which skips
+    the detection once cancelled). The best detection ``accept`` takes becomes ``choice``
+    with the new frame; if none, the old ``choice`` stands. SUCCESS either way.
 
-    Reads ``choice``, ``target``; writes ``choice`` (the new frame and its best detection,
-    with a mask). Facing the target keeps its mask off the image border, where a cut-off
-    mask would bias the bearing and range. If the fresh frame misses the target, the
-    coarse view's detection stands.
+    Subclasses say where to look and for what (``aim``) and which detections count
+    (``accept``). Writes ``choice``.
     """
 
-    READS = ("choice", "target")
     WRITES = ("choice",)
     JOBS = ("_job",)
     STOPS_BASE = True
+    ACTIVITY = "grounding the target"  # what a failed job was doing
+    KEPT = "not in the fresh frame: keeping the earlier detection"
+
+    def aim(self) -> tuple[float, Entity | None]:
+        """The heading to face (rad, odometry frame) and what to ground there."""
+        raise NotImplementedError
+
+    def accept(self, detection) -> bool:
+        raise NotImplementedError
 
     def initialise(self) -> None:
-        choice: CoarseChoice = self.get("choice")
-        obs, det = choice.view.observation, choice.detection
-        self._yaw = obs.pose.yaw + obs.intrinsics.pixel_bearing(det.centre[0])
-        self._target = target_entity(self) or det.entity
+        self._yaw, self._target = self.aim()
         self._job = None
 
     def update(self) -> Status:
-        base = self.ctx.base
         if self._job is None:
             if not self.face(self._yaw):
                 return Status.RUNNING
-            target, grounder = self._target, self.ctx.grounder
+            base, grounder, target = self.ctx.base, self.ctx.grounder, self._target
 
             def take(cancelled):
                 obs = base.observe()
@@ -123,18 +127,40 @@ class Ground(PmNavBehaviour):
 
             self._job = self.ctx.worker.submit(take)
             return Status.RUNNING
-        status, taken = self.poll(self._job, "grounding the target")
+        status, taken = self.poll(self._job, self.ACTIVITY)
         if status is not None:
             return status
         obs, dets = taken
-        masked = [d for d in dets if d.mask is not None]
-        if masked:
-            best = max(masked, key=lambda d: d.score)
+        accepted = [d for d in dets if self.accept(d)]
+        if accepted:
+            best = max(accepted, key=lambda d: d.score)
             self.bb.set("choice", CoarseChoice(View(0.0, obs, dets), best))
-            self.feedback_message = f"grounded, score {best.score:.2f}"
+            self.feedback_message = f"seen in the fresh frame, score {best.score:.2f}"
         else:
-            self.feedback_message = "not in the fresh frame: keeping the coarse view's detection"
+            self.feedback_message = self.KEPT
         return Status.SUCCESS
+
+
+class Ground(FaceAndGround):
+    """Grounding: face the coarse direction and ground the target in a fresh frame.
+
+    Reads ``choice``, ``target``; writes ``choice`` (the new frame and its best detection,
+    with a mask). Facing the target keeps its mask off the image border, where a cut-off
+    mask would bias the bearing and range. If the fresh frame misses the target, the
+    coarse view's detection stands.
+    """
+
+    READS = ("choice", "target")
+    KEPT = "not in the fresh frame: keeping the coarse view's detection"
+
+    def aim(self) -> tuple[float, Entity | None]:
+        choice: CoarseChoice = self.get("choice")
+        obs, det = choice.view.observation, choice.detection
+        yaw = obs.pose.yaw + obs.intrinsics.pixel_bearing(det.centre[0])
+        return yaw, target_entity(self) or det.entity
+
+    def accept(self, detection) -> bool:
+        return detection.mask is not None
 
 
 class FineDirection(PmNavBehaviour):
