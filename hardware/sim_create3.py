@@ -7,7 +7,7 @@ against a Create 3:
 
 - in ``cmd_vel`` (geometry_msgs/Twist); like the robot it stops ``cmd_timeout``
   (0.5 s) after the last command, and with ``safety_override: none`` reverses at most
-  its backup limit (0.15 m, refilled by driving forward; ``backup_limit.py``);
+  its backup limit (0.15 m, refilled by driving forward; ``pmnav_bt/backup_limit.py``);
 - out ``odom`` (nav_msgs/Odometry, ``odom_rate_hz``): odom -> base_link; with
   ``odom_at_origin`` (default) the odometry frame starts at the start pose, as a
   Create 3's does where it boots;
@@ -34,7 +34,7 @@ import time
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
-from pmnav_bt.hardware.backup_limit import BackupBuffer
+from pmnav_bt.backup_limit import BackupBuffer
 from pmnav_bt.seams import CAMERA_HEIGHT_M, Pose2D
 
 PARAMETERS = {
@@ -106,6 +106,7 @@ class SimCreate3:
             hfov=math.radians(float(p["hfov_deg"])),
             camera_height=float(p["camera_height"]),
             segmentation=bool(p["publish_segmentation"]),
+            backup_limit=None,  # kept below from odometry, as the robot keeps it
         )
         self.base = NoisyOdometry(self.inner, float(p["odometry_noise"]), seed=int(p["seed"]))
         self.backup = BackupBuffer()

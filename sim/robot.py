@@ -6,7 +6,9 @@ velocity, and a translation that would make the body's cylinder touch a wall,
 door, landmark or obstacle is cut at the contact point (bisection to 0.1 mm), which
 ends the motion as BLOCKED. A collision event is counted once, when the body first
 touches something; it ends when the body is 1 cm clear again. Turning in place never
-collides (the body is a round cylinder).
+collides (the body is a round cylinder). Like the Create 3 (``safety_override: none``)
+it reverses only within its backup buffer (``pmnav_bt.backup_limit``): at most 0.15 m
+over floor it has just driven forward over; a reverse beyond it stops as BLOCKED.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from pmnav_bt.backup_limit import BACKUP_LIMIT_M, BackupBuffer
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.seams import (
     CAMERA_HEIGHT_M,
@@ -58,7 +61,8 @@ class SimBase:
 
     ``width``/``height``/``hfov`` set the camera; ``depth``/``segmentation`` choose what
     ``observe`` renders besides RGB. The body starts at ``pose`` (default: the world's
-    start pose).
+    start pose). ``backup_limit``: metres it may reverse after driving forward (None: no
+    limit, as with the Create 3's ``safety_override: backup_only``).
     """
 
     def __init__(
@@ -76,6 +80,7 @@ class SimBase:
         radius: float = RADIUS,
         max_linear: float = MAX_LINEAR,
         max_angular: float = MAX_ANGULAR,
+        backup_limit: float | None = BACKUP_LIMIT_M,
     ) -> None:
         self.world = world
         self.clock = clock if clock is not None else SimClock()
@@ -87,6 +92,7 @@ class SimBase:
         self.max_linear = max_linear
         self.max_angular = max_angular
         self.stats = MotionStats()
+        self.backup = None if backup_limit is None else BackupBuffer(limit=backup_limit)
         self._pose = pose if pose is not None else world.start_pose()
         self._status = MotionStatus.IDLE
         self._step: DiscreteAction | None = None
@@ -136,6 +142,10 @@ class SimBase:
         w = max(-self.max_angular, min(self.max_angular, float(angular)))
         with self.world.lock:
             self._step = None
+            if v < 0.0 and self.backup is not None and self.backup.left <= 0.0:
+                self._cmd = (0.0, 0.0)  # refused, as the robot refuses it (BACKUP_LIMIT)
+                self._status = MotionStatus.BLOCKED
+                return
             self._cmd = (v, w)
             self._status = MotionStatus.MOVING if (v or w) else MotionStatus.IDLE
 
@@ -163,6 +173,8 @@ class SimBase:
             self._cmd = (0.0, 0.0)
             self._status = MotionStatus.IDLE
             self._in_contact = False
+            if self.backup is not None:
+                self.backup.reset()  # put down somewhere new
             self._sync_body()
 
     def execute(self, action: DiscreteAction, timeout: float = 30.0) -> MotionStatus:
@@ -234,9 +246,13 @@ class SimBase:
                 v, w = self._cmd
                 self._rotate(w * h / 2.0)
                 want = v * h
+                if want < 0.0 and self.backup is not None:
+                    want = max(want, -self.backup.left)  # the backup buffer's end
                 moved = self._translate(want)
                 self._rotate(w * h / 2.0)
-                if abs(moved) < abs(want) - 1e-12:
+                if self.backup is not None:
+                    self.backup.left = min(self.backup.limit, self.backup.left + moved)
+                if abs(moved) < abs(v * h) - 1e-12:
                     self._cmd = (0.0, 0.0)
                     self._status = MotionStatus.BLOCKED
             else:
@@ -248,6 +264,8 @@ class SimBase:
             want = min(self.max_linear * h, self._remaining)
             moved = self._translate(want)
             self._remaining -= moved
+            if self.backup is not None:
+                self.backup.left = min(self.backup.limit, self.backup.left + moved)
             if moved < want - 1e-12:
                 self._step = None
                 self._status = MotionStatus.BLOCKED

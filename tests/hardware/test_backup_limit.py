@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from pmnav_bt.hardware.backup_limit import BACKUP_LIMIT_M, BackupBuffer
+from pmnav_bt.backup_limit import BACKUP_LIMIT_M, BackupBuffer
 from pmnav_bt.seams import Pose2D
 
 

@@ -306,7 +306,7 @@ def test_create3_base_over_dds(domain_id, tmp_path):
     without frames."""
     from rclpy.node import Node
 
-    from pmnav_bt.hardware.backup_limit import BACKUP_LIMIT_M
+    from pmnav_bt.backup_limit import BACKUP_LIMIT_M
     from pmnav_bt.hardware.create3 import Create3Base, Create3Options, SensorTimeoutError
     from pmnav_bt.hardware.runtime import RosRuntime
     from pmnav_bt.hardware.testing import Probe

@@ -8,6 +8,7 @@ import threading
 import numpy as np
 import pytest
 
+from pmnav_bt.backup_limit import BACKUP_LIMIT_M
 from pmnav_bt.seams import (
     FORWARD_STEP_M,
     TURN_STEP_RAD,
@@ -95,10 +96,12 @@ def test_driving_into_a_wall_stops_at_the_wall_with_one_collision(base):
     assert base.stats.collisions == 1
     assert base.stats.actions == 8
     assert base.stats.path_length == pytest.approx(1.2 - RADIUS, abs=1e-3)
-    # Backing off and driving in again is a second collision event.
+    # Backing off (as far as the backup buffer allows) and driving in again is a second
+    # collision event.
     base.set_velocity(-0.2, 0.0)
     base.clock.wait(1.0)
-    assert base.pose().x == pytest.approx(1.2 - RADIUS - 0.2, abs=2e-3)
+    assert base.pose().x == pytest.approx(1.2 - RADIUS - BACKUP_LIMIT_M, abs=2e-3)
+    assert base.motion_status() == MotionStatus.BLOCKED
     base.set_velocity(1.0, 0.0)
     base.clock.wait(3.0)
     assert base.motion_status() == MotionStatus.BLOCKED
@@ -114,8 +117,8 @@ def test_velocity_commands_are_clipped(base):
     assert base.motion_status() == MotionStatus.MOVING
     base.clock.wait(0.5)
     assert base.pose().yaw == pytest.approx(0.5 * MAX_ANGULAR, abs=1e-9)
-    base.set_pose(Pose2D(0.0, 8.0, math.pi / 2))  # along the corridor
-    base.set_velocity(-3.0, 0.0)
+    base.set_pose(Pose2D(0.0, 8.0, -math.pi / 2))  # along the corridor
+    base.set_velocity(3.0, 0.0)
     base.clock.wait(2.0)
     assert base.pose().y == pytest.approx(8.0 - 2.0 * MAX_LINEAR, abs=1e-9)
     base.set_velocity(0.0, 0.0)
@@ -213,3 +216,28 @@ def test_rendering_in_a_worker_while_the_clock_runs(base):
     t.join(timeout=30)
     assert not errors and len(frames) == 12
     assert base.pose().y == pytest.approx(8.0 - 8 * FORWARD_STEP_M, abs=1e-9)
+
+
+def test_it_reverses_only_within_the_create3_backup_buffer(base):
+    """As the Create 3 with safety_override none: no reverse until it has driven forward,
+    then at most 0.15 m; a reverse beyond that stops BLOCKED, without a collision."""
+    base.set_pose(Pose2D(0.0, 8.0, math.pi / 2))
+    base.set_velocity(-0.2, 0.0)
+    assert base.motion_status() == MotionStatus.BLOCKED  # refused: nothing driven yet
+    base.clock.wait(0.5)
+    assert base.pose().y == pytest.approx(8.0)
+    base.set_velocity(0.2, 0.0)
+    base.clock.wait(2.0)  # 0.4 m forward fills the buffer (capped)
+    y = base.pose().y
+    base.set_velocity(-0.2, 0.0)
+    base.clock.wait(2.0)
+    assert base.pose().y == pytest.approx(y - BACKUP_LIMIT_M, abs=1e-6)
+    assert base.motion_status() == MotionStatus.BLOCKED
+    assert base.velocity_command == (0.0, 0.0)
+    assert base.stats.collisions == 0
+    base.set_velocity(0.2, 0.0)  # 0.1 m forward: 0.1 m of reverse again
+    base.clock.wait(0.5)
+    y = base.pose().y
+    base.set_velocity(-0.2, 0.0)
+    base.clock.wait(2.0)
+    assert base.pose().y == pytest.approx(y - 0.1, abs=1e-6)

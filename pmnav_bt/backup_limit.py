@@ -8,8 +8,9 @@ down somewhere new (a kidnap) empties it. Values from iRobot's create3_sim
 ``motion_control_node`` (BACKUP_BUFFER_STOP_THRESHOLD) and the Create 3 safety docs
 (https://iroboteducation.github.io/create3_docs/api/safety/).
 
-``BackupBuffer`` mirrors that from odometry: the simulated Create 3 enforces it, and
-``Create3Base`` uses it so that it never asks for a reverse the robot would refuse.
+``BackupBuffer`` mirrors that from odometry: both simulators enforce it (``SimBase``,
+used by ``pmnav sim``, and the ROS 2 simulated Create 3), and ``Create3Base`` uses it
+so that it never asks for a reverse the robot would refuse.
 """
 
 from __future__ import annotations
