@@ -5,6 +5,7 @@ corridor axis towards where the map says signs are readable."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from py_trees.common import Status
 
@@ -13,14 +14,16 @@ from pmnav_bt.behaviours.context import Context, thumbnail
 from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M
 from pmnav_bt.failures import FailureCode
+from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.perception.read_range import sign_visible_range
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
 from pmnav_bt.pose.visibility import entity_xy
 from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
-from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation
+from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation, Pose2D
 
 NO_PROGRESS_S = 6.0  # clock seconds without moving 0.1 m: the drive is blocked
 MIN_BLOCKED_DRIVE_M = 0.2  # blocked sooner: a brush with a wall, not the corridor's end
@@ -36,29 +39,47 @@ def wall_mask(grounder: Grounder, obs: Observation):
 
 
 def read_panorama(ctx: Context, views: list):
-    """(sightings, corridor axis in odometry or None, free floor ahead of each view) of a
-    panorama. Worker only."""
+    """(sightings, corridor axis in odometry or None, free floor ahead of each view, the
+    odometry's rotation-scale error or None) of a panorama. Worker only.
+
+    A rotation-scale error turns each view's odometry yaw by a share of the turning since:
+    the views are put back into the odometry frame of the last one (where the robot is
+    now) before signs, free floor and the axis are read from them."""
+    fits = []
+    for i, v in enumerate(views):
+        mask = wall_mask(ctx.grounder, v.observation)
+        fit = None if mask is None else fit_wall_angle(wall_points(v.observation, mask))
+        if fit is not None:
+            fits.append((i, fit))
+    error = rotation_scale_error([(views[i].observation.pose.yaw, *f) for i, f in fits])
+    if error is not None:
+        turned = [0.0]
+        for a, b in zip(views, views[1:], strict=False):
+            turned.append(turned[-1] + wrap_angle(b.observation.pose.yaw - a.observation.pose.yaw))
+        views = [
+            replace(v, observation=_turned(v.observation, -error * (r - turned[-1])))
+            for v, r in zip(views, turned, strict=True)
+        ]
     sightings = [
         s for v in views for d in v.detections or () if (s := sighting(ctx.pm, v.observation, d))
     ]
-    angles = []
-    for v in views:
-        mask = wall_mask(ctx.grounder, v.observation)
-        if mask is None:
-            continue
-        fit = fit_wall_angle(wall_points(v.observation, mask))
-        if fit is not None:
-            angles.append((v.observation.pose.yaw, fit[0], fit[1]))
+    angles = [(views[i].observation.pose.yaw, f[0], f[1]) for i, f in fits]
     free = tuple(
         (v.observation.pose.yaw, min(free_distance(v.observation, 0.0), 50.0)) for v in views
     )
-    return sightings, axis_in_odom(angles), free
+    return sightings, axis_in_odom(angles), free, error
+
+
+def _turned(obs: Observation, dyaw: float) -> Observation:
+    q = obs.pose
+    return replace(obs, pose=Pose2D(q.x, q.y, wrap_angle(q.yaw + dyaw)))
 
 
 class UpdateBelief(PmNavBehaviour):
     """Add the last panorama to the corridor belief (the signs read and where, and the
     corridor axis from the walls); start a belief when there is none, with the current
-    estimate as its prior when there is one.
+    estimate as its prior when there is one. How the walls' direction moved while the
+    panorama turned calibrates the odometry's rotation (``CalibratedBase``).
 
     Reads ``views``, ``belief``, ``map_T_odom``, ``pose_tracker``; writes ``belief``.
     """
@@ -75,7 +96,10 @@ class UpdateBelief(PmNavBehaviour):
         status, read = self.poll(self._job, "reading the panorama")
         if status is not None:
             return status
-        sightings, axis, free = read
+        sightings, axis, free, rot_error = read
+        if rot_error is not None and isinstance(self.ctx.base, CalibratedBase):
+            gain = self.ctx.base.calibrate(rot_error)
+            self.ctx.log("calibrate", "", rotation_error=rot_error, gain=gain)
         views = self.get("views") or []
         belief = self.get("belief")
         if belief is None:

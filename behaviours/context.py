@@ -15,6 +15,7 @@ from pmnav_bt.config import Config
 from pmnav_bt.control import Limits, Odometer
 from pmnav_bt.geometry import se2_compose, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.pose.odometry import CalibratedBase
 from pmnav_bt.seams import Base, CoarseDirection, Grounder, Planner, Pose2D, Refiner
 from pmnav_bt.worker import Worker
 
@@ -33,7 +34,8 @@ class TraceEvent:
 
 @dataclass
 class Context:
-    """Injected into every behaviour of one tree."""
+    """Injected into every behaviour of one tree. ``base`` is wrapped in a
+    ``CalibratedBase``: its odometry's rotation scale is learnt from the walls."""
 
     base: Base
     pm: PrioriMap  # the map-less baseline: a SignsOnly (sign vocabulary, no geometry)
@@ -46,6 +48,10 @@ class Context:
     odometer: Odometer = field(default_factory=Odometer)
     trace: list[TraceEvent] = field(default_factory=list)
     budget_actions: int = 500
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.base, CalibratedBase):
+            self.base = CalibratedBase(self.base)
 
     @classmethod
     def wired(

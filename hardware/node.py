@@ -48,6 +48,7 @@ from typing import Any
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.failures import Failure, FailureCode, failure_from
+from pmnav_bt.geometry import se2_compose
 from pmnav_bt.hardware import action_server
 from pmnav_bt.hardware.create3 import Create3Options
 from pmnav_bt.hardware.diagnostics import diagnostic_array
@@ -586,7 +587,7 @@ class _Viz:
         from pmnav_bt.hardware.messages import path_message, pose_stamped, transform_stamped
 
         ctl = self.ctl
-        odom = ctl.base.pose()
+        odom = self.ctx.base.pose()  # the tree's odometry (rotation-calibrated)
         if not self._traj or _moved(self._traj[-1], odom):
             self._traj.append(odom)
         plan = self._bb("plan")
@@ -604,6 +605,8 @@ class _Viz:
         ctl.pub_pose.publish(pose_stamped(self.map_pose(odom), stamp, frame))
         ctl.pub_traj.publish(path_message([self.map_pose(q) for q in self._traj], stamp, frame))
         if m is not None:
+            # map -> the robot's own odom frame: through the calibrated odometry's frame.
+            m = se2_compose(m, self.ctx.base.corr_T_raw())
             tf = transform_stamped(Pose2D(*m), stamp, ctl.map_frame, ctl.odom_frame)
             ctl.pub_map_odom.publish(tf)
             if ctl.pub_tf is not None:

@@ -124,7 +124,7 @@ def run_localization(start: LocStart, config: Config) -> LocResult:
             tree.setup()
             while ctx.now() < MAX_CLOCK_S:
                 tree.tick()
-                ctx.odometer.update(base.pose())
+                ctx.odometer.update(ctx.base.pose())
                 status = tree.root.status
                 if status != py_trees.common.Status.RUNNING:
                     break
@@ -138,7 +138,7 @@ def run_localization(start: LocStart, config: Config) -> LocResult:
         tf = store.get(f"{NAMESPACE}/map_T_odom")
         attempts = store.get(f"{NAMESPACE}/fix_attempts") or 0
         failure = store.get(f"{NAMESPACE}/failure")
-        truth, odom = inner.pose(), base.pose()
+        truth, odom = inner.pose(), ctx.base.pose()  # the tree's (calibrated) odometry
         driven = inner.stats.path_length
     pos_err = yaw_err = None
     ok = status == py_trees.common.Status.SUCCESS and tf is not None

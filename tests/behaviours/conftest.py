@@ -87,7 +87,7 @@ class Rig(BlackboardAccess):
 
     def estimate(self) -> Pose2D:
         """The tree's map pose: map_T_odom composed with the odometry pose."""
-        return map_pose(self.get("map_T_odom"), self.base.pose())
+        return map_pose(self.get("map_T_odom"), self.ctx.base.pose())
 
     def stopped(self) -> bool:
         """No velocity command in force and no motion going on."""
