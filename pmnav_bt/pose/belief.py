@@ -48,7 +48,8 @@ BLIND_SPREAD_M = 0.75  # ... and how tight the belief must be for it
 LOOK_SPACING_M = 6.0  # look round at least this far beyond an earlier look in the same way
 NEAR_WALL_M = 2.0  # depth: a wall closer than this ahead of a view ...
 MAX_RAY_M = 8.0  # free floor seen in depth is checked along the view up to this far
-RAY_SLACK_M = 0.4  # ... short of where it ends, and this far outside the corridors
+RAY_SLACK_M = 0.4  # ... short of where it ends, this far outside the corridors (and a
+# probe beyond a near wall must be this far inside one to count against a hypothesis)
 P_DEPTH = 0.1  # a hypothesis that disagrees with one such depth reading
 JUNCTION_REACH_M = 1.0  # side corridors of a junction this close are the robot's
 CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
@@ -242,7 +243,9 @@ class CorridorBelief:
                 d = free + 0.5
                 probe = _apply_many(tfs, (g.odom.x + d * c, g.odom.y + d * s_))
                 pn, poff = self.vis.nearest_many(probe)
-                self.logw += np.where(poff <= half[pn], math.log(P_DEPTH), 0.0)
+                # Clearly inside a corridor: an oblique view puts the probe only a little
+                # beyond the wall, and the hypothesis is a lattice point on the centre line.
+                self.logw += np.where(poff <= half[pn] - RAY_SLACK_M, math.log(P_DEPTH), 0.0)
             reach = min(free, MAX_RAY_M) - RAY_SLACK_M
             if reach > 1.0:
                 end = _apply_many(tfs, (g.odom.x + reach * c, g.odom.y + reach * s_))

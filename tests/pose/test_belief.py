@@ -193,3 +193,30 @@ def test_a_mirror_symmetric_corridor_is_told_apart_by_looking_into_a_side_corrid
     fix = b.fix()
     assert fix is not None
     np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=1.0)
+
+
+def test_views_that_meet_a_side_wall_obliquely_do_not_count_against_the_true_place():
+    # sign_sparse_2, 0.4 m off the centre line of a bare corridor, facing along it: the
+    # views 30 deg off the axis meet the side walls 1.6-3.2 m away. A probe just beyond
+    # where depth ends (on an oblique ray, only a little beyond the wall) must not be
+    # taken for free floor under the true hypothesis; the ends of dead ends, where such
+    # probes fall outside the map, are no likelier than the true place.
+    pm = parse_building(generate_sign_sparse(2))
+    poly = Visibility.of(pm).corridors
+    true = (30.4, 40.0, -math.pi / 2)
+    odom = se2_compose(ODOM_T_MAP, true)
+    free = []
+    for a in np.radians([30, 90, 150, 210, 270, 330]):
+        h = true[2] + a
+        ray = shapely.LineString(
+            [true[:2], (true[0] + 50 * math.cos(h), true[1] + 50 * math.sin(h))]
+        )
+        hit = ray.intersection(poly.boundary)
+        d = min(shapely.Point(true[:2]).distance(p) for p in getattr(hit, "geoms", [hit]))
+        free.append((h + ODOM_T_MAP[2], d))
+    b = CorridorBelief(pm)
+    b.observe(Glimpse(Pose2D(*odom), {}, None, tuple(free)), axis_odom=odom[2])
+    d = np.linalg.norm(b.xy - (30.0, 40.0), axis=1)
+    facing = np.abs(np.angle(np.exp(1j * (b.yaw - true[2])))) < 0.1
+    i = int(np.argmin(np.where(facing, d, np.inf)))
+    assert b.logw[i] >= b.logw.max() - 0.5
