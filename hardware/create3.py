@@ -47,11 +47,11 @@ import weakref
 from collections import deque
 from dataclasses import dataclass
 
+from pmnav_bt.backup_limit import BackupBuffer
 from pmnav_bt.errors import PmNavError, SensorError
 from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.hardware import qos
-from pmnav_bt.backup_limit import BackupBuffer
 from pmnav_bt.hardware.clock import RosClock
 from pmnav_bt.hardware.messages import (
     depth_from_image,

@@ -32,9 +32,9 @@ import sys
 import threading
 import time
 
+from pmnav_bt.backup_limit import BackupBuffer
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
-from pmnav_bt.backup_limit import BackupBuffer
 from pmnav_bt.seams import CAMERA_HEIGHT_M, Pose2D
 
 PARAMETERS = {
