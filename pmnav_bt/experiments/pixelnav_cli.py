@@ -51,7 +51,11 @@ def _np_load(path: Path):
 
 @app.command()
 def train(
-    data: Path = typer.Option(Path("out/pixelnav/data"), "--data", help="gen's folder."),
+    data: list[Path] = typer.Option(
+        [Path("out/pixelnav/data")],
+        "--data",
+        help="gen's folder; repeat for several (validation: the last folder's last shards).",
+    ),
     out: Path = typer.Option(Path("out/pixelnav/train"), "--out", help="Checkpoints, curves."),
     model: str = typer.Option("small", "--model", help="tiny, small (CPU) or large (GPU)."),
     steps: int = typer.Option(4000, "--steps", min=1),
@@ -60,6 +64,12 @@ def train(
     seed: int = typer.Option(0, "--seed"),
     threads: int = typer.Option(1, "--threads", min=1, help="CPU threads for torch."),
     eval_every: int = typer.Option(250, "--eval-every", min=1),
+    history: int = typer.Option(0, "--history", min=0, help="Frames the model sees (0: preset's)."),
+    stop_weight: float = typer.Option(2.0, "--stop-weight", min=0.0, help="CE weight of STOP."),
+    warmup: int = typer.Option(200, "--warmup", min=0, help="Steps of linear lr warm-up."),
+    init: Path | None = typer.Option(
+        None, "--init", help="Fine-tune from these weights (.safetensors) instead of scratch."
+    ),
 ) -> None:
     """Imitation training (resumes from --out's checkpoint); curves.png beside it."""
     from pmnav_bt.pixelnav.train import TrainConfig, preset
@@ -67,14 +77,20 @@ def train(
 
     cli_values.seed(seed)
     check_output_dir(out)
+    arch = preset(model)
+    if history:
+        arch = arch.model_copy(update={"history": history})
     cfg = TrainConfig(
-        model=preset(model),
+        model=arch,
         steps=steps,
         batch=batch,
         lr=lr,
         seed=seed,
         threads=threads,
         eval_every=eval_every,
+        stop_weight=stop_weight,
+        warmup=warmup,
+        init=str(init) if init else "",
     )
     state = run(data, out, cfg)
     last = state["history"][-1] if state["history"] else {}
@@ -96,12 +112,15 @@ def export(
     stop_threshold: float = typer.Option(
         0.5, "--stop-threshold", min=0.0, max=1.0, help="STOP once its probability is this."
     ),
+    stop_steps: float | None = typer.Option(
+        None, "--stop-steps", min=0.0, help="Also STOP when at most this many steps are left."
+    ),
 ) -> None:
     """Write a trained model as safetensors + JSON config (what refiner.weights loads)."""
     from pmnav_bt.pixelnav.train import export as run
 
     check_output_file(dest, "--dest", (".safetensors",))
-    w, j = run(run_dir, dest, stop_threshold)
+    w, j = run(run_dir, dest, stop_threshold, stop_steps)
     typer.echo(f"{w} ({w.stat().st_size / 1e6:.1f} MB), {j}")
 
 
@@ -121,12 +140,22 @@ def eval_(
     stop_threshold: float | None = typer.Option(
         None, "--stop-threshold", min=0.0, max=1.0, help="Override the weights' threshold."
     ),
+    stop_steps: float | None = typer.Option(
+        None, "--stop-steps", min=0.0, help="Override the weights' steps-left STOP rule."
+    ),
 ) -> None:
     """The skill alone: PixelNav vs the geometric refiner on the same held-out goals
     (success: stopped within 1 m of the goal point within 64 steps)."""
     import torch
 
-    from pmnav_bt.experiments.pixelnav_eval import evaluate, format_table, table, trials_json
+    from pmnav_bt.experiments.pixelnav_eval import (
+        evaluate,
+        failures,
+        format_failures,
+        format_table,
+        table,
+        trials_json,
+    )
     from pmnav_bt.pixelnav.policy import PixelNavPolicy
 
     cli_values.count(n, "-n")
@@ -136,11 +165,14 @@ def eval_(
     policy = PixelNavPolicy.load(weights or None)
     if stop_threshold is not None:
         policy.stop_threshold = stop_threshold
+    if stop_steps is not None:
+        policy.stop_steps = stop_steps
     trials = evaluate(policy, buildings, n, seed=seed, validation=validation)
-    rows = table(trials)
-    text = format_table(rows)
+    rows, why = table(trials), failures(trials)
+    text = format_table(rows) + "\n\n" + format_failures(why)
     (out / "skill.json").write_text(
-        json.dumps({"rows": rows, "trials": trials_json(trials)}, indent=1), encoding="utf-8"
+        json.dumps({"rows": rows, "failures": why, "trials": trials_json(trials)}, indent=1),
+        encoding="utf-8",
     )
     (out / "skill.txt").write_text(text + "\n", encoding="utf-8")
     typer.echo(text)

@@ -10,7 +10,9 @@ buildings from the held-out seed range. Each goal is tried by
   it or when a step is blocked (the tree's approach, open loop, in discrete steps).
 
 Success: the agent stops within ``SUCCESS_M`` of the goal point (in the plane) within
-``MAX_STEPS`` actions. "Reached" counts coming that close at any time.
+``MAX_STEPS`` actions. "Reached" counts coming that close at any time. A failure has a
+reason (``FAILURES``): it stopped short (never that close), stopped after passing the
+goal (was that close, stopped farther), or never stopped (passing the goal or not).
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from pmnav_bt.seams import (
 )
 
 SUCCESS_M = 1.0
+FAILURES = ("stopped short", "stopped after passing", "no stop, passed", "no stop, never near")
 BANDS = ((1.0, 2.0), (2.0, 3.0), (3.0, 4.0), (4.0, 5.0))
 
 
@@ -46,6 +49,15 @@ class Trial:
     reached: bool
     steps: int
     final_error: float  # m from the goal point where it stopped (or at the budget)
+
+    @property
+    def failure(self) -> str:
+        """Why it failed (one of ``FAILURES``), or "" for a success."""
+        if self.success:
+            return ""
+        if self.steps < MAX_STEPS:  # it stopped
+            return FAILURES[1] if self.reached else FAILURES[0]
+        return FAILURES[2] if self.reached else FAILURES[3]
 
 
 def _first_obs(roller: Roller, pose: Pose2D, frame) -> Observation:
@@ -208,6 +220,35 @@ def table(trials: list[Trial]) -> list[dict]:
     return rows
 
 
+def failures(trials: list[Trial]) -> list[dict]:
+    """Rows: method x failure reason -> count, and the median distance of those goals."""
+    rows = []
+    for method in ("pixelnav", "geometric"):
+        ts = [t for t in trials if t.method == method]
+        for why in FAILURES:
+            fs = [t for t in ts if t.failure == why]
+            rows.append(
+                {
+                    "method": method,
+                    "failure": why,
+                    "n": len(fs),
+                    "of": len(ts),
+                    "median_goal_m": float(np.median([t.distance for t in fs])) if fs else None,
+                    "median_steps": float(np.median([t.steps for t in fs])) if fs else None,
+                }
+            )
+    return rows
+
+
+def format_failures(rows: list[dict]) -> str:
+    by = {(r["method"], r["failure"]): r for r in rows}
+    lines = [f"{'failures':<22} {'PixelNav':>8} {'geometric':>9}"]
+    for why in FAILURES:
+        p, q = by[("pixelnav", why)], by[("geometric", why)]
+        lines.append(f"{why:<22} {p['n']:>8} {q['n']:>9}")
+    return "\n".join(lines)
+
+
 def format_table(rows: list[dict]) -> str:
     by = {(r["method"], r["group"]): r for r in rows}
     groups = list(dict.fromkeys(r["group"] for r in rows))
@@ -229,4 +270,4 @@ def format_table(rows: list[dict]) -> str:
 
 
 def trials_json(trials: list[Trial]) -> list[dict]:
-    return [asdict(t) for t in trials]
+    return [asdict(t) | {"failure": t.failure} for t in trials]
