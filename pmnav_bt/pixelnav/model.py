@@ -105,10 +105,17 @@ class PixelNavNet(nn.Module):
         x = torch.cat([normalise(goal_frame), goal_channel(goal_px, self.cfg)], dim=1)
         return self.goal_encoder(x)
 
-    def encode_frames(self, frames: torch.Tensor) -> torch.Tensor:
-        """(B, T, H, W, 3) uint8 -> (B, T, dim) frame tokens."""
+    def encode_frames(self, frames: torch.Tensor, pad: torch.Tensor | None = None) -> torch.Tensor:
+        """(B, T, H, W, 3) uint8 -> (B, T, dim) frame tokens; with ``pad`` (B, T), only
+        the real frames are encoded (padding tokens are zeros, masked out later)."""
         b, t = frames.shape[:2]
-        return self.frame_encoder(normalise(frames.flatten(0, 1))).view(b, t, -1)
+        if pad is None:
+            return self.frame_encoder(normalise(frames.flatten(0, 1))).view(b, t, -1)
+        real = ~pad
+        tok = self.frame_encoder(normalise(frames[real]))
+        out = tok.new_zeros(b, t, tok.shape[-1])
+        out[real] = tok
+        return out
 
     def decode(
         self, goal_tok: torch.Tensor, frame_tok: torch.Tensor, pad: torch.Tensor | None = None
@@ -139,4 +146,6 @@ class PixelNavNet(nn.Module):
         frames: torch.Tensor,
         pad: torch.Tensor | None = None,
     ) -> dict[str, torch.Tensor]:
-        return self.decode(self.encode_goal(goal_frame, goal_px), self.encode_frames(frames), pad)
+        return self.decode(
+            self.encode_goal(goal_frame, goal_px), self.encode_frames(frames, pad), pad
+        )

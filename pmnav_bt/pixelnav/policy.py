@@ -6,9 +6,11 @@ It is both seams the tree uses for a grounded target:
   as the ``geometric`` refiner measures them (PixelNav gives actions, not metres);
 - ``PixelGoalPolicy``: ``reset`` on a grounded frame, then ``act`` per frame: stop,
   forward 0.25 m or turn 30 deg, the goal pixel tracked in the frame, the steps left.
-  STOP when its probability reaches ``stop_threshold`` (from the weights' JSON, chosen
-  on validation buildings in closed loop), else the likeliest move; with ``no_reversal``
-  a turn never directly undoes the turn before it (imitation policies dither there).
+  STOP when its probability reaches ``stop_threshold`` or (``stop_steps``, when set) when
+  the temporal-distance head expects at most that many steps left (both from the
+  weights' JSON, chosen on validation buildings in closed loop), else the likeliest move;
+  with ``no_reversal`` a turn never directly undoes the turn before it (imitation
+  policies dither there).
 
 The goal token is computed once per goal and each frame's token once, so a step costs one
 frame encoding and one pass of the small transformer over the last ``history`` tokens.
@@ -53,11 +55,19 @@ class PixelNavPolicy:
     gives_range = True
     max_steps = MAX_STEPS
 
-    def __init__(self, net, device=None, stop_threshold: float = 0.5, no_reversal: bool = True):
+    def __init__(
+        self,
+        net,
+        device=None,
+        stop_threshold: float = 0.5,
+        no_reversal: bool = True,
+        stop_steps: float | None = None,
+    ):
         import torch
 
         self.net = net.eval()
         self.stop_threshold = stop_threshold
+        self.stop_steps = stop_steps
         self.no_reversal = no_reversal
         self._last_action = STOP
         self.cfg = net.cfg
@@ -90,6 +100,8 @@ class PixelNavPolicy:
             cfg = ModelConfig.model_validate(info["model"])
             stop = float(info.get("stop_threshold", 0.5))
             no_reversal = bool(info.get("no_reversal", True))
+            stop_steps = info.get("stop_steps")
+            stop_steps = None if stop_steps is None else float(stop_steps)
         except (ValueError, KeyError, TypeError) as err:
             raise BackendError(f"{meta}: not a PixelNav model config ({err})") from None
         dev = torch.device(device) if device else torch.device("cpu")
@@ -100,7 +112,7 @@ class PixelNavPolicy:
             raise BackendError(
                 f"{w}: weights do not fit the config in {meta.name}: {err}"
             ) from None
-        return cls(net.to(dev), dev, stop, no_reversal)
+        return cls(net.to(dev), dev, stop, no_reversal, stop_steps)
 
     # -- Refiner ------------------------------------------------------------------------------
 
@@ -161,7 +173,8 @@ class PixelNavPolicy:
         v = (track[1] + 0.5) * k.height / cfg.height - 0.5
         # STOP once it is likely enough (the threshold is calibrated on validation
         # buildings and kept in the weights' JSON), else the likeliest move.
-        if float(probs[STOP]) >= self.stop_threshold:
+        near = self.stop_steps is not None and steps <= self.stop_steps
+        if float(probs[STOP]) >= self.stop_threshold or near:
             action = ACTIONS[STOP]
         else:
             moves = probs.clone()

@@ -64,6 +64,7 @@ class TrainConfig(BaseModel):
     tdist_weight: float = Field(0.5, ge=0.0)
     track_weight: float = Field(1.0, ge=0.0)
     threads: int = Field(1, ge=1, description="CPU threads for torch")
+    init: str = Field("", description="start from these weights (.safetensors): fine-tuning")
 
 
 def pick_device() -> torch.device:
@@ -129,6 +130,9 @@ class Sampler:
                 out["goal_frame"][b] = cv2.GaussianBlur(out["goal_frame"][b], (3, 3), 0.6)
                 for i in range(m):
                     out["frames"][b, i] = cv2.GaussianBlur(out["frames"][b, i], (3, 3), 0.6)
+        longest = int((~out["pad"]).sum(1).max())  # drop the columns that are padding only
+        for key in ("frames", "pad", "action", "tdist", "track", "track_valid"):
+            out[key] = out[key][:, :longest]
         return out
 
 
@@ -215,19 +219,48 @@ def split_episodes(data: dict[str, np.ndarray], n_shards_eps: list[int], val_fra
     return np.arange(cut), np.arange(cut, total)
 
 
+def find_shards(data_dirs: list[Path]) -> list[Path]:
+    """The shards of each folder in turn (validation takes the last ones: of the last folder)."""
+    shards: list[Path] = []
+    for d in data_dirs:
+        shards += sorted(d.glob("shard_*.npz"))
+    if len(shards) < 2:
+        names = ", ".join(str(d) for d in data_dirs)
+        raise TrainError(f"{names}: {len(shards)} shard(s); run `pmnav pixelnav gen` first")
+    return shards
+
+
+def init_weights(net: PixelNavNet, path: str) -> None:
+    """Load ``path`` into ``net`` for fine-tuning; a shorter history's position table fills
+    the first rows (the rest repeat its last row)."""
+    w = Path(path)
+    if not w.is_file():
+        raise TrainError(f"--init {w}: no such weights file")
+    sd = load_file(str(w))
+    pos = sd.get("pos")
+    if pos is not None and pos.shape[0] < net.pos.shape[0]:
+        grown = pos[-1:].repeat(net.pos.shape[0], 1)
+        grown[: pos.shape[0]] = pos
+        sd["pos"] = grown
+    try:
+        net.load_state_dict(sd)
+    except RuntimeError as err:
+        raise TrainError(f"--init {w}: weights do not fit the model config: {err}") from None
+
+
 def train(
-    data_dir: str | Path, out_dir: str | Path, cfg: TrainConfig, progress: bool = True
+    data_dir: str | Path | list, out_dir: str | Path, cfg: TrainConfig, progress: bool = True
 ) -> dict:
-    """Train (or resume) into ``out_dir``; returns the final state (history included)."""
+    """Train (or resume) into ``out_dir`` on the shards of ``data_dir`` (a folder or a
+    list of them); returns the final state (history included)."""
     from tqdm import tqdm
 
     from pmnav_bt.pixelnav.plot import save_curves
 
     torch.set_num_threads(cfg.threads)
-    data_dir, out = Path(data_dir), Path(out_dir)
-    shards = sorted(data_dir.glob("shard_*.npz"))
-    if len(shards) < 2:
-        raise TrainError(f"{data_dir}: {len(shards)} shard(s); run `pmnav pixelnav gen` first")
+    dirs = [Path(d) for d in (data_dir if isinstance(data_dir, list | tuple) else [data_dir])]
+    out = Path(out_dir)
+    shards = find_shards(dirs)
     out.mkdir(parents=True, exist_ok=True)
     state_path = out / STATE_FILE
     state = {"step": 0, "history": [], "config": cfg.model_dump(mode="json"), "seconds": 0.0}
@@ -248,6 +281,8 @@ def train(
     if state["step"] > 0:
         net.load_state_dict(load_file(str(out / MODEL_FILE), device=str(device)))
         load_optimizer(opt, out / OPTIM_FILE)
+    elif cfg.init:
+        init_weights(net, cfg.init)
     tr_s, va_s = Sampler(data, train_eps, cfg), Sampler(data, val_eps, cfg)
     val_batches = [
         to_torch(va_s.batch(np.random.default_rng([cfg.seed, 10**9, i]), cfg.batch), device)
@@ -319,10 +354,13 @@ def save_checkpoint(net: PixelNavNet, opt, state: dict, out: Path) -> None:
 
 
 def export(
-    train_dir: str | Path, dest: str | Path, stop_threshold: float = 0.5
+    train_dir: str | Path,
+    dest: str | Path,
+    stop_threshold: float = 0.5,
+    stop_steps: float | None = None,
 ) -> tuple[Path, Path]:
     """The trained model as ``dest.safetensors`` + ``dest.json`` (its model config and
-    the policy's STOP probability threshold)."""
+    the policy's STOP rule: the probability threshold, and the steps-left one or None)."""
     train_dir, dest = Path(train_dir), Path(dest)
     state = json.loads((train_dir / STATE_FILE).read_text(encoding="utf-8"))
     sd = load_file(str(train_dir / MODEL_FILE))
@@ -334,6 +372,7 @@ def export(
     meta = {
         "model": state["config"]["model"],
         "stop_threshold": stop_threshold,
+        "stop_steps": stop_steps,
         "trained_steps": state["step"],
         "train_seconds": round(state.get("seconds", 0.0), 1),
         "data": state.get("data", {}),

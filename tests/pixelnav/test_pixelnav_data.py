@@ -92,3 +92,20 @@ def test_the_sampler_flips_turns_with_the_image(shard):
     swap = {STOP: STOP, FORWARD: FORWARD, LEFT: RIGHT, RIGHT: LEFT}
     assert [swap[x] for x in a["action"][real]] == list(b["action"][real])
     assert np.allclose(b["goal_px"][:, 0], (TINY.width - 1) - a["goal_px"][:, 0])
+
+
+def test_sampler_batches_end_at_the_longest_window(shard):
+    from pmnav_bt.pixelnav.model import TINY
+    from pmnav_bt.pixelnav.train import Sampler, TrainConfig
+
+    d = dict(shard)
+    model = TINY.model_copy(update={"history": MAX_STEPS})
+    s = Sampler(d, np.arange(2), TrainConfig(model=model))
+    longest = int(np.diff(d["offsets"]).max())
+    for seed in range(3):
+        b = s.batch(np.random.default_rng(seed), 4)
+        t = b["frames"].shape[1]
+        assert t <= longest
+        assert (~b["pad"][:, -1]).any()  # no column of padding only
+        for key in ("pad", "action", "tdist", "track", "track_valid"):
+            assert b[key].shape[1] == t

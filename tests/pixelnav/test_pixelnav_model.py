@@ -119,3 +119,31 @@ def test_export_writes_weights_and_their_config(tmp_path):
     args = batch()
     with torch.no_grad():
         assert torch.equal(m(*args)["action"], loaded(*args)["action"])
+
+
+def test_padded_frames_are_not_encoded_and_real_ones_encode_as_without_padding():
+    m = net()
+    gf, gp, frames = batch()
+    pad = torch.zeros(3, TINY.history, dtype=torch.bool)
+    pad[1:, 2:] = True
+    with torch.no_grad():
+        tok = m.encode_frames(frames, pad)
+        full = m.encode_frames(frames)
+    assert torch.allclose(tok[~pad], full[~pad], atol=1e-5)
+    assert torch.equal(tok[pad], torch.zeros_like(tok[pad]))
+
+
+def test_fine_tuning_starts_from_weights_of_a_shorter_history(tmp_path):
+    from pmnav_bt.pixelnav.train import TrainError, init_weights
+
+    short = net(3)
+    path = tmp_path / "w.safetensors"
+    save_file({k: v.contiguous() for k, v in short.state_dict().items()}, str(path))
+    longer = PixelNavNet(TINY.model_copy(update={"history": 2 * TINY.history}))
+    init_weights(longer, str(path))
+    n = TINY.history + 1
+    assert torch.equal(longer.pos[:n], short.pos)
+    assert torch.equal(longer.pos[n:], short.pos[-1:].expand(TINY.history, -1))
+    assert torch.equal(longer.frame_encoder[0].weight, short.frame_encoder[0].weight)
+    with pytest.raises(TrainError, match="--init"):
+        init_weights(PixelNavNet(TINY.model_copy(update={"dim": 32})), str(path))

@@ -120,3 +120,27 @@ def test_export_keeps_the_stop_threshold(tmp_path):
     save_checkpoint(m, torch.optim.AdamW(m.parameters()), state, tmp_path)
     w, _ = export(tmp_path, tmp_path / "w.safetensors", stop_threshold=0.25)
     assert PixelNavPolicy.load(w).stop_threshold == 0.25
+
+
+def test_the_steps_left_rule_stops_when_the_distance_head_says_the_goal_is_near(policy):
+    policy.reset(obs(0), goal())
+    policy.stop_threshold = 1.01  # never by the STOP probability
+    policy.stop_steps = None
+    assert DiscreteAction.STOP not in {policy.act(obs(i)).action for i in range(4)}
+    step = policy.act(obs(5))
+    policy.reset(obs(0), goal())
+    policy.stop_steps = step.steps_to_goal + 100.0  # any estimate is within reach
+    assert policy.act(obs(1)).action == DiscreteAction.STOP
+
+
+def test_export_keeps_the_steps_left_rule(tmp_path):
+    from pmnav_bt.pixelnav.train import TrainConfig, export, save_checkpoint
+
+    torch.manual_seed(0)
+    m = PixelNavNet(TINY)
+    state = {"step": 1, "history": [], "config": TrainConfig(model=TINY).model_dump(mode="json")}
+    save_checkpoint(m, torch.optim.AdamW(m.parameters()), state, tmp_path)
+    w, _ = export(tmp_path, tmp_path / "w.safetensors", stop_threshold=0.3, stop_steps=1.5)
+    assert PixelNavPolicy.load(w).stop_steps == 1.5
+    w, _ = export(tmp_path, tmp_path / "v.safetensors", stop_threshold=0.3)
+    assert PixelNavPolicy.load(w).stop_steps is None
