@@ -20,6 +20,7 @@ import time
 import numpy as np
 import torch
 
+from pmnav_bt.pixelnav.dataset import MAX_STEPS
 from pmnav_bt.pixelnav.policy import PixelNavPolicy
 from pmnav_bt.seams import Detection, Pose2D
 from pmnav_bt.sim.robot import SimBase
@@ -51,7 +52,7 @@ def main() -> None:
     goal = Detection("door", (200, 60, 239, 179), 1.0, mask=mask)
     resets, steps = [], []
     for i in range(args.steps + 20):
-        if i % 32 == 0:
+        if i % MAX_STEPS == 0:  # a new goal once the skill's budget is spent
             t = time.perf_counter()
             policy.reset(frames[0], goal)
             resets.append(time.perf_counter() - t)

@@ -176,3 +176,54 @@ def eval_(
     )
     (out / "skill.txt").write_text(text + "\n", encoding="utf-8")
     typer.echo(text)
+
+
+@app.command()
+def calibrate(
+    weights: str = typer.Option("", "--weights", help="A .safetensors; default: shipped."),
+    buildings: int = typer.Option(6, "--buildings", min=1, help="Validation buildings."),
+    n: int = typer.Option(25, "-n", min=1, help="Goals per building."),
+    seed: int = typer.Option(0, "--seed"),
+    thresholds: str = typer.Option(
+        "0.02,0.05,0.1,0.15,0.2,0.3,0.4,0.5", "--thresholds", help="STOP probabilities to try."
+    ),
+    steps: str = typer.Option(
+        "off,0.5,1,1.5,2,3", "--steps", help="Steps-left STOP rules to try (off: none)."
+    ),
+    out: Path = typer.Option(Path("out/pixelnav/calibrate"), "--out", help="Folder for results."),
+) -> None:
+    """Choose the STOP rule on validation buildings (never the held-out ones): one
+    STOP-free closed-loop trace per goal answers every rule exactly; SR per rule."""
+    import torch
+
+    from pmnav_bt.experiments.pixelnav_eval import evaluate, sweep
+    from pmnav_bt.pixelnav.policy import PixelNavPolicy
+
+    cli_values.count(n, "-n")
+    cli_values.seed(seed)
+    check_output_dir(out)
+    ths = [cli_values.parse_number(x, "--thresholds") for x in thresholds.split(",")]
+    sts = [
+        None if x.strip() == "off" else cli_values.parse_number(x, "--steps")
+        for x in steps.split(",")
+    ]
+    torch.set_num_threads(1)
+    policy = PixelNavPolicy.load(weights or None)
+    traces: list = []
+    evaluate(policy, buildings, n, seed=seed, validation=True, traces=traces)
+    rows = sweep(traces, ths, sts)
+    head = "threshold " + " ".join(f"{'off' if s is None else f'<={s:g}':>6}" for s in sts)
+    lines = [f"SR by STOP rule, {len(traces)} validation goals (columns: steps left)", head]
+    for th in ths:
+        cells = [r for r in rows if r["stop_threshold"] == th]
+        lines.append(f"{th:>9g} " + " ".join(f"{r['sr']:>6.1%}" for r in cells))
+    best = max(rows, key=lambda r: r["sr"])
+    lines.append(
+        f"best: --stop-threshold {best['stop_threshold']:g}"
+        + ("" if best["stop_steps"] is None else f" --stop-steps {best['stop_steps']:g}")
+        + f" (SR {best['sr']:.1%})"
+    )
+    (out / "calibrate.json").write_text(
+        json.dumps({"rows": rows, "traces": traces}, indent=1), encoding="utf-8"
+    )
+    typer.echo("\n".join(lines))

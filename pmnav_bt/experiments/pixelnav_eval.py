@@ -122,6 +122,52 @@ def run_geometric(roller: Roller, start: Pose2D, obs0: Observation, det: Detecti
     return False, MAX_STEPS, reached
 
 
+def trace_policy(policy, roller: Roller, start: Pose2D, obs0: Observation, det: Detection, goal):
+    """The policy from ``start`` with STOP turned off, for ``MAX_STEPS`` steps: per step
+    (STOP probability, steps left it expects, m from the goal before the step). Until a
+    STOP rule fires the moves are those of a policy with that rule, so one trace answers
+    every rule (``sweep``)."""
+    base = roller.base
+    base.set_pose(start)
+    keep = policy.stop_threshold, policy.stop_steps
+    policy.stop_threshold, policy.stop_steps = math.inf, None
+    try:
+        policy.reset(obs0, det)
+        obs, rows = obs0, []
+        for _ in range(MAX_STEPS):
+            p = base.pose()
+            err = math.hypot(goal[0] - p.x, goal[1] - p.y)
+            step = policy.act(obs)
+            rows.append((policy.last_stop_prob, step.steps_to_goal, err))
+            base.execute(step.action)
+            obs = base.observe()
+    finally:
+        policy.stop_threshold, policy.stop_steps = keep
+    return rows
+
+
+def stop_step(trace, threshold: float, steps: float | None) -> int | None:
+    """The first step at which the rule (STOP probability >= ``threshold``, or at most
+    ``steps`` steps left) stops, or None."""
+    for i, (prob, left, _) in enumerate(trace):
+        if prob >= threshold or (steps is not None and left <= steps):
+            return i
+    return None
+
+
+def sweep(traces, thresholds, steps_options) -> list[dict]:
+    """SR of each STOP rule on the same traces (success: stopped within ``SUCCESS_M``)."""
+    rows = []
+    for th in thresholds:
+        for st in steps_options:
+            ok = 0
+            for tr in traces:
+                i = stop_step(tr, th, st)
+                ok += i is not None and tr[i][2] <= SUCCESS_M
+            rows.append({"stop_threshold": th, "stop_steps": st, "sr": ok / max(1, len(traces))})
+    return rows
+
+
 VALIDATION_SHARDS = 73  # seed 0: shards 73-79 were the shipped model's validation split (74 shards)
 
 
@@ -132,9 +178,12 @@ def evaluate(
     seed: int = 0,
     progress: bool = True,
     validation: bool = False,
+    traces: list | None = None,
 ):
     """Trials of both methods on the same goals of held-out buildings (``validation``:
-    of the buildings of training's validation shards instead, for calibration)."""
+    of the buildings of training's validation shards instead, for calibration). With
+    ``traces`` (a list), the policy's STOP-free traces are appended to it instead
+    (``trace_policy``) and only the geometric trials are returned."""
     from tqdm import tqdm
 
     from pmnav_bt.sim.world import SimWorld
@@ -167,6 +216,9 @@ def evaluate(
                         run_geometric, roller, start, obs0, det, pt, cfg.stop_radius
                     ),
                 }
+                if traces is not None:
+                    traces.append(trace_policy(policy, roller, start, obs0, det, pt))
+                    del runs["pixelnav"]
                 for method, fn in runs.items():
                     stopped, steps, reached = fn()
                     p = roller.base.pose()

@@ -78,6 +78,7 @@ class PixelNavPolicy:
         self._tokens: list = []
         self._last_track = (0.0, 0.0)
         self._last_frame = None
+        self.last_stop_prob = 0.0  # the last step's STOP probability (for calibration)
 
     @classmethod
     def load(cls, weights: str | Path | None = None, device: str | None = None) -> PixelNavPolicy:
@@ -168,6 +169,7 @@ class PixelNavPolicy:
             track = np.clip(out["track"][0, -1].cpu().numpy(), -1.0, 2.0) * (cfg.width, cfg.height)
             steps = float(out["tdist"][0, -1]) * _tdist_scale()
         self._last_track = (float(track[0]), float(track[1]))
+        self.last_stop_prob = float(probs[STOP])
         k = obs.intrinsics
         u = (track[0] + 0.5) * k.width / cfg.width - 0.5
         v = (track[1] + 0.5) * k.height / cfg.height - 0.5

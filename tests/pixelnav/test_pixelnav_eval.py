@@ -2,7 +2,15 @@
 
 from __future__ import annotations
 
-from pmnav_bt.experiments.pixelnav_eval import FAILURES, Trial, failures, format_failures
+import pytest
+
+from pmnav_bt.experiments.pixelnav_eval import (
+    FAILURES,
+    Trial,
+    failures,
+    format_failures,
+    stop_step,
+)
 from pmnav_bt.pixelnav.dataset import MAX_STEPS
 
 
@@ -35,3 +43,47 @@ def test_failures_are_counted_per_method_and_reason():
     text = format_failures(failures(ts))
     line = text.splitlines()[1]
     assert line.startswith("stopped short") and line.split()[-2:] == ["2", "0"]
+
+
+def test_a_rule_stops_at_its_first_firing_step():
+    from pmnav_bt.experiments.pixelnav_eval import sweep
+
+    trace = [(0.01, 9.0, 3.0), (0.04, 5.0, 2.0), (0.2, 1.0, 0.8), (0.5, 0.0, 0.4)]
+    assert stop_step(trace, 0.03, None) == 1
+    assert stop_step(trace, 0.3, None) == 3
+    assert stop_step(trace, 0.3, 1.0) == 2
+    assert stop_step(trace, 0.9, None) is None
+    rows = {
+        (r["stop_threshold"], r["stop_steps"]): r["sr"]
+        for r in sweep([trace], [0.03, 0.1, 0.9], [None, 0.0])
+    }
+    assert rows == {
+        (0.03, None): 0.0,  # stops 2 m away
+        (0.03, 0.0): 0.0,
+        (0.1, None): 1.0,  # stops 0.8 m away
+        (0.1, 0.0): 1.0,
+        (0.9, None): 0.0,  # never stops
+        (0.9, 0.0): 1.0,  # the distance head stops it 0.4 m away
+    }
+
+
+def test_one_stop_free_trace_answers_a_rule_as_the_closed_loop_does():
+    torch = pytest.importorskip("torch")
+    from pmnav_bt.experiments.pixelnav_eval import evaluate, sweep
+    from pmnav_bt.pixelnav.model import TINY, PixelNavNet
+    from pmnav_bt.pixelnav.policy import PixelNavPolicy
+
+    torch.manual_seed(0)
+    policy = PixelNavPolicy(PixelNavNet(TINY))
+    traces: list = []
+    evaluate(policy, 1, 3, progress=False, validation=True, traces=traces)
+    probs = sorted(p for tr in traces for p, _, _ in tr)
+    threshold = probs[len(probs) * 9 // 10]  # fires part-way along some traces
+    policy.stop_threshold = threshold
+    closed = [t for t in evaluate(policy, 1, 3, progress=False, validation=True)]
+    closed = [t for t in closed if t.method == "pixelnav"]
+    at = [stop_step(tr, threshold, None) for tr in traces]
+    assert any(i is not None and i > 0 for i in at)  # a stop part-way: the test bites
+    assert [t.steps for t in closed] == [MAX_STEPS if i is None else i + 1 for i in at]
+    sr = sweep(traces, [threshold], [None])[0]["sr"]
+    assert sr == sum(t.success for t in closed) / len(closed)
