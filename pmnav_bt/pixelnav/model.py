@@ -35,13 +35,16 @@ class ModelConfig(BaseModel):
     layers: int = Field(2, ge=1)
     heads: int = Field(4, ge=1)
     ff: int = Field(256, ge=8, description="transformer feed-forward width")
-    history: int = Field(16, ge=1, description="frames the transformer sees")
+    history: int = Field(64, ge=1, description="frames the transformer sees")
     goal_half: int = Field(2, ge=0, description="goal square: +- this many px")
     dropout: float = Field(0.1, ge=0.0, lt=1.0)
 
 
+# The shipped presets see the whole 64-step budget (as the paper's decoder does): a
+# 16-frame window slid or re-seated mid-approach, and the network, which had learned that a
+# full window means a late step, stopped short there.
 SMALL = ModelConfig()
-LARGE = ModelConfig(channels=(32, 64, 128, 128), dim=256, layers=4, heads=8, ff=1024, history=32)
+LARGE = ModelConfig(channels=(32, 64, 128, 128), dim=256, layers=4, heads=8, ff=1024, history=64)
 TINY = ModelConfig(channels=(4, 8), dim=16, layers=1, heads=2, ff=32, history=4, dropout=0.0)
 PRESETS = {"tiny": TINY, "small": SMALL, "large": LARGE}
 

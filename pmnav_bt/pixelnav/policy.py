@@ -14,7 +14,9 @@ It is both seams the tree uses for a grounded target:
 
 The goal token is computed once per goal and each frame's token once, so a step costs one
 frame encoding and one pass of the small transformer over the last ``history`` tokens.
-When the history is full the goal is re-seated on the last frame at the pixel where the
+The shipped model's history (64 frames) covers the skill's whole budget, so within it the
+network always sees every frame since the goal frame. Past a full history (a smaller
+model, or a longer run) the goal is re-seated on the last frame at the pixel where the
 policy tracked it there (training shows the network such re-seated goals), and the
 history starts afresh after it; a goal tracked out of view keeps the old goal and the
 window slides.
