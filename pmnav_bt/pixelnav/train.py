@@ -374,6 +374,7 @@ def export(
         "stop_threshold": stop_threshold,
         "stop_steps": stop_steps,
         "trained_steps": state["step"],
+        "fine_tuned_from": state["config"].get("init", ""),
         "train_seconds": round(state.get("seconds", 0.0), 1),
         "data": state.get("data", {}),
         "final": state["history"][-1] if state["history"] else {},
