@@ -87,3 +87,14 @@ def test_one_stop_free_trace_answers_a_rule_as_the_closed_loop_does():
     assert [t.steps for t in closed] == [MAX_STEPS if i is None else i + 1 for i in at]
     sr = sweep(traces, [threshold], [None])[0]["sr"]
     assert sr == sum(t.success for t in closed) / len(closed)
+
+
+def test_calibrate_names_a_bad_rule_in_one_line(capsys, tmp_path):
+    from pmnav_bt.experiments.cli import main
+
+    for argv in (["--thresholds", "0.1,lots"], ["--steps", "off,nan"]):
+        with pytest.raises(SystemExit) as info:
+            main(["pixelnav", "calibrate", "--out", str(tmp_path), *argv])
+        err = capsys.readouterr().err.strip()
+        assert info.value.code != 0 and len(err.splitlines()) == 1
+        assert argv[0] in err and "Traceback" not in err
