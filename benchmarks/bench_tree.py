@@ -35,7 +35,13 @@ def run(ep, deferred: bool, overrides=()) -> tuple[list[float], float, bool, int
     durations: list[float] = []
     t0 = time.perf_counter()
     with SimWorld(b) as world:
-        inner = SimBase(world, pose=ep.start_pose, width=cfg.sim.width, height=cfg.sim.height)
+        inner = SimBase(
+            world,
+            pose=ep.start_pose,
+            width=cfg.sim.width,
+            height=cfg.sim.height,
+            reading_width=cfg.sim.reading_width,
+        )
         base = NoisyOdometry(inner, cfg.sim.odometry_noise, seed=ep.seed)
         ctx = make_context(
             base, pm, cfg, seed=ep.seed, budget=ep.step_budget * 2, deferred_work=deferred

@@ -80,7 +80,13 @@ def main() -> None:
     planner = VlmPlanner(client, fallback=not args.no_fallback, tries=1)
     ticks: list[tuple[float, float]] = []  # (start, duration)
     with SimWorld(b) as world:
-        base = SimBase(world, pose=ep.start_pose, width=cfg.sim.width, height=cfg.sim.height)
+        base = SimBase(
+            world,
+            pose=ep.start_pose,
+            width=cfg.sim.width,
+            height=cfg.sim.height,
+            reading_width=cfg.sim.reading_width,
+        )
         ctx = make_context(base, pm, cfg, seed=0, budget=2000, deferred_work=False)
         coarse = None
         if args.stage == "plan":

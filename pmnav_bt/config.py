@@ -214,6 +214,14 @@ class TreeConfig(_Section):
 class SimConfig(_Section):
     width: int = Field(320, ge=16, le=1920, description="camera pixels (60 deg horizontal field)")
     height: int = Field(240, ge=16, le=1080, description="camera pixels")
+    reading_width: int = Field(
+        640,
+        ge=0,
+        le=1920,
+        description="pixels: the camera also offers each view this wide for reading signs "
+        "(rendered when the grounder reads; the tree's other checks keep width x height); "
+        "0 or at most width: none",
+    )
     odometry_noise: float = Field(
         0.02, ge=0.0, le=1.0, description="std of the relative error of each odometry increment"
     )

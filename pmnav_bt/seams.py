@@ -96,12 +96,47 @@ def parse_label(label: str) -> tuple[str, str]:
     return kind, ident
 
 
+@runtime_checkable
+class ReadingView(Protocol):
+    """The view of an observation's RGB frame at the camera's higher resolution, for
+    reading signs: a body whose camera has more pixels than the tree's frame offers it
+    (the simulator renders it, a robot keeps the camera's full image), made only when
+    asked. ``width`` x ``height``: its size (pixels, the frame's aspect ratio)."""
+
+    width: int
+    height: int
+
+    def rgb(self) -> np.ndarray:
+        """(height, width, 3) uint8: the same view as the observation's ``rgb``."""
+        ...
+
+
+@dataclass(frozen=True)
+class ImageReading:
+    """A ``ReadingView`` of an image already at hand (a robot camera's full frame)."""
+
+    image: np.ndarray  # (H, W, 3) uint8
+
+    @property
+    def width(self) -> int:
+        return int(self.image.shape[1])
+
+    @property
+    def height(self) -> int:
+        return int(self.image.shape[0])
+
+    def rgb(self) -> np.ndarray:
+        return self.image
+
+
 @dataclass
 class Observation:
     """What the body sees at one instant.
 
     ``segmentation`` holds integer ids whose meaning is in ``labels``:
     "floor", "wall", "door:<room>", "sign:<room>", "landmark:<id>", "obstacle".
+    ``reading``: the same view at a higher resolution for reading signs, when the body
+    offers one (None: read ``rgb``).
     """
 
     rgb: np.ndarray  # (H, W, 3) uint8
@@ -112,6 +147,7 @@ class Observation:
     segmentation: np.ndarray | None = None  # (H, W) int32
     labels: dict[int, str] = field(default_factory=dict)
     camera_height: float = CAMERA_HEIGHT_M
+    reading: ReadingView | None = None
 
 
 class DiscreteAction(str, Enum):

@@ -14,7 +14,10 @@ over floor it has just driven forward over; a reverse beyond it stops as BLOCKED
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
+
+import numpy as np
 
 from pmnav_bt.backup_limit import BACKUP_LIMIT_M, BackupBuffer
 from pmnav_bt.geometry import wrap_angle
@@ -56,13 +59,44 @@ class MotionStats:
     actions: int = 0
 
 
+class RenderedReading:
+    """A view rendered at a higher resolution when first asked for (``seams.ReadingView``):
+    RGB only, from the pose and heading of the observation it belongs to."""
+
+    def __init__(
+        self,
+        world: SimWorld,
+        body: Pose2D,
+        yaw_offset: float,
+        intrinsics: CameraIntrinsics,
+        camera_height: float,
+    ) -> None:
+        self.width, self.height = intrinsics.width, intrinsics.height
+        self._args = (world, body.x, body.y, body.yaw + yaw_offset, intrinsics)
+        self._height_m = camera_height
+        self._rgb: np.ndarray | None = None
+        self._lock = threading.Lock()
+
+    def rgb(self) -> np.ndarray:
+        with self._lock:
+            if self._rgb is None:
+                frame = render_camera(
+                    *self._args, height=self._height_m, depth=False, segmentation=False
+                )
+                self._rgb = frame.rgb
+            return self._rgb
+
+
 class SimBase:
     """A simulated Create 3 in a SimWorld, driven by a SimClock (``pmnav_bt.seams.Base``).
 
     ``width``/``height``/``hfov`` set the camera; ``depth``/``segmentation`` choose what
-    ``observe`` renders besides RGB. The body starts at ``pose`` (default: the world's
-    start pose). ``backup_limit``: metres it may reverse after driving forward (None: no
-    limit, as with the Create 3's ``safety_override: backup_only``).
+    ``observe`` renders besides RGB. ``reading_width`` (pixels, wider than ``width``):
+    each observation offers the same view at that size for reading signs
+    (``Observation.reading``, rendered only when asked; 0: none). The body starts at
+    ``pose`` (default: the world's start pose). ``backup_limit``: metres it may reverse
+    after driving forward (None: no limit, as with the Create 3's
+    ``safety_override: backup_only``).
     """
 
     def __init__(
@@ -77,6 +111,7 @@ class SimBase:
         camera_height: float = CAMERA_HEIGHT,
         depth: bool = True,
         segmentation: bool = True,
+        reading_width: int = 0,
         radius: float = RADIUS,
         max_linear: float = MAX_LINEAR,
         max_angular: float = MAX_ANGULAR,
@@ -88,6 +123,13 @@ class SimBase:
         self.camera_height = camera_height
         self.render_depth = depth
         self.render_segmentation = segmentation
+        self.reading_intrinsics = (
+            CameraIntrinsics.from_hfov(
+                reading_width, max(1, round(reading_width * height / width)), hfov
+            )
+            if reading_width > width
+            else None
+        )
         self.radius = radius
         self.max_linear = max_linear
         self.max_angular = max_angular
@@ -219,6 +261,10 @@ class SimBase:
             depth=self.render_depth if depth is None else depth,
             segmentation=self.render_segmentation if segmentation is None else segmentation,
         )
+        k = self.reading_intrinsics
+        reading = None
+        if k is not None:
+            reading = RenderedReading(self.world, body, yaw_offset, k, self.camera_height)
         return Observation(
             rgb=frame.rgb,
             pose=body,
@@ -228,6 +274,7 @@ class SimBase:
             segmentation=frame.segmentation,
             labels=labels,
             camera_height=self.camera_height,
+            reading=reading,
         )
 
     def close(self) -> None:

@@ -115,7 +115,13 @@ def run_episode(
         geodesic = goal_geodesic(pm, episode.goal, footprints, floor=world.floor_space())
         if setup_world is not None:
             setup_world(world)
-        inner = SimBase(world, pose=episode.start_pose, width=sim.width, height=sim.height)
+        inner = SimBase(
+            world,
+            pose=episode.start_pose,
+            width=sim.width,
+            height=sim.height,
+            reading_width=sim.reading_width,
+        )
         base = (
             NoisyOdometry(inner, sim.odometry_noise, seed=episode.seed)
             if sim.odometry_noise > 0

@@ -108,7 +108,11 @@ def run_localization(start: LocStart, config: Config) -> LocResult:
     sim = config.sim
     with SimWorld(b) as world:
         inner = SimBase(
-            world, pose=Pose2D(start.x, start.y, start.yaw), width=sim.width, height=sim.height
+            world,
+            pose=Pose2D(start.x, start.y, start.yaw),
+            width=sim.width,
+            height=sim.height,
+            reading_width=sim.reading_width,
         )
         base = (
             NoisyOdometry(inner, sim.odometry_noise, seed=start.seed)

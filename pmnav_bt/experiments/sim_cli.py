@@ -251,6 +251,16 @@ def _jobs(jobs: int | None) -> int:
     return cli_values.jobs(jobs) if jobs is not None else min(2, cli_values.cpu_count())
 
 
+def reading_note(cfg) -> str:
+    """The header's note of the width signs are read at, where the camera offers one."""
+    from pmnav_bt.perception.read_range import reading_width
+
+    w = reading_width(cfg)
+    if w <= cfg.sim.width:
+        return ""
+    return f", signs read at {w}x{round(w * cfg.sim.height / cfg.sim.width)}"
+
+
 def eval_header(building, tier, n, seed, cfg, configs) -> str:
     """The results.md header: what ran, each variant's grounder, the tier rules."""
     from pmnav_bt.eval.task import budget_rule
@@ -266,7 +276,7 @@ def eval_header(building, tier, n, seed, cfg, configs) -> str:
         f"# PM-Nav evaluation\n\nbuildings: {building}; tiers: {tier}; {n} per tier per "
         f"building; seed {seed}; {grounders} (miss {g.miss_rate:.0%}, false positives "
         f"{g.false_positive_rate:.0%}); odometry noise {cfg.sim.odometry_noise:.0%}; camera "
-        f"{cfg.sim.width}x{cfg.sim.height}\n\nTiers:\n"
+        f"{cfg.sim.width}x{cfg.sim.height}{reading_note(cfg)}\n\nTiers:\n"
         + tier_definition(budget_rule(cfg.tree.budget_actions, cfg.tree.budget_path_factor))
     )
 

@@ -179,6 +179,16 @@ def _quad_crop(img: np.ndarray, quad: np.ndarray) -> np.ndarray:
     )
 
 
+def scale_sign(sign: SignText, f: float) -> SignText:
+    """``sign`` with its boxes scaled by ``f`` (from one image size to another)."""
+
+    def box(b: Box) -> Box:
+        return (b[0] * f, b[1] * f, b[2] * f, b[3] * f)
+
+    lines = tuple(TextLine(ln.text, ln.score, box(ln.box)) for ln in sign.lines)
+    return SignText(lines, box(sign.box))
+
+
 class SignReader:
     """Reads the sign plates of an RGB frame (see the module docstring).
 
@@ -192,8 +202,11 @@ class SignReader:
         self.min_score = min_score
         self._ocr = _engine(threads)
 
-    def candidates(self, rgb: np.ndarray) -> list[tuple[Box, float]]:
-        """Plate candidates: (box in frame pixels, text-line height), largest first.
+    def candidates(
+        self, rgb: np.ndarray, min_line_px: float = MIN_LINE_PX
+    ) -> list[tuple[Box, float]]:
+        """Plate candidates: (box in frame pixels, text-line height), largest first; lines
+        lower than ``min_line_px`` (pixels of this frame) are left out.
 
         Frames wider than 320 px are searched at 320 px (the cue needs no detail).
         """
@@ -201,18 +214,24 @@ class SignReader:
         s = min(1.0, 320.0 / w)
         small = rgb if s == 1.0 else cv2.resize(rgb, (int(w * s), int(h * s)), cv2.INTER_AREA)
         gray = cv2.cvtColor(small, cv2.COLOR_RGB2GRAY)
-        min_h = max(2, int(round(MIN_LINE_PX * s)))
+        min_h = max(2, int(round(min_line_px * s)))
         plates = group_lines(text_line_boxes(gray, min_h))
         plates = [((b[0] / s, b[1] / s, b[2] / s, b[3] / s), lh / s) for b, lh in plates]
         plates.sort(key=lambda p: -(p[0][2] - p[0][0]) * (p[0][3] - p[0][1]))
         return plates[: self.max_candidates]
 
-    def read(self, rgb: np.ndarray) -> list[SignText]:
+    def read(
+        self, rgb: np.ndarray, candidates: list[tuple[Box, float]] | None = None
+    ) -> list[SignText]:
         """Every candidate plate whose text could be read, with its lines.
 
-        Lines are found per candidate, then recognised together in one batch.
+        ``candidates``: (box, text-line height) in ``rgb``'s pixels, if found elsewhere
+        (default: ``self.candidates(rgb)``). Lines are found per candidate, then
+        recognised together in one batch.
         """
-        found = [(box, self.find_lines(rgb, box, lh)) for box, lh in self.candidates(rgb)]
+        if candidates is None:
+            candidates = self.candidates(rgb)
+        found = [(box, self.find_lines(rgb, box, lh)) for box, lh in candidates]
         crops = [crop for _, lines in found for _, crop in lines]
         if not crops:
             return []

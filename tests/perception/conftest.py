@@ -18,10 +18,14 @@ RANGE = 1.8  # m to the wall
 
 
 def wall_frame(
-    signs: list[tuple[str, float]], depth: bool = True, range_m: float = RANGE
+    signs: list[tuple[str, float]],
+    depth: bool = True,
+    range_m: float = RANGE,
+    k: CameraIntrinsics = K,
 ) -> Observation:
-    """A camera facing a plain wall ``range_m`` away, with sign plates at lateral offsets
-    (m, left positive) centred at camera height."""
+    """A camera ``k`` facing a plain wall ``range_m`` away, with sign plates at lateral
+    offsets (m, left positive) centred at camera height."""
+    K = k  # noqa: N806 - the module's name for the camera
     rgb = np.full((K.height, K.width, 3), WALL_RGB, np.uint8)
     px_per_m = K.fx / range_m
     for text, y_left in signs:
@@ -40,5 +44,6 @@ def wall_frame(
 
 @pytest.fixture
 def wall():
-    """``wall.frame(signs, depth=True)``, with the camera ``wall.K`` at ``wall.RANGE`` m."""
+    """``wall.frame(signs, depth=True, range_m=RANGE, k=K)``, with the camera ``wall.K`` at
+    ``wall.RANGE`` m."""
     return SimpleNamespace(frame=wall_frame, K=K, RANGE=RANGE)

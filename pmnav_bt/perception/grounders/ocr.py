@@ -11,6 +11,8 @@
 - ``detect(landmark)``: the landmark's sign.
 - ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
 
+Where the body offers a wider view of the frame for reading (``Observation.reading``),
+plates are looked for in the frame and read in that view; boxes stay in frame pixels.
 No simulator labels are read. Results are cached for the last frame, so the tree can
 ask ``read_signs`` and ``detect`` of one frame at the cost of one reading.
 """
@@ -26,7 +28,7 @@ from pmnav_bt.map.building import Building
 from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.doors import DoorLayout, door_from_sign
 from pmnav_bt.perception.sign_match import SignMatcher
-from pmnav_bt.perception.signs import SignReader
+from pmnav_bt.perception.signs import MIN_LINE_PX, SignReader, SignText, scale_sign
 from pmnav_bt.registry import BackendDeps
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
 
@@ -82,7 +84,7 @@ class OcrGrounder:
             if c is not None and c[0] is obs.rgb and c[1] == obs.stamp:
                 return c[2]
         signs, doors = [], []
-        for sign in self.reader.read(obs.rgb):
+        for sign in self._read_text(obs):
             m = self.matcher.match([(line.text, line.score) for line in sign.lines])
             if m is None:
                 continue
@@ -104,6 +106,21 @@ class OcrGrounder:
         with self._lock:
             self._cache = (obs.rgb, obs.stamp, result)
         return result
+
+    def _read_text(self, obs: Observation) -> list[SignText]:
+        """The frame's signs, boxes in the frame's pixels. Where the body offers a wider
+        view (``obs.reading``), plates are looked for in the frame as the reader looks for
+        them in that view (scaled lines as low), and only then is the view made and read."""
+        r = obs.reading
+        w = obs.rgb.shape[1]
+        if r is None or r.width <= w:
+            return self.reader.read(obs.rgb)
+        s = r.width / w
+        found = self.reader.candidates(obs.rgb, min_line_px=MIN_LINE_PX / s)
+        if not found:
+            return []
+        cands = [((b[0] * s, b[1] * s, b[2] * s, b[3] * s), lh * s) for b, lh in found]
+        return [scale_sign(t, 1.0 / s) for t in self.reader.read(r.rgb(), cands)]
 
     def _door(self, obs: Observation, sign: Detection, plate: depth_geom.PlatePose) -> Detection:
         door = door_from_sign(obs, plate, self.layout)
