@@ -8,6 +8,7 @@ progress for a while, or depth showing something on the floor ahead.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from py_trees.common import Status
@@ -164,19 +165,30 @@ class Approach(DriveTo):
 class MoveToward(DriveTo):
     """Move along the way to the target until ``keep`` metres short of it, at most
     ``distance`` metres: into search range before a search, or on towards a target not
-    found ("continue to locate the old landmark"). Reads ``target``, ``map_T_odom``."""
+    found ("continue to locate the old landmark"). Either may be a function of this
+    behaviour (e.g. of the target's sign: how close it must be to be read). Reads
+    ``target``, ``map_T_odom``."""
 
-    def __init__(self, name: str, ctx: Context, keep: float, distance: float = math.inf):
+    def __init__(
+        self,
+        name: str,
+        ctx: Context,
+        keep: float | Callable[[PmNavBehaviour], float],
+        distance: float | Callable[[PmNavBehaviour], float] = math.inf,
+    ):
         super().__init__(name, ctx)
         self.keep = keep
         self.distance = distance
+
+    def _metres(self, value: float | Callable[[PmNavBehaviour], float]) -> float:
+        return float(value(self) if callable(value) else value)
 
     def goal(self) -> tuple[float, float]:
         t = self.get("target")
         est = self.estimate()
         d = np.asarray(t.position, float) - (est.x, est.y)
         n = float(np.linalg.norm(d))
-        step = max(0.0, min(self.distance, n - self.keep))
+        step = max(0.0, min(self._metres(self.distance), n - self._metres(self.keep)))
         if step == 0.0:
             return est.x, est.y
         return float(est.x + d[0] * step / n), float(est.y + d[1] * step / n)

@@ -9,7 +9,10 @@ Latency: wall time and process CPU time of ``read_signs`` per frame (the models 
 loaded before timing; one onnxruntime thread). On a shared machine the wall time
 includes waiting for a core: the load average is printed with it.
 
-Run: python benchmarks/bench_signs.py [--views 160] [--seed 0]
+Recall is also given per plate kind (``read_range.plate_kind``: a bare number, a name with
+short lines, a name with a long line set smaller); ``--kind`` renders views of one kind only.
+
+Run: python benchmarks/bench_signs.py [--views 160] [--seed 0] [--kind "long name"]
 Target: read_signs p50 < 150 ms and p95 < 400 ms per 320x240 frame on 2 cores.
 """
 
@@ -25,6 +28,7 @@ import numpy as np
 
 from pmnav_bt.map.building import builtin_buildings
 from pmnav_bt.perception.grounders.ocr import OcrGrounder
+from pmnav_bt.perception.read_range import PLATE_KINDS, plate_kind
 from pmnav_bt.seams import EntityKind, landmark_label, sign_label
 from pmnav_bt.sim.sign_views import sample_views
 from pmnav_bt.sim.world import SimWorld
@@ -44,17 +48,20 @@ def band_of(d: float) -> int:
     return next(i for i, (a, b) in enumerate(BANDS) if a <= d < b or (i == len(BANDS) - 1))
 
 
-def run(width: int, height: int, views: int, seed: int) -> None:
+def run(width: int, height: int, views: int, seed: int, kind: str | None = None) -> None:
     names = builtin_buildings()
     per = math.ceil(views / len(names))
     stats = defaultdict(lambda: defaultdict(int))
+    kinds = defaultdict(lambda: defaultdict(int))  # (plate kind, band) -> views, hits
     times: list[float] = []
     cpu: list[float] = []
     total = 0
     for k, name in enumerate(names):
         world = SimWorld(name)
         g = OcrGrounder(world.building)
-        for v in sample_views(world, per, width=width, height=height, seed=seed + k):
+        select = None if kind is None else (lambda text: plate_kind(text) == kind)
+        views_k = sample_views(world, per, width=width, height=height, seed=seed + k, select=select)
+        for v in views_k:
             obs = v.observation
             t0, c0 = time.perf_counter(), time.process_time()
             dets = g.read_signs(obs)
@@ -63,6 +70,9 @@ def run(width: int, height: int, views: int, seed: int) -> None:
             s = stats[band_of(v.distance)]
             s["views"] += 1
             s["hit"] += any(d.entity == v.entity for d in dets)
+            kd = kinds[(plate_kind(v.text), band_of(v.distance))]
+            kd["views"] += 1
+            kd["hit"] += any(d.entity == v.entity for d in dets)
             for d in dets:
                 s["named"] += 1
                 s["right"] += shows(obs, d.entity, d.box)
@@ -70,7 +80,10 @@ def run(width: int, height: int, views: int, seed: int) -> None:
         world.close()
     ms = np.array(times) * 1000
     cpu_ms = np.array(cpu) * 1000
-    print(f"\n{width}x{height}: {total} views, {len(names)} buildings, 0-70 deg off the plate")
+    only = "" if kind is None else f", {kind} plates only"
+    print(
+        f"\n{width}x{height}: {total} views, {len(names)} buildings, 0-70 deg off the plate{only}"
+    )
     print(f"{'distance':>10s} {'views':>6s} {'recall':>7s} {'named':>6s} {'precision':>9s}")
     tot = defaultdict(int)
     for i, (a, b) in enumerate(BANDS):
@@ -83,6 +96,17 @@ def run(width: int, height: int, views: int, seed: int) -> None:
     rec = 100 * tot["hit"] / max(tot["views"], 1)
     prec = 100 * tot["right"] / tot["named"] if tot["named"] else float("nan")
     print(f"{'all':>10s} {tot['views']:6d} {rec:6.1f}% {tot['named']:6d} {prec:8.1f}%")
+    print("recall per plate kind (read_range.plate_kind):")
+    for kind in PLATE_KINDS:
+        cells = []
+        for i in range(len(BANDS)):
+            kd = kinds[(kind, i)]
+            cells.append(
+                f"{100 * kd['hit'] / kd['views']:5.1f}% of {kd['views']:3d}"
+                if kd["views"]
+                else "    -       "
+            )
+        print(f"{kind:>10s} " + "  ".join(cells))
     for what, v in (("wall time", ms), ("CPU time", cpu_ms)):
         print(
             f"read_signs {what}: p50 {np.percentile(v, 50):.0f} ms, "
@@ -95,9 +119,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--views", type=int, default=160, help="views per resolution")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--kind", choices=PLATE_KINDS, help="views of this plate kind only")
     args = ap.parse_args()
     for w, h in ((320, 240), (640, 480)):
-        run(w, h, args.views, args.seed)
+        run(w, h, args.views, args.seed, args.kind)
 
 
 if __name__ == "__main__":

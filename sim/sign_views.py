@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import random
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,11 +63,15 @@ def sample_views(
     angles: tuple[float, float] = (0.0, math.radians(70.0)),
     seed: int = 0,
     segmentation: bool = True,
+    select: Callable[[str], bool] | None = None,
 ) -> Iterator[SignView]:
-    """``n`` views of random plates of ``world`` (seeded), each from a free spot in the corridor."""
+    """``n`` views of random plates of ``world`` (seeded), each from a free spot in the
+    corridor; ``select``: only plates whose text it accepts."""
     rng = random.Random(seed)
     k = CameraIntrinsics.from_hfov(width, height, HFOV)
-    items = plates(world)
+    items = [(e, it) for e, it in plates(world) if select is None or select(it.text)]
+    if not items:
+        return
     free = world.free_space
     made = tries = 0
     while made < n and tries < 200 * max(n, 1):

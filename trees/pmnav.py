@@ -46,7 +46,7 @@ from pmnav_bt.behaviours.search import (
     target_bearing,
     target_entity,
 )
-from pmnav_bt.perception.read_range import search_settings
+from pmnav_bt.perception.read_range import SearchRanges
 from pmnav_bt.seams import PixelGoalPolicy
 from pmnav_bt.trees.localize import active_localize_subtree, recovery_subtree
 
@@ -63,7 +63,16 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
     """One plan step: target determination, then search-verify-approach for a visible
     target or drive-turn-check for an unseen turn or fork, then target update."""
     cfg = ctx.config.tree
-    ranges = search_settings(ctx.config)  # from the reader's range unless set
+    # how close to go to read the target's sign: the reader's range for its plate kind
+    # (perception/read_range.py), unless set in the config
+    ranges = SearchRanges(ctx.config, ctx.pm.building)
+
+    def search_range(b) -> float:
+        return ranges.of(target_entity(b)).search_range
+
+    def research_distance(b) -> float:
+        return ranges.of(target_entity(b)).research_distance
+
     coarse_only = cfg.variant == "coarse_only"
     # A pixel-goal policy (refiner.backend=pixelnav) drives the approach in closed loop.
     closed_loop = not coarse_only and isinstance(ctx.refiner, PixelGoalPolicy)
@@ -93,7 +102,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
         children=[
             # On up to level with the target (its node): a sign hangs beside its door,
             # maybe on the far side, readable (not just visible) only from about there.
-            MoveToward("MoveOn", ctx, keep=0.0, distance=ranges.research_distance),
+            MoveToward("MoveOn", ctx, keep=0.0, distance=research_distance),
             AlwaysFail(name="SearchAgain"),
         ],
     )
@@ -102,7 +111,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
         memory=True,
         children=[
             TargetIs("IsVisible", ctx, visible=True),
-            MoveToward("IntoSearchRange", ctx, keep=ranges.search_range),
+            MoveToward("IntoSearchRange", ctx, keep=search_range),
             Retry(
                 "Search",
                 Selector("SearchOrMoveOn", memory=True, children=[search_once, research]),

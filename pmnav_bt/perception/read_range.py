@@ -5,13 +5,17 @@ The ``ocr`` reader's recall per distance band is measured by ``benchmarks/bench_
 the last band where the reader names at least ``RELIABLE_RECALL`` of the signs. Other
 widths are interpolated between the measured ones (below the smallest, in proportion to
 the width: a sign's text is that many pixels smaller; above the largest, no farther, as
-the reader's crops are upscaled anyway). The oracle (``sim_gt``) reads to its
-``grounder.max_range``.
+the reader's crops are upscaled anyway). The width is the one signs are read at: the
+camera's wider reading view where it offers one (``sim.reading_width``, on a robot the
+camera's own width), else the frame's. Plates with a name read nearer than bare numbers:
+each ``plate_kind`` has its own measured table where it differs. The oracle (``sim_gt``)
+reads to its ``grounder.max_range``.
 
-From the read range follow (``search_settings``): where the tree searches for a target
-(``tree.search_range``), how far it moves on before searching again
-(``tree.research_distance``), and the range the localization belief expects signs to be
-read from (``pose.visibility``). Values set in the config win.
+From the read range follow (``search_settings``, ``SearchRanges`` per plate kind): how
+close the tree goes to a target before searching for its sign (``tree.search_range``),
+how far it moves on before searching again (``tree.research_distance``), and the range
+the localization belief expects signs (all kinds) to be read from (``pose.visibility``).
+Values set in the config win.
 """
 
 from __future__ import annotations
@@ -21,12 +25,32 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.config import Config
+    from pmnav_bt.map.building import Building
+    from pmnav_bt.seams import Entity
 
 # benchmarks/bench_signs.py --views 200 (2026-11, 8 built-in buildings, 0-70 deg off the
 # plate): (band start m, band end m, recall) per camera width.
 OCR_RECALL: dict[int, tuple[tuple[float, float, float], ...]] = {
     320: ((1.5, 2.5, 0.939), (2.5, 3.5, 0.490), (3.5, 4.5, 0.033), (4.5, 6.0, 0.045)),
     640: ((1.5, 2.5, 0.949), (2.5, 3.5, 0.837), (3.5, 4.5, 0.300), (4.5, 6.0, 0.136)),
+}
+# Plate kinds by the sign text (as the priori-map knows it; sim/textures.py lays plates out
+# so: a leading room number on its own line, the name's words wrapped at LINE_CHARS).
+PLATE_KINDS = ("number", "name", "long name")
+LINE_CHARS = 14
+LONG_LINE_CHARS = 10
+# bench_signs.py --views 120 --kind name / --kind "long name" (2026-11): plates with a name
+# are read from nearer than bare numbers (number plates: 100 / 100 / 45 / 20 % at 640 px,
+# as all plates or better, so they keep the table above).
+OCR_RECALL_BY_KIND: dict[str, dict[int, tuple[tuple[float, float, float], ...]]] = {
+    "name": {
+        320: ((1.5, 2.5, 0.900), (2.5, 3.5, 0.269), (3.5, 4.5, 0.0), (4.5, 6.0, 0.0)),
+        640: ((1.5, 2.5, 0.967), (2.5, 3.5, 0.423), (3.5, 4.5, 0.100), (4.5, 6.0, 0.143)),
+    },
+    "long name": {
+        320: ((1.5, 2.5, 0.880), (2.5, 3.5, 0.205), (3.5, 4.5, 0.0), (4.5, 6.0, 0.0)),
+        640: ((1.5, 2.5, 0.960), (2.5, 3.5, 0.744), (3.5, 4.5, 0.391), (4.5, 6.0, 0.0)),
+    },
 }
 RELIABLE_RECALL = 0.75  # the tree searches where signs are read this often
 POSSIBLE_RECALL = 0.25  # beyond where signs are read this often, a reading is unexpected
@@ -38,9 +62,25 @@ MAX_RESEARCH_DISTANCE_M = 2.0
 SEARCH_MARGIN_M = 0.5
 
 
-def measured_range(width: int, recall: float = RELIABLE_RECALL) -> float:
-    """The far end of the last band with at least ``recall``, at a measured width."""
-    bands = OCR_RECALL[width]
+def plate_kind(text: str) -> str:
+    """ "number": a bare number or word (one line); "name": a number and a name whose lines
+    hold at most ``LONG_LINE_CHARS`` characters; "long name": one with a longer line."""
+    words = text.split()
+    if len(words) <= 1:
+        return "number" if len(text.strip()) <= LONG_LINE_CHARS else "long name"
+    if words[0][:1].isdigit():
+        words = words[1:]
+    longest, line = 0, ""
+    for w in words:
+        line = w if not line or len(line) + 1 + len(w) > LINE_CHARS else f"{line} {w}"
+        longest = max(longest, len(line))
+    return "long name" if longest > LONG_LINE_CHARS else "name"
+
+
+def measured_range(width: int, recall: float = RELIABLE_RECALL, kind: str | None = None) -> float:
+    """The far end of the last band with at least ``recall``, at a measured width, for
+    plates of ``kind`` (None: all plates)."""
+    bands = OCR_RECALL_BY_KIND.get(kind or "", OCR_RECALL)[width]
     far = bands[0][0]
     for _, end, r in bands:
         if r < recall:
@@ -49,17 +89,17 @@ def measured_range(width: int, recall: float = RELIABLE_RECALL) -> float:
     return far
 
 
-def ocr_read_range(width: int, recall: float = RELIABLE_RECALL) -> float:
-    """How far (m) the OCR reader names at least ``recall`` of the signs with a camera
-    ``width`` pixels wide."""
+def ocr_read_range(width: int, recall: float = RELIABLE_RECALL, kind: str | None = None) -> float:
+    """How far (m) the OCR reader names at least ``recall`` of the signs (of plate
+    ``kind``, None: all) with a camera ``width`` pixels wide."""
     widths = sorted(OCR_RECALL)
     if width <= widths[0]:
-        return measured_range(widths[0], recall) * width / widths[0]
+        return measured_range(widths[0], recall, kind) * width / widths[0]
     for lo, hi in zip(widths, widths[1:], strict=False):
         if width <= hi:
-            a, b = measured_range(lo, recall), measured_range(hi, recall)
+            a, b = measured_range(lo, recall, kind), measured_range(hi, recall, kind)
             return a + (b - a) * (width - lo) / (hi - lo)
-    return measured_range(widths[-1], recall)
+    return measured_range(widths[-1], recall, kind)
 
 
 def _oracle(config: Config) -> bool:
@@ -68,12 +108,18 @@ def _oracle(config: Config) -> bool:
     return GROUNDERS.spec(config.grounder.backend).needs_sim_labels
 
 
-def sign_read_range(config: Config, width: int | None = None) -> float:
-    """How far the configured grounder reliably names signs (m); ``width``: the camera's,
-    if not ``sim.width``."""
+def reading_width(config: Config) -> int:
+    """The width (pixels) signs are read at: ``sim.reading_width`` where the camera offers
+    that wider view (``Observation.reading``), else the frame's ``sim.width``."""
+    return max(config.sim.width, config.sim.reading_width)
+
+
+def sign_read_range(config: Config, width: int | None = None, kind: str | None = None) -> float:
+    """How far the configured grounder reliably names signs (m) of plate ``kind`` (None:
+    all); ``width``: the reading camera's, if not ``reading_width(config)``."""
     if _oracle(config):
         return config.grounder.max_range
-    return ocr_read_range(width or config.sim.width)
+    return ocr_read_range(width or reading_width(config), kind=kind)
 
 
 def sign_visible_range(config: Config, width: int | None = None) -> float | None:
@@ -82,7 +128,7 @@ def sign_visible_range(config: Config, width: int | None = None) -> float | None
     None for the oracle: the belief's own ``READ_RANGE_M``, checked against it."""
     if _oracle(config):
         return None
-    return ocr_read_range(width or config.sim.width, POSSIBLE_RECALL)
+    return ocr_read_range(width or reading_width(config), POSSIBLE_RECALL)
 
 
 @dataclass(frozen=True)
@@ -95,11 +141,13 @@ class SearchSettings:
     read_range: float
 
 
-def search_settings(config: Config, width: int | None = None) -> SearchSettings:
-    """``tree.search_range`` and ``tree.research_distance`` as set, else from the read range:
-    ``read_range - SEARCH_MARGIN_M`` (at most the oracle's 4.5 m) and half of that (at most
-    2 m)."""
-    read = sign_read_range(config, width)
+def search_settings(
+    config: Config, width: int | None = None, kind: str | None = None
+) -> SearchSettings:
+    """``tree.search_range`` and ``tree.research_distance`` as set, else from the read range
+    of plate ``kind`` (None: all plates): ``read_range - SEARCH_MARGIN_M`` (at most the
+    oracle's 4.5 m) and half of that (at most 2 m)."""
+    read = sign_read_range(config, width, kind)
     t = config.tree
     search = t.search_range
     if search is None:
@@ -108,3 +156,25 @@ def search_settings(config: Config, width: int | None = None) -> SearchSettings:
     if research is None:
         research = min(MAX_RESEARCH_DISTANCE_M, search / 2.0)
     return SearchSettings(search, research, read)
+
+
+def entity_plate_kind(building: Building, entity: Entity) -> str:
+    """The plate kind of the sign that names ``entity`` (by the priori-map's sign text)."""
+    from pmnav_bt.planning.resolve import sign_text
+
+    return plate_kind(sign_text(building, entity))
+
+
+class SearchRanges:
+    """The tree's search distances per plate kind (``search_settings``), looked up by the
+    entity a step looks for: how close to go to read that entity's sign."""
+
+    def __init__(self, config: Config, building: Building, width: int | None = None):
+        self.building = building
+        self.by_kind = {k: search_settings(config, width, k) for k in PLATE_KINDS}
+        self.default = search_settings(config, width)
+
+    def of(self, entity: Entity | None) -> SearchSettings:
+        if entity is None:
+            return self.default
+        return self.by_kind[entity_plate_kind(self.building, entity)]

@@ -7,6 +7,8 @@ import pytest
 from pmnav_bt.config import load_config
 from pmnav_bt.perception.read_range import (
     ocr_read_range,
+    plate_kind,
+    reading_width,
     search_settings,
     sign_read_range,
     sign_visible_range,
@@ -30,10 +32,17 @@ def test_other_widths_between_and_beyond_the_measured_ones():
 
 
 def test_the_tree_searches_within_the_readers_range():
+    # The default camera offers a 640x480 view for reading (sim.reading_width).
     ocr = search_settings(load_config(None, ["grounder.backend=ocr"]))
-    assert (ocr.search_range, ocr.research_distance, ocr.read_range) == (2.0, 1.0, 2.5)
-    big = search_settings(load_config(None, ["sim.width=640", "sim.height=480"]))
+    assert (ocr.search_range, ocr.research_distance, ocr.read_range) == (3.0, 1.5, 3.5)
+    small = search_settings(load_config(None, ["sim.reading_width=0"]))
+    assert (small.search_range, small.research_distance, small.read_range) == (2.0, 1.0, 2.5)
+    big = search_settings(
+        load_config(None, ["sim.width=640", "sim.height=480", "sim.reading_width=0"])
+    )
     assert (big.search_range, big.research_distance) == (3.0, 1.5)
+    assert reading_width(load_config(None, ["sim.reading_width=480"])) == 480
+    assert reading_width(load_config(None, ["sim.reading_width=200"])) == 320  # the frame's
     # The oracle reads to its max_range (9 m): the settings it was tuned with.
     oracle = load_config(None, ["grounder.backend=sim_gt"])
     assert (search_settings(oracle).search_range, search_settings(oracle).research_distance) == (
@@ -49,12 +58,35 @@ def test_the_tree_searches_within_the_readers_range():
 def test_the_localization_belief_expects_signs_where_the_reader_can_read_them(fig2_map):
     from pmnav_bt.pose.belief import CorridorBelief
 
-    cfg = load_config(None, ["grounder.backend=ocr"])
+    cfg = load_config(None, ["grounder.backend=ocr", "sim.reading_width=0"])
     belief = CorridorBelief(fig2_map, read_range=sign_visible_range(cfg))
     assert belief.vis.read_range == 3.5
+    assert sign_visible_range(load_config(None, ["grounder.backend=ocr"])) == 4.5  # at 640
     assert CorridorBelief(fig2_map).vis.read_range == 9.5  # the oracle's
     near = belief.vis.readable_from((16.0, 0.0))
     assert near and near < CorridorBelief(fig2_map).vis.readable_from((16.0, 0.0))
+
+
+def test_plate_kinds_by_the_sign_text():
+    assert plate_kind("113") == plate_kind("Elevator") == "number"
+    assert plate_kind("102 Pharmacy") == plate_kind("104 Laboratory") == "name"
+    assert plate_kind("116 Blood Collection") == "name"  # "Blood" / "Collection"
+    assert plate_kind("117 One-Stop Service Centre") == "long name"  # "Service Centre"
+    assert plate_kind("Main Stairs") == plate_kind("Registration") == "long name"
+
+
+def test_plates_with_a_name_are_read_from_nearer():
+    # bench_signs --kind name: 42 % at 2.5-3.5 m at 640 px; --kind "long name": 74 %
+    # (all plates: 84 %, bare numbers 100 %).
+    assert ocr_read_range(640, kind="name") == ocr_read_range(640, kind="long name") == 2.5
+    assert ocr_read_range(640, kind="number") == ocr_read_range(640) == 3.5
+    assert ocr_read_range(320, kind="name") == 2.5  # the first band: 90 %
+    assert ocr_read_range(640, 0.25, kind="name") == 3.5  # 10 % at 3.5-4.5 m
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    assert search_settings(cfg, kind="name").search_range == 2.0
+    assert search_settings(cfg, kind="number").search_range == 3.0
+    oracle = load_config(None, ["grounder.backend=sim_gt"])
+    assert search_settings(oracle, kind="name").search_range == 4.5
 
 
 def test_the_built_tree_uses_them(fig2_map):
@@ -62,13 +94,21 @@ def test_the_built_tree_uses_them(fig2_map):
 
     from pmnav_bt.trees.pmnav import step_subtree
 
-    def keeps(cfg) -> dict[str, tuple[float, float]]:
-        root = step_subtree(SimpleNamespace(config=cfg, now=lambda: 0.0, refiner=None))
-        return {
-            b.name: (b.keep, b.distance)
-            for b in root.iterate()
-            if b.name in ("IntoSearchRange", "MoveOn")
-        }
+    def keeps(cfg, look_for: str) -> dict[str, tuple[float, float]]:
+        ctx = SimpleNamespace(config=cfg, now=lambda: 0.0, refiner=None, pm=fig2_map)
+        root = step_subtree(ctx)
+        target = SimpleNamespace(look_for=look_for)
+        out = {}
+        for b in root.iterate():
+            if b.name in ("IntoSearchRange", "MoveOn"):
+                b.get = lambda key, t=target: t if key == "target" else None
+                out[b.name] = (b._metres(b.keep), b._metres(b.distance))
+        return out
 
-    got = keeps(load_config(None, ["grounder.backend=ocr"]))
+    ocr = load_config(None, ["grounder.backend=ocr"])
+    got = keeps(ocr, "room5")  # "105"
+    assert got["IntoSearchRange"][0] == 3.0 and got["MoveOn"] == (0.0, 1.5)
+    got = keeps(ocr, "room17")  # "117 One-Stop Service Centre": go nearer to read it
+    assert got["IntoSearchRange"][0] == 2.0 and got["MoveOn"] == (0.0, 1.0)
+    got = keeps(load_config(None, ["grounder.backend=ocr", "sim.reading_width=0"]), "room5")
     assert got["IntoSearchRange"][0] == 2.0 and got["MoveOn"] == (0.0, 1.0)
