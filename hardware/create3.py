@@ -59,6 +59,7 @@ from pmnav_bt.hardware.messages import (
     labels_from_image,
     pose_from_odometry,
     rgb_from_image,
+    shrink_frame,
     stamp_to_sec,
 )
 from pmnav_bt.seams import (
@@ -69,6 +70,7 @@ from pmnav_bt.seams import (
     TURN_STEP_RAD,
     CameraIntrinsics,
     DiscreteAction,
+    ImageReading,
     MotionStatus,
     Observation,
     Pose2D,
@@ -112,6 +114,9 @@ class Create3Options:
     camera_height: float = CAMERA_HEIGHT_M
     hfov_deg: float = 60.0  # intrinsics until a CameraInfo arrives
     stall_s: float = 2.0
+    # frames wider than this are shrunk to it for the tree, and the camera's full image is
+    # kept as the observation's view for reading signs (0: the tree gets the camera's image)
+    frame_width: int = 0
 
     def __post_init__(self) -> None:
         for name in ("cmd_rate_hz", "odom_timeout", "camera_timeout", "max_linear", "max_angular"):
@@ -289,6 +294,12 @@ class Create3Base:
             pose = self._pose_at(rgb.stamp)
             info = self._info
         image = rgb_from_image(rgb.msg)
+        d = depth_from_image(depth.msg) if depth is not None else None
+        s = labels_from_image(seg.msg) if seg is not None else None
+        reading = None
+        if 0 < opt.frame_width < image.shape[1]:
+            reading = ImageReading(image)
+            image, d, s = shrink_frame(image, d, s, opt.frame_width)
         h, w = image.shape[:2]
         k = intrinsics_from_camera_info(info, w, h) if info is not None else None
         if k is None:
@@ -298,11 +309,18 @@ class Create3Base:
             pose=pose,
             stamp=rgb.stamp,
             intrinsics=k,
-            depth=depth_from_image(depth.msg) if depth is not None else None,
-            segmentation=labels_from_image(seg.msg) if seg is not None else None,
+            depth=d,
+            segmentation=s,
             labels=dict(labels) if labels is not None else {},
             camera_height=opt.camera_height,
+            reading=reading,
         )
+
+    def camera_width(self) -> int | None:
+        """The width (pixels) of the camera's newest image (None before the first): the
+        width signs are read at."""
+        with self._frames:
+            return int(self._rgb[-1].msg.width) if self._rgb else None
 
     def step(self, action: DiscreteAction) -> None:
         """Start a discrete step, closed on odometry; replaces any motion in progress."""

@@ -123,6 +123,24 @@ def labels_from_image(msg) -> np.ndarray:
     return _typed(msg, kinds[enc]).astype(np.int32)
 
 
+def shrink_frame(rgb: np.ndarray, depth, seg, width: int):
+    """A camera frame shrunk to ``width`` pixels (aspect kept): colour by area averaging,
+    depth and labels by the nearest pixel (no mixed ranges or labels at edges)."""
+    import cv2
+
+    h, w = rgb.shape[:2]
+    size = (int(width), max(1, round(h * width / w)))
+
+    def nearest(a):
+        if a is None:
+            return None
+        rows = ((np.arange(size[1]) + 0.5) * a.shape[0] / size[1]).astype(int)
+        cols = ((np.arange(size[0]) + 0.5) * a.shape[1] / size[0]).astype(int)
+        return np.ascontiguousarray(a[rows][:, cols])
+
+    return cv2.resize(rgb, size, interpolation=cv2.INTER_AREA), nearest(depth), nearest(seg)
+
+
 def intrinsics_from_camera_info(msg, width: int | None = None, height: int | None = None):
     """sensor_msgs/CameraInfo -> CameraIntrinsics, scaled to ``width`` x ``height`` if the
     image size differs from the calibration (binning); None for an uncalibrated camera."""

@@ -87,6 +87,11 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "camera_height": (CAMERA_HEIGHT_M, "m above the floor"),
     "hfov_deg": (60.0, "horizontal field of view until a CameraInfo arrives"),
     "stall_s": (2.0, "a motion without progress for this long is BLOCKED"),
+    "frame_width": (
+        0,
+        "shrink wider camera frames to this for the tree and read signs in "
+        "the full image; 0: the tree gets the camera's image",
+    ),
     "map_frame": ("map", ""),
     "odom_frame": ("odom", ""),
     "publish_tf": (True, "publish map -> odom on /tf (needs tf2_msgs)"),
@@ -131,6 +136,18 @@ def declare_parameters(node, spec: dict[str, tuple[Any, str]]) -> dict[str, Any]
         out[name] = node.get_parameter(name).value
     check_unknown(node, spec)
     return out
+
+
+def camera_config(cfg, camera_width: int | None, opt: Create3Options):
+    """``cfg`` with the robot camera's size where the simulator's stands: the tree's frame
+    width (``sim.width``) and the width signs are read at (``sim.reading_width``), from
+    which the reader's range and the search distances follow (perception/read_range.py).
+    Unchanged before the first frame; search distances set in the config still win."""
+    if not camera_width:
+        return cfg
+    frame = opt.frame_width if 0 < opt.frame_width < camera_width else camera_width
+    sim = cfg.sim.model_copy(update={"width": frame, "reading_width": camera_width})
+    return cfg.model_copy(update={"sim": sim})
 
 
 def create3_options(params: dict[str, Any]) -> Create3Options:
@@ -467,6 +484,7 @@ class PmNavController:
         result: dict[str, Any] = {"id": run.id, "goal": goal, **self._room_fields(goal)}
         try:
             self._wait_ready(run, req, w0)
+            ctx.config = camera_config(cfg, self.base.camera_width(), self.base.options)
             max_ticks = max(1, int(float(p["max_duration_s"]) * cfg.tree.tick_hz))
             out = run_tree(ctx, goal, max_ticks, log=writer, on_tick=on_tick, sync_workers=False)
             result.update(

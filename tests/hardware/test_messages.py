@@ -141,3 +141,33 @@ def test_ros_clock_keeps_its_rate_and_can_be_interrupted(domain_id):
         assert not clock.interrupted
     finally:
         rt.shutdown()
+
+
+def test_a_frame_shrunk_for_the_tree_keeps_ranges_and_labels_unmixed():
+    from pmnav_bt.hardware.messages import shrink_frame
+
+    rgb = np.zeros((480, 640, 3), np.uint8)
+    rgb[:, 320:] = 200
+    depth = np.where(np.arange(640) < 320, 1.0, 5.0).astype(np.float32)[None].repeat(480, 0)
+    seg = np.where(np.arange(640) < 320, 3, 7).astype(np.int32)[None].repeat(480, 0)
+    small, d, s = shrink_frame(rgb, depth, seg, 320)
+    assert small.shape == (240, 320, 3) and d.shape == s.shape == (240, 320)
+    assert set(np.unique(d)) == {1.0, 5.0} and set(np.unique(s)) == {3, 7}  # no blends
+    assert d[:, 159].max() == 1.0 and d[:, 160].min() == 5.0
+    assert shrink_frame(rgb, None, None, 320)[1:] == (None, None)
+
+
+def test_the_robot_cameras_width_sets_the_readers_range():
+    from pmnav_bt.config import load_config
+    from pmnav_bt.hardware.create3 import Create3Options
+    from pmnav_bt.hardware.node import camera_config
+    from pmnav_bt.perception.read_range import search_settings
+
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    assert camera_config(cfg, None, Create3Options()) is cfg  # no frame yet
+    at320 = camera_config(cfg, 320, Create3Options())
+    assert (at320.sim.width, at320.sim.reading_width) == (320, 320)
+    assert search_settings(at320).search_range == 2.0
+    shrunk = camera_config(cfg, 640, Create3Options(frame_width=320))
+    assert (shrunk.sim.width, shrunk.sim.reading_width) == (320, 640)
+    assert search_settings(shrunk).search_range == 3.0

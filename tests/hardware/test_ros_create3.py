@@ -383,6 +383,14 @@ def test_create3_base_over_dds(domain_id, tmp_path):
             math.radians(60), abs=1e-3
         )
         assert "wall" in obs.labels.values() and obs.camera_height == 1.6
+        assert obs.reading is None and base.camera_width() == 160
+        # Frames shrunk for the tree, the camera's full image kept for reading signs.
+        base.options.frame_width = 80
+        small = base.observe()
+        assert small.rgb.shape == (60, 80, 3) and small.depth.shape == (60, 80)
+        assert small.segmentation.shape == (60, 80) and small.intrinsics.width == 80
+        assert small.intrinsics.hfov == pytest.approx(math.radians(60), abs=1e-3)
+        assert small.reading.rgb().shape == (120, 160, 3)
 
         probe.set_param("sim_create3", "publish_camera", False)
         t0 = time.monotonic()
