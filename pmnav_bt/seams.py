@@ -110,6 +110,11 @@ class ReadingView(Protocol):
         """(height, width, 3) uint8: the same view as the observation's ``rgb``."""
         ...
 
+    def crop(self, box: tuple[int, int, int, int]) -> np.ndarray:
+        """``rgb()[y0:y1, x0:x1]`` for ``box`` (x0, y0, x1, y1) inside the view: a body
+        may make that part alone (the simulator renders just those pixels)."""
+        ...
+
 
 @dataclass(frozen=True)
 class ImageReading:
@@ -127,6 +132,10 @@ class ImageReading:
 
     def rgb(self) -> np.ndarray:
         return self.image
+
+    def crop(self, box: tuple[int, int, int, int]) -> np.ndarray:
+        x0, y0, x1, y1 = box
+        return self.image[y0:y1, x0:x1]
 
 
 @dataclass

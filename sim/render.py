@@ -50,13 +50,20 @@ def render_camera(
     pitch: float = 0.0,
     depth: bool = True,
     segmentation: bool = True,
+    window: tuple[int, int, int, int] | None = None,
 ) -> Frame:
     """Render the view of a camera at (x, y, height) looking along ``yaw`` (tilted by ``pitch``).
 
+    ``window`` (x0, y0, x1, y1, pixels of the camera's image): render only that part of
+    the image (an off-axis frustum: the same pixels, for a fraction of the cost).
     Uses pybullet's headless tiny renderer, under the world's lock.
     """
     w, h = intrinsics.width, intrinsics.height
     vfov = 2.0 * math.atan((h / 2.0) / intrinsics.fy)
+    full_w = w
+    if window is not None:
+        x0, y0, x1, y1 = window
+        w, h = x1 - x0, y1 - y0
     fwd = (math.cos(yaw) * math.cos(pitch), math.sin(yaw) * math.cos(pitch), math.sin(pitch))
     jx, jy, jz = EYE_JITTER
     eye = (x + jx, y + jy, height + jz)
@@ -65,7 +72,23 @@ def render_camera(
     with world.lock:
         c = world.client
         view = p.computeViewMatrix(eye, target, (0.0, 0.0, 1.0), physicsClientId=c)
-        proj = p.computeProjectionMatrixFOV(math.degrees(vfov), w / h, NEAR, FAR, physicsClientId=c)
+        if window is None:
+            proj = p.computeProjectionMatrixFOV(
+                math.degrees(vfov), w / h, NEAR, FAR, physicsClientId=c
+            )
+        else:  # the sub-frustum of the full image's pixels x0..x1, y0..y1
+            top = NEAR * math.tan(vfov / 2.0)
+            right = top * full_w / intrinsics.height
+            sx, sy = 2.0 * right / full_w, 2.0 * top / intrinsics.height
+            proj = p.computeProjectionMatrix(
+                -right + sx * x0,
+                -right + sx * x1,
+                top - sy * y1,
+                top - sy * y0,
+                NEAR,
+                FAR,
+                physicsClientId=c,
+            )
         _, _, rgba, zbuf, seg = p.getCameraImage(
             w,
             h,

@@ -60,8 +60,9 @@ class MotionStats:
 
 
 class RenderedReading:
-    """A view rendered at a higher resolution when first asked for (``seams.ReadingView``):
-    RGB only, from the pose and heading of the observation it belongs to."""
+    """A view rendered at a higher resolution when asked for (``seams.ReadingView``): RGB
+    only, from the pose and heading of the observation it belongs to; ``crop`` renders
+    just the pixels asked for (a plate's crop: a few ms, the whole 640x480 view ~150 ms)."""
 
     def __init__(
         self,
@@ -85,6 +86,19 @@ class RenderedReading:
                 )
                 self._rgb = frame.rgb
             return self._rgb
+
+    def crop(self, box: tuple[int, int, int, int]) -> np.ndarray:
+        x0, y0, x1, y1 = box
+        with self._lock:
+            if self._rgb is not None:
+                return self._rgb[y0:y1, x0:x1]
+        window = (max(0, x0), max(0, y0), min(self.width, x1), min(self.height, y1))
+        if window[2] <= window[0] or window[3] <= window[1]:
+            return np.zeros((0, 0, 3), np.uint8)
+        frame = render_camera(
+            *self._args, height=self._height_m, depth=False, segmentation=False, window=window
+        )
+        return frame.rgb
 
 
 class SimBase:

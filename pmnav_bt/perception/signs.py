@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 
 from pmnav_bt.errors import BackendError
+from pmnav_bt.seams import ImageReading, ReadingView
 
 Box = tuple[float, float, float, float]  # x0, y0, x1, y1 (pixels)
 
@@ -221,13 +222,14 @@ class SignReader:
         return plates[: self.max_candidates]
 
     def read(
-        self, rgb: np.ndarray, candidates: list[tuple[Box, float]] | None = None
+        self, rgb: np.ndarray | ReadingView, candidates: list[tuple[Box, float]] | None = None
     ) -> list[SignText]:
         """Every candidate plate whose text could be read, with its lines.
 
-        ``candidates``: (box, text-line height) in ``rgb``'s pixels, if found elsewhere
-        (default: ``self.candidates(rgb)``). Lines are found per candidate, then
-        recognised together in one batch.
+        ``rgb``: the frame, or a ``ReadingView`` whose candidate crops are made one by
+        one (then ``candidates`` are needed). ``candidates``: (box, text-line height) in
+        ``rgb``'s pixels, if found elsewhere (default: ``self.candidates(rgb)``). Lines
+        are found per candidate, then recognised together in one batch.
         """
         if candidates is None:
             candidates = self.candidates(rgb)
@@ -249,14 +251,17 @@ class SignReader:
                 out.append(SignText(tuple(read), box))
         return out
 
-    def find_lines(self, rgb: np.ndarray, box: Box, line_h: float) -> list[tuple[Box, np.ndarray]]:
+    def find_lines(
+        self, rgb: np.ndarray | ReadingView, box: Box, line_h: float
+    ) -> list[tuple[Box, np.ndarray]]:
         """Text lines inside ``box`` (padded), top to bottom: (box in frame pixels, upright
         BGR crop for the recogniser). Lines too low to be read are left out."""
-        h, w = rgb.shape[:2]
+        src = ImageReading(rgb) if isinstance(rgb, np.ndarray) else rgb
         pad = PAD_LINES * line_h
         x0, y0 = int(max(0, box[0] - pad)), int(max(0, box[1] - pad))
-        x1, y1 = int(min(w, box[2] + pad + 1)), int(min(h, box[3] + pad + 1))
-        crop = rgb[y0:y1, x0:x1]
+        x1 = int(min(src.width, box[2] + pad + 1))
+        y1 = int(min(src.height, box[3] + pad + 1))
+        crop = src.crop((x0, y0, x1, y1))
         if crop.size == 0:
             return []
         scale = float(np.clip(LINE_PX / max(line_h, 1.0), 0.5, 6.0))

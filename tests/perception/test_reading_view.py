@@ -44,6 +44,10 @@ def test_the_sim_body_offers_a_wider_view_rendered_when_asked(world):
 
     small = cv2.resize(big, (320, 240), interpolation=cv2.INTER_AREA)
     assert np.abs(small.astype(int) - obs.rgb.astype(int)).mean() < 12
+    # A plate's crop alone: the same pixels, rendered without the rest of the view.
+    fresh = _base(world, 640).observe().reading
+    part = fresh.crop((300, 200, 420, 260))
+    assert fresh._rgb is None and np.array_equal(part, big[200:260, 300:420])
     assert _base(world, 0).observe().reading is None
     assert _base(world, 320).observe().reading is None  # no wider than the frame
 
@@ -70,6 +74,8 @@ def test_a_frame_without_plate_candidates_never_makes_the_wider_view(wall, fig2)
         def rgb(self):
             raise AssertionError("made the reading view for a plain wall")
 
+        crop = rgb
+
     from dataclasses import replace
 
     g = OcrGrounder(fig2)
@@ -80,3 +86,5 @@ def test_a_frame_without_plate_candidates_never_makes_the_wider_view(wall, fig2)
     signs = g.read_signs(replace(obs, reading=ImageReading(big)))
     assert [d.entity for d in signs] == [Entity.room("room2")]
     assert signs[0].box[2] <= 320
+    assert isinstance(ImageReading(big), ReadingView)
+    assert ImageReading(big).crop((10, 20, 30, 60)).shape == (40, 20, 3)

@@ -12,7 +12,8 @@
 - ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
 
 Where the body offers a wider view of the frame for reading (``Observation.reading``),
-plates are looked for in the frame and read in that view; boxes stay in frame pixels.
+plates are looked for in the frame and their crops read in that view (only the crops are
+made); boxes stay in frame pixels.
 No simulator labels are read. Results are cached for the last frame, so the tree can
 ask ``read_signs`` and ``detect`` of one frame at the cost of one reading.
 """
@@ -110,7 +111,8 @@ class OcrGrounder:
     def _read_text(self, obs: Observation) -> list[SignText]:
         """The frame's signs, boxes in the frame's pixels. Where the body offers a wider
         view (``obs.reading``), plates are looked for in the frame as the reader looks for
-        them in that view (scaled lines as low), and only then is the view made and read."""
+        them in that view (scaled lines as low), and only their crops of the view are made
+        and read."""
         r = obs.reading
         w = obs.rgb.shape[1]
         if r is None or r.width <= w:
@@ -120,7 +122,7 @@ class OcrGrounder:
         if not found:
             return []
         cands = [((b[0] * s, b[1] * s, b[2] * s, b[3] * s), lh * s) for b, lh in found]
-        return [scale_sign(t, 1.0 / s) for t in self.reader.read(r.rgb(), cands)]
+        return [scale_sign(t, 1.0 / s) for t in self.reader.read(r, cands)]
 
     def _door(self, obs: Observation, sign: Detection, plate: depth_geom.PlatePose) -> Detection:
         door = door_from_sign(obs, plate, self.layout)
