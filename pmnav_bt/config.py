@@ -219,8 +219,8 @@ class SimConfig(_Section):
         ge=0,
         le=1920,
         description="pixels: the camera also offers each view this wide for reading signs "
-        "(rendered when the grounder reads; the tree's other checks keep width x height); "
-        "0 or at most width: none",
+        "(only the plates' crops are made, when the grounder reads; the tree's other checks "
+        "keep width x height); 0 or at most width: none",
     )
     odometry_noise: float = Field(
         0.02, ge=0.0, le=1.0, description="std of the relative error of each odometry increment"
