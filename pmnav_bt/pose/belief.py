@@ -55,6 +55,7 @@ JUNCTION_REACH_M = 1.0  # side corridors of a junction this close are the robot'
 CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
 DIFFUSE_MASS = 0.3  # below this (best cluster), the belief is diffuse: look close by first
 NEAR_JUNCTION_M = 6.0  # ... at a junction or corridor end this close (its shape tells much)
+FIRST_JUNCTION_QUANTILE = 0.2  # diffuse, first drive: stop where this share puts a junction
 SWITCH_COST_RATIO = 2.0  # turn back when the other way is expected this much shorter
 TELLING_MIN_WEIGHT = 0.05  # hypotheses this likely (of the best) must be told apart ...
 TELLING_MAX_MODES = 4  # ... when they form at most this many clusters ...
@@ -407,10 +408,13 @@ class CorridorBelief:
             go = float(min(max(go, seen_to + LOOK_SPACING_M), 2.0 * max_distance))
         # Stop at the next junction (most of the belief agrees where): look round there.
         if run[k]:
-            ws, rs = np.array(run[k]).T
-            to_junction = float(
-                rs[np.argsort(rs)][np.searchsorted(np.cumsum(ws[np.argsort(rs)]), ws.sum() / 2)]
-            )
+            # Where most of the belief puts it; on the first drive from a diffuse belief
+            # (a bare corridor), where a share of it already does: a drive past a
+            # junction not looked round at skips the place that tells most.
+            _, mass = self.best_cluster()
+            first = mass < DIFFUSE_MASS and len(self.glimpses) <= 1
+            q = FIRST_JUNCTION_QUANTILE if first else 0.5
+            to_junction = _weighted_quantile(*np.array(run[k]).T, q)
             at = p + u * to_junction
             looked = any(
                 math.hypot(g.odom.x - at[0], g.odom.y - at[1]) < 3.0 for g in self.glimpses
@@ -546,9 +550,13 @@ class CorridorBelief:
 
 
 def _weighted_median(w: np.ndarray, x: np.ndarray) -> float:
+    return _weighted_quantile(w, x, 0.5)
+
+
+def _weighted_quantile(w: np.ndarray, x: np.ndarray, q: float) -> float:
     order = np.argsort(x)
     c = np.cumsum(w[order])
-    return float(x[order][min(len(x) - 1, int(np.searchsorted(c, c[-1] / 2.0)))])
+    return float(x[order][min(len(x) - 1, int(np.searchsorted(c, q * c[-1])))])
 
 
 def _apply_many(tfs: np.ndarray, p) -> np.ndarray:

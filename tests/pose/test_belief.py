@@ -155,6 +155,29 @@ def test_free_floor_seen_into_a_side_corridor_points_the_first_lead_at_the_junct
     assert abs(math.remainder(lead.heading - (odom[2] + math.pi), 2 * math.pi)) < 0.1
 
 
+def test_the_first_drive_from_a_bare_corridor_stops_at_a_junction_to_look():
+    # sign_sparse_0 hard episode 2: 7.3 m south of the crossing branch2 (30, 30) in a
+    # bare corridor, six views that read nothing. The belief is spread over every bare
+    # stretch; half of it puts the next junction 15 m or more ahead, and the first drive
+    # went 15 m, past the crossing (where the side corridors and room 13-14 would have
+    # told the place) into a 30 m bare dead end. It must stop where the nearest likely
+    # junction is and look round there.
+    pm = parse_building(generate_sign_sparse(0))
+    true = (30.0, 22.7, math.radians(53.0))
+    odom = se2_compose(ODOM_T_MAP, true)
+    free = tuple(
+        (true[2] + a + ODOM_T_MAP[2], _free(pm, true, true[2] + a))
+        for a in np.radians([0, 60, 120, 180, 240, 300])
+    )
+    b = CorridorBelief(pm)
+    b.observe(Glimpse(Pose2D(*odom), {}, None, free), axis_odom=odom[2] - true[2] + math.pi / 2)
+    lead = b.lead(Pose2D(*odom), 16.0)
+    h = lead.heading - ODOM_T_MAP[2]
+    end_y = true[1] + lead.distance * math.sin(h)
+    assert abs(math.cos(h)) < 1e-6  # along the corridor (x = 30)
+    assert -1.0 <= end_y <= 31.0, end_y  # not past branch2 (y = 30) nor turn1 (y = 0)
+
+
 def _drive_straight(pm, xy, map_heading: float, distance: float):
     """Move ``distance`` straight on (a robot that keeps its heading, off the centre line
     too) until 0.3 m from a wall."""
