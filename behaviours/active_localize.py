@@ -31,6 +31,10 @@ SIGN_APPROACH_M = 3.0  # with a sign in view ahead, drive this much further, the
 WALL_CHECK_S = 1.0  # clock seconds between wall checks while driving along the corridor
 STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
+# Bearings in each view along which the free floor is measured: three rays a view, so
+# a six-view panorama looks every 20 deg (a side corridor's opening is seen from a
+# junction's mouth, where one ray per view can miss it between two views).
+FREE_BEARINGS = tuple(math.radians(b) for b in (-20.0, 0.0, 20.0))
 
 
 def wall_mask(grounder: Grounder, obs: Observation):
@@ -39,8 +43,9 @@ def wall_mask(grounder: Grounder, obs: Observation):
 
 
 def read_panorama(ctx: Context, views: list):
-    """(sightings, corridor axis in odometry or None, free floor ahead of each view, the
-    odometry's rotation-scale error or None) of a panorama. Worker only.
+    """(sightings, corridor axis in odometry or None, the free floor along each view's
+    ``FREE_BEARINGS`` (odometry yaw, m), the odometry's rotation-scale error or None) of a
+    panorama. Worker only.
 
     A rotation-scale error turns each view's odometry yaw by a share of the turning since:
     the views are put back into the odometry frame of the last one (where the robot is
@@ -65,7 +70,9 @@ def read_panorama(ctx: Context, views: list):
     ]
     angles = [(views[i].observation.pose.yaw, f[0], f[1]) for i, f in fits]
     free = tuple(
-        (v.observation.pose.yaw, min(free_distance(v.observation, 0.0), 50.0)) for v in views
+        (wrap_angle(v.observation.pose.yaw + b), min(free_distance(v.observation, b), 50.0))
+        for v in views
+        for b in FREE_BEARINGS
     )
     return sightings, axis_in_odom(angles), free, error
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import shapely
 
+from pmnav_bt.behaviours.active_localize import FREE_BEARINGS
 from pmnav_bt.geometry import se2_apply, se2_compose, se2_inverse
 from pmnav_bt.map.building import load_building
 from pmnav_bt.map.generate import generate_sign_sparse
@@ -153,6 +154,24 @@ def test_free_floor_seen_into_a_side_corridor_points_the_first_lead_at_the_junct
     b.observe(Glimpse(Pose2D(*odom), {}, None, free), axis_odom=odom[2])
     lead = b.lead(Pose2D(*odom), 16.0)
     assert abs(math.remainder(lead.heading - (odom[2] + math.pi), 2 * math.pi)) < 0.1
+
+
+@pytest.mark.parametrize("heading_deg", [60.0, 77.0, 90.0, 100.0, 110.0])
+def test_rays_every_20_deg_see_the_side_corridors_whatever_the_panoramas_start(heading_deg):
+    # sign_sparse_0 hard episode 3: the same start as above, but the panorama began at
+    # 77 deg (odometry turned it): with one ray a view (every 60 deg) none looked into the
+    # side corridors, and the first drive went north into the bare dead end. The panorama
+    # measures free floor along FREE_BEARINGS of each view; some ray then sees them.
+    pm = parse_building(generate_sign_sparse(0))
+    true = (30.0, 32.4, math.radians(heading_deg))
+    odom = se2_compose(ODOM_T_MAP, true)
+    rays = [math.radians(60.0 * v) + b for v in range(6) for b in FREE_BEARINGS]
+    free = tuple((true[2] + a + ODOM_T_MAP[2], _free(pm, true, true[2] + a)) for a in rays)
+    b = CorridorBelief(pm)
+    b.observe(Glimpse(Pose2D(*odom), {}, None, free), axis_odom=odom[2] - true[2] + math.pi / 2)
+    lead = b.lead(Pose2D(*odom), 16.0)
+    south = se2_compose(ODOM_T_MAP, (0.0, 0.0, -math.pi / 2))[2]
+    assert abs(math.remainder(lead.heading - south, 2 * math.pi)) < 0.1
 
 
 def test_the_first_drive_from_a_bare_corridor_stops_at_a_junction_to_look():
