@@ -325,7 +325,10 @@ class CorridorBelief:
         across it at a junction). It keeps the way it chose last while enough of the belief
         says that way goes on (so it explores one way to the end, then the other), else the
         open way with the least expected corridor distance to where the map says two
-        signs are readable."""
+        signs are readable. The drive stops at the next junction, where half the belief
+        puts it (on the first drive from a diffuse belief, where a fifth does: from a
+        bare corridor the median junction is far, and a nearer one passed unlooked-at
+        is the place that would have told the position)."""
         dist, _ = self.vis.towards_signs
         if not dist:
             return None
