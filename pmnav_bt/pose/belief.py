@@ -35,6 +35,7 @@ P_SPURIOUS = 0.005  # a sign is read that the map says cannot be read from there
 SIGHT_SIGMA_M = 0.8  # spread of a sign's seen position around the map's
 DRIFT_PER_M = 0.05  # the sight spread grows with odometry distance from the reference
 FIX_MASS = 0.85  # a cluster holding this much weight is a fix
+SIGN_AGREE_M = 1.0  # signs fixing the position together must agree on it this well
 MISREAD = math.log(P_MISS * P_SPURIOUS)  # readable here, but read far from its place
 P_THROUGH_WALL = 0.02  # the robot is where the hypothesis puts it inside a wall
 OFF_CORRIDOR_M = 1.0  # beyond a corridor's half-width by this much: inside a wall
@@ -312,10 +313,9 @@ class CorridorBelief:
             return self.to_odom(tf), spread + 0.5
         if len({tuple(d) for d in dst}) >= 2 and np.ptp(np.array(dst), axis=0).max() >= 2.0:
             tf, res = fit_se2(np.array(src), np.array(dst))
-        else:  # one sign: the heading is the hypothesis's, the position from the sign
-            shift = np.mean([d - se2_apply(tf, s) for s, d in zip(src, dst, strict=True)], axis=0)
+        else:  # signs close together: the heading is the hypothesis's, the position theirs
+            shift, res = _sign_shift(tf, src, dst)
             tf = (tf[0] + float(shift[0]), tf[1] + float(shift[1]), tf[2])
-            res = 0.0
         spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
         tf = self.to_odom((float(tf[0]), float(tf[1]), float(tf[2])))
         return tf, math.hypot(spread, res)
@@ -550,6 +550,26 @@ class CorridorBelief:
     def _axis(self) -> float:
         """The corridor axis in odometry, as seen at the reference."""
         return 0.0 if self.ref is None else self.ref.yaw - self.axis_offset
+
+
+def _sign_shift(tf, src, dst) -> tuple[np.ndarray, float]:
+    """The shift that puts the signs read (``src``, odometry) on their map places (``dst``)
+    under ``tf``, and its residual (m, RMS over the signs kept).
+
+    Each sign's shift is the mean of its sightings'. Signs that disagree by more than
+    ``SIGN_AGREE_M`` cannot all be right (a sign plate sits beside the door or elevator the
+    map places, up to 1.7 m off): those that agree with the sign asking for the smallest
+    shift, the one the belief's hypothesis (every sighting, depth, the corridors) already
+    agrees with, are kept."""
+    per: dict[tuple, list] = {}
+    for s, d in zip(src, dst, strict=True):
+        per.setdefault(tuple(d), []).append(d - se2_apply(tf, s))
+    shifts = np.array([np.mean(v, axis=0) for v in per.values()])
+    least = shifts[int(np.argmin(np.linalg.norm(shifts, axis=1)))]
+    kept = shifts[np.linalg.norm(shifts - least, axis=1) <= SIGN_AGREE_M]
+    shift = kept.mean(axis=0)
+    res = float(np.sqrt(np.mean(np.sum((kept - shift) ** 2, axis=1))))
+    return shift, res
 
 
 def _weighted_median(w: np.ndarray, x: np.ndarray) -> float:
