@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
@@ -150,7 +151,10 @@ class FixFromBelief(PmNavBehaviour):
         now = [Sighting(e, entity_xy(self.ctx.pm, e), xy) for e, xy in last.seen.items()]
         fix = fix_pose(now)
         if fix is not None:
-            tf = belief.to_odom(fix.map_T_odom)  # the sightings are in the belief's frame
+            used = [x.map_xy for x in now if x.entity in fix.entities]
+            pivot = tuple(np.mean(used, axis=0))
+            # the sightings are in the belief's frame; the heading follows its walls
+            tf = belief.to_odom(belief.level_with_walls(fix.map_T_odom, pivot))
             sigma, how = 0.3 + fix.residual, f"{len(fix.entities)} signs"
         else:
             got = belief.fix()

@@ -35,6 +35,7 @@ P_SPURIOUS = 0.005  # a sign is read that the map says cannot be read from there
 SIGHT_SIGMA_M = 0.8  # spread of a sign's seen position around the map's
 DRIFT_PER_M = 0.05  # the sight spread grows with odometry distance from the reference
 FIX_MASS = 0.85  # a cluster holding this much weight is a fix
+MAX_LEVEL = math.radians(15.0)  # a two-sign fit is turned onto the walls' axis up to this
 SIGN_AGREE_M = 1.0  # signs fixing the position together must agree on it this well
 MISREAD = math.log(P_MISS * P_SPURIOUS)  # readable here, but read far from its place
 P_THROUGH_WALL = 0.02  # the robot is where the hypothesis puts it inside a wall
@@ -162,14 +163,17 @@ class CorridorBelief:
             if axis_odom is not None:
                 self.axis_offset = wrap_angle(2.0 * (self.ref.yaw - axis_odom)) / 2.0
             self._drift, self._raw, self._corr = 0.0, glimpse.odom, (glimpse.odom.x, glimpse.odom.y)
+            self._last_axis = axis_odom  # the walls' axis at the last glimpse (straightened)
             self.glimpses.append(glimpse)
             self._build()
             return
         drift = self._drift
+        self._last_axis = None
         if axis_odom is not None:
             d = wrap_angle(4.0 * (axis_odom - self._ref_axis)) / 4.0  # mod pi/2
             if abs(wrap_angle(4.0 * (d - drift)) / 4.0) < MAX_DRIFT_STEP:
                 drift = d
+                self._last_axis = wrap_angle(axis_odom - drift)
         # Straighten the odometry: the leg since the last glimpse turned by the mean drift.
         raw, mean = glimpse.odom, (self._drift + drift) / 2.0
         c, s = math.cos(-mean), math.sin(-mean)
@@ -199,6 +203,28 @@ class CorridorBelief:
     def to_odom(self, map_T_straight: tuple[float, float, float]) -> tuple[float, float, float]:
         """A fix in the belief's straightened frame as ``map_T_odom`` for the odometry now."""
         return se2_compose(map_T_straight, self._straighten_tf())
+
+    def level_with_walls(
+        self, map_T_straight: tuple[float, float, float], pivot: tuple[float, float]
+    ) -> tuple[float, float, float]:
+        """A fix (in the belief's straightened frame) turned about ``pivot`` (map) so that
+        the corridor axis the walls gave at the last glimpse lies along the map's corridor
+        there (mod 90 deg): two signs a couple of metres apart, each plate a little off
+        where the map puts its door, give a heading several degrees off; the walls give it
+        to a degree or two. Unchanged without a wall axis, or when they differ by more than
+        ``MAX_LEVEL`` (another corridor's wall)."""
+        axis = getattr(self, "_last_axis", None)
+        if self.ref is None or axis is None:
+            return map_T_straight
+        here = se2_apply(map_T_straight, (self._corr[0], self._corr[1]))
+        seg = self.pm.locate(float(here[0]), float(here[1])).segment
+        err = wrap_angle(4.0 * (seg.heading - (axis + map_T_straight[2]))) / 4.0
+        if abs(err) > MAX_LEVEL:
+            return map_T_straight
+        c, s = math.cos(err), math.sin(err)
+        px, py = pivot
+        x, y = map_T_straight[0] - px, map_T_straight[1] - py
+        return (px + c * x - s * y, py + s * x + c * y, wrap_angle(map_T_straight[2] + err))
 
     def sightings(self) -> list[tuple[Entity, tuple[float, float]]]:
         """Every sign read so far and where (odometry), oldest first."""
