@@ -150,11 +150,12 @@ class FixFromBelief(PmNavBehaviour):
         last = belief.glimpses[-1]
         now = [Sighting(e, entity_xy(self.ctx.pm, e), xy) for e, xy in last.seen.items()]
         fix = fix_pose(now)
-        if fix is not None:
+        level = None
+        if fix is not None:  # the heading follows the walls; a fit they refute is not taken
             used = [x.map_xy for x in now if x.entity in fix.entities]
-            pivot = tuple(np.mean(used, axis=0))
-            # the sightings are in the belief's frame; the heading follows its walls
-            tf = belief.to_odom(belief.level_with_walls(fix.map_T_odom, pivot))
+            level = belief.level_with_walls(fix.map_T_odom, tuple(np.mean(used, axis=0)))
+        if level is not None:
+            tf = belief.to_odom(level)  # the sightings are in the belief's frame
             sigma, how = 0.3 + fix.residual, f"{len(fix.entities)} signs"
         else:
             got = belief.fix()

@@ -206,13 +206,14 @@ class CorridorBelief:
 
     def level_with_walls(
         self, map_T_straight: tuple[float, float, float], pivot: tuple[float, float]
-    ) -> tuple[float, float, float]:
+    ) -> tuple[float, float, float] | None:
         """A fix (in the belief's straightened frame) turned about ``pivot`` (map) so that
         the corridor axis the walls gave at the last glimpse lies along the map's corridor
         there (mod 90 deg): two signs a couple of metres apart, each plate a little off
         where the map puts its door, give a heading several degrees off; the walls give it
-        to a degree or two. Unchanged without a wall axis, or when they differ by more than
-        ``MAX_LEVEL`` (another corridor's wall)."""
+        to a degree or two. Unchanged without a wall axis; when they differ by more than
+        ``MAX_LEVEL``: then None, the signs cannot be where the map puts them (a misread,
+        or a plate far from its map point) and the fix is not to be taken."""
         axis = getattr(self, "_last_axis", None)
         if self.ref is None or axis is None:
             return map_T_straight
@@ -220,7 +221,7 @@ class CorridorBelief:
         seg = self.pm.locate(float(here[0]), float(here[1])).segment
         err = wrap_angle(4.0 * (seg.heading - (axis + map_T_straight[2]))) / 4.0
         if abs(err) > MAX_LEVEL:
-            return map_T_straight
+            return None
         c, s = math.cos(err), math.sin(err)
         px, py = pivot
         x, y = map_T_straight[0] - px, map_T_straight[1] - py
@@ -337,9 +338,13 @@ class CorridorBelief:
             if spread > BLIND_SPREAD_M:
                 return None
             return self.to_odom(tf), spread + 0.5
+        fitted = None
         if len({tuple(d) for d in dst}) >= 2 and np.ptp(np.array(dst), axis=0).max() >= 2.0:
-            tf, res = fit_se2(np.array(src), np.array(dst))
-        else:  # signs close together: the heading is the hypothesis's, the position theirs
+            fit, res = fit_se2(np.array(src), np.array(dst))
+            fitted = self.level_with_walls(fit, tuple(np.mean(dst, axis=0)))
+        if fitted is not None:
+            tf = fitted
+        else:  # signs close together, or a fit the walls refute: the hypothesis's heading
             shift, res = _sign_shift(tf, src, dst)
             tf = (tf[0] + float(shift[0]), tf[1] + float(shift[1]), tf[2])
         spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))

@@ -316,3 +316,33 @@ def test_a_two_sign_fit_is_turned_onto_the_walls_axis():
     assert abs(math.degrees(wrap_angle(tf[2] - truth[2]))) < 0.5
     here = se2_apply(tf, (g.odom.x, g.odom.y))
     assert np.hypot(*(np.asarray(here) - true[:2])) < 1.0  # the plates' own offset remains
+
+
+def test_a_sign_fit_the_walls_refute_is_not_taken_and_the_belief_fixes_instead():
+    """The OCR stack read the elevator's plate 2.2 m from the elevator the map places and
+    room4's door sign 2.5 m away (sign_sparse_2, Table 3 redundant #0): the two-sign fit
+    is 48 deg off the walls' axis. It is refused; the belief's fix leaves the sign that
+    disagrees out and keeps the walls' heading."""
+    pm = parse_building(generate_sign_sparse(2))
+    readable = {e for p in Visibility.of(pm).lattice_points for e in p.readable}
+    room4 = next(e for e in readable if e.id == "room4")
+    elevator = next(e for e in readable if e.id == "elevator1")
+    plates = {room4: (-0.2, 0.2), elevator: (-0.13, 2.18)}
+    seen = {e: tuple(se2_apply(ODOM_T_MAP, np.add(entity_xy(pm, e), d))) for e, d in plates.items()}
+    b = CorridorBelief(pm)
+    for y in (35.5, 33.5):  # a second look, 2 m on: the same plates
+        true = (0.0, y, -math.pi / 2)
+        g = glimpse(pm, true, (), depth=True)
+        axis = wrap_angle(true[2] + ODOM_T_MAP[2])
+        b.observe(Glimpse(g.odom, seen, None, g.free), axis_odom=axis)
+    now = [Sighting(e, entity_xy(pm, e), xy) for e, xy in seen.items()]
+    fit = fix_pose(now)
+    assert fit is not None
+    truth = se2_inverse(ODOM_T_MAP)
+    assert abs(math.degrees(wrap_angle(fit.map_T_odom[2] - truth[2]))) > 30.0
+    assert b.level_with_walls(fit.map_T_odom, (0.0, 32.0)) is None
+    fix = b.fix()
+    assert fix is not None
+    assert abs(math.degrees(wrap_angle(fix[0][2] - truth[2]))) < 2.0
+    here = se2_apply(fix[0], (g.odom.x, g.odom.y))
+    assert np.hypot(*(np.asarray(here) - true[:2])) < 0.5
