@@ -14,11 +14,12 @@ import random
 from dataclasses import replace
 
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.seams import DiscreteAction, MotionStatus, Observation, Pose2D
+from pmnav_bt.seams import Observation, Pose2D
 from pmnav_bt.sim.robot import SimBase
+from pmnav_bt.wrapped_base import WrappedBase
 
 
-class NoisyOdometry:
+class NoisyOdometry(WrappedBase):
     """A Base whose pose is drifting odometry of the wrapped SimBase.
 
     ``noise`` is the standard deviation of the relative error of each increment; the
@@ -26,8 +27,7 @@ class NoisyOdometry:
     """
 
     def __init__(self, base: SimBase, noise: float, seed: int = 0):
-        self.inner = base
-        self.clock = base.clock
+        super().__init__(base)
         self.noise = float(noise)
         self._rng = random.Random(seed)
         self._last_true = base.pose()
@@ -77,15 +77,3 @@ class NoisyOdometry:
     def observe(self) -> Observation:
         obs = self.inner.observe()
         return replace(obs, pose=self.pose())
-
-    def step(self, action: DiscreteAction) -> None:
-        self.inner.step(action)
-
-    def set_velocity(self, linear: float, angular: float) -> None:
-        self.inner.set_velocity(linear, angular)
-
-    def motion_status(self) -> MotionStatus:
-        return self.inner.motion_status()
-
-    def stop(self) -> None:
-        self.inner.stop()

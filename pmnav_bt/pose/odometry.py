@@ -22,7 +22,8 @@ from dataclasses import replace
 import numpy as np
 
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
-from pmnav_bt.seams import Base, DiscreteAction, MotionStatus, Observation, Pose2D
+from pmnav_bt.seams import Base, Observation, Pose2D
+from pmnav_bt.wrapped_base import WrappedBase
 
 MIN_VIEWS = 4  # wall directions needed in one panorama to measure the rotation error
 MIN_SPAN = math.radians(180.0)  # ... spread over at least this much turning
@@ -54,7 +55,7 @@ def rotation_scale_error(angles: list[tuple[float, float, int]]) -> float | None
     return None if rms > MAX_RESIDUAL else float(slope)
 
 
-class CalibratedBase:
+class CalibratedBase(WrappedBase):
     """A ``Base`` whose odometry yaw increments are multiplied by ``gain``.
 
     Poses are re-integrated from the wrapped base's increments each time they are read
@@ -63,8 +64,7 @@ class CalibratedBase:
     """
 
     def __init__(self, inner: Base) -> None:
-        self.inner = inner
-        self.clock = inner.clock
+        super().__init__(inner)
         self.gain = 1.0
         self._asked: list[float] = []  # the gain each measurement asked for
         self._lock = threading.Lock()
@@ -132,15 +132,3 @@ class CalibratedBase:
         q = obs.pose
         x, y, yaw = se2_compose(corr_T_raw, (q.x, q.y, q.yaw))
         return replace(obs, pose=Pose2D(x, y, wrap_angle(yaw)))
-
-    def step(self, action: DiscreteAction) -> None:
-        self.inner.step(action)
-
-    def set_velocity(self, linear: float, angular: float) -> None:
-        self.inner.set_velocity(linear, angular)
-
-    def motion_status(self) -> MotionStatus:
-        return self.inner.motion_status()
-
-    def stop(self) -> None:
-        self.inner.stop()
