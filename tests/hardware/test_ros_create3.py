@@ -291,8 +291,10 @@ def test_faults_over_dds(probe, domain_id, tmp_path):
         assert odom and abs(odom[-1][1]) < 1e-3 and abs(odom[-1][2]) < 1e-3, "still moving"
         if last_v or last_w:  # it was moving when killed: the timeout stopped it
             stopped_after = (moving[-1] if moving else t_kill) - last_cmd_t
-            # 0.5 s timeout + one odometry period (the stop shows in the next message) + slack
-            assert stopped_after <= 0.5 + 0.25, f"stopped {stopped_after:.2f} s after the last cmd"
+            # The 0.5 s timeout stopped it (the log says so below), not the end of the test:
+            # 0.5 s + one odometry period, with a wide margin for a loaded machine (the
+            # probe's receive times are wall clock; 1.01 s was seen on 2 busy cores).
+            assert stopped_after <= 0.5 + 1.0, f"stopped {stopped_after:.2f} s after the last cmd"
             probe.wait_for(lambda: "cmd_vel timeout" in sim.log.read_text(), 5.0, "log", (sim,))
             print(f"controller killed: the base stopped {stopped_after:.2f} s after the last cmd")
     finally:
