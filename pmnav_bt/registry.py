@@ -182,26 +182,22 @@ class Backends:
     planner: Planner | None  # None: the map-less baseline plans nothing
 
 
-def build_backends(config: Config, pm: PrioriMap, *, on_robot: bool, seed: int = 0) -> Backends:
-    """Every seam's back end, as ``config`` names them (the simulator and the robot alike)."""
+def build_backends(
+    config: Config, pm: PrioriMap, *, on_robot: bool, seed: int = 0, planner: bool = True
+) -> Backends:
+    """Every seam's back end, as ``config`` names them (the simulator and the robot alike);
+    ``planner=False``: no planner (``build_perception``)."""
     deps = BackendDeps(config=config, pm=pm, seed=seed, on_robot=on_robot)
     deps.grounder = GROUNDERS.build(config.grounder.backend, deps)
     return Backends(
         grounder=deps.grounder,
         coarse=COARSE.build(config.coarse.backend, deps),
         refiner=REFINERS.build(config.refiner.backend, deps),
-        planner=PLANNERS.build(config.planner.backend, deps),
+        planner=PLANNERS.build(config.planner.backend, deps) if planner else None,
     )
 
 
 def build_perception(config: Config, pm: Any, *, on_robot: bool, seed: int = 0) -> Backends:
     """The perception back ends only (grounder, coarse direction, refiner), no planner:
     the map-less baseline's, with ``pm`` its sign vocabulary (``map.signs_only.SignsOnly``)."""
-    deps = BackendDeps(config=config, pm=pm, seed=seed, on_robot=on_robot)
-    deps.grounder = GROUNDERS.build(config.grounder.backend, deps)
-    return Backends(
-        grounder=deps.grounder,
-        coarse=COARSE.build(config.coarse.backend, deps),
-        refiner=REFINERS.build(config.refiner.backend, deps),
-        planner=None,
-    )
+    return build_backends(config, pm, on_robot=on_robot, seed=seed, planner=False)
