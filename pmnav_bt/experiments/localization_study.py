@@ -4,7 +4,10 @@ by how many landmarks are readable there (redundant > 2, minimal = 2, scarce 0-1
 Start poses are points of the corridor centre lines, facing along the corridor (either
 way, seeded), at least ``START_CLEARANCE_M`` from key waypoints; the class comes from the
 priori-map's readability model (``pmnav_bt.pose.visibility``: line of sight within the
-corridors, ``READ_RANGE_M``). A run succeeds when the subtree ends in SUCCESS with the
+corridors) with the read range of the perception under test: the OCR reader's reliable
+range per plate kind (``read_range.landmark_ranges``: a sign 6 m away that it cannot read
+is not a landmark the robot has), or ``READ_RANGE_M`` for the oracle and for the
+map's-range classes of earlier rounds (``ranges=None``). A run succeeds when the subtree ends in SUCCESS with the
 estimated pose within ``SUCCESS_POS_M`` and ``SUCCESS_YAW_DEG`` of the truth; d is the
 number of panoramas it took (``fix_attempts``), and SDF = S * 2 / max(2, d).
 
@@ -17,6 +20,7 @@ import json
 import math
 import random
 import time
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
@@ -24,7 +28,8 @@ import numpy as np
 
 from pmnav_bt.config import Config
 from pmnav_bt.eval.metrics import sdf_term
-from pmnav_bt.pose.visibility import LandmarkDensity, Visibility
+from pmnav_bt.perception.read_range import entity_plate_kind
+from pmnav_bt.pose.visibility import LandmarkDensity, Visibility, density_class, entity_xy
 
 SUCCESS_POS_M = 1.0
 SUCCESS_YAW_DEG = 15.0
@@ -64,28 +69,44 @@ class LocResult:
         return sdf_term(self.success, max(1, self.attempts))
 
 
-def classified_starts(building: str, n: int, seed: int = 0) -> list[LocStart]:
-    """Up to ``n`` start poses of each landmark-density class in ``building`` (seeded)."""
+def classified_starts(
+    building: str, n: int, seed: int = 0, ranges: Mapping[str, float] | None = None
+) -> list[LocStart]:
+    """Up to ``n`` start poses of each landmark-density class in ``building`` (seeded),
+    counting the landmarks readable within ``ranges`` (m per plate kind, as
+    ``read_range.landmark_ranges``; None: ``READ_RANGE_M`` for every plate)."""
     from pmnav_bt.map.building import load_building
     from pmnav_bt.map.priori_map import parse_building
 
-    pm = parse_building(load_building(building))
-    vis = Visibility.of(pm)
+    b = load_building(building)
+    pm = parse_building(b)
+    vis = Visibility.of(pm, None if ranges is None else max(ranges.values()))
     keys = np.array([pm.node_xy(w.id) for w in pm.key_waypoints])
     rng = random.Random(f"{building}:{seed}")
     by_class: dict[LandmarkDensity, list] = {c: [] for c in LandmarkDensity}
     for p in vis.lattice_points:
         if np.min(np.linalg.norm(keys - np.array(p.xy), axis=1)) < START_CLEARANCE_M:
             continue
-        by_class[vis.density(p.xy)].append(p)
+        readable = _within(b, pm, p, ranges)
+        by_class[density_class(readable)].append((p, readable))
     out = []
     for cls, pts in by_class.items():
-        for i, p in enumerate(rng.sample(pts, min(n, len(pts)))):
+        for i, (p, readable) in enumerate(rng.sample(pts, min(n, len(pts)))):
             h = pm.segments[p.segment - 1].heading + (math.pi if rng.random() < 0.5 else 0.0)
-            out.append(
-                LocStart(building, p.xy[0], p.xy[1], h, cls.value, len(p.readable), seed * 1000 + i)
-            )
+            out.append(LocStart(building, p.xy[0], p.xy[1], h, cls.value, readable, seed * 1000 + i))
     return out
+
+
+def _within(building, pm, point, ranges: Mapping[str, float] | None) -> int:
+    """How many of the signs in sight of a lattice point are within their kind's range."""
+    if ranges is None:
+        return len(point.readable)
+    here = np.array(point.xy)
+    return sum(
+        np.linalg.norm(np.array(entity_xy(pm, e)) - here)
+        <= ranges[entity_plate_kind(building, e)]
+        for e in point.readable
+    )
 
 
 def run_localization(start: LocStart, config: Config) -> LocResult:

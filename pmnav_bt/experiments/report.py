@@ -130,7 +130,8 @@ def render_report(folder: Path) -> Path:
         lines += [
             f"Buildings: {t3['building']} ({t3['n']} starts per class per building); "
             f"grounder {t3.get('grounder', g.grounder.backend if g else '?')}. Class: signs "
-            "readable from the start by the priori-map's visibility model: redundant > 2, "
+            "readable from the start by the priori-map's visibility model "
+            f"({t3.get('class_range', '<= 9.5 m')}): redundant > 2, "
             "minimal = 2, scarce 0-1. SDF = S * 2 / max(2, panoramas).",
             "",
             table3(study),
@@ -290,7 +291,14 @@ def report(
     from pmnav_bt import cli_values
     from pmnav_bt.experiments.evaluation import episodes_for
     from pmnav_bt.experiments.localization_study import classified_starts
-    from pmnav_bt.experiments.sim_cli import _buildings, _config, _jobs, _tiers
+    from pmnav_bt.experiments.sim_cli import (
+        _buildings,
+        _class_ranges,
+        _config,
+        _jobs,
+        _ranges_text,
+        _tiers,
+    )
     from pmnav_bt.experiments.stored_run import run_stored_evaluation, run_stored_study
     from pmnav_bt.experiments.variants import VARIANTS, variant_configs
     from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
@@ -320,11 +328,13 @@ def report(
                 t3_names += [f"{SIGN_SPARSE_FAMILY}_{k}" for k in range(family_size)]
             else:
                 t3_names += _buildings(part)
-        starts = [s for b in t3_names for s in classified_starts(b, table3_n, seed)]
+        ranges = _class_ranges("stack", base)
+        starts = [s for b in t3_names for s in classified_starts(b, table3_n, seed, ranges)]
         t3 = {
             "building": ", ".join(t3_names),
             "n": table3_n,
             "grounder": base.grounder.backend,
+            "class_range": _ranges_text(ranges),
         }
     ev = {"building": building, "tier": tier, "n": n, "seed": seed}
     out.mkdir(parents=True, exist_ok=True)

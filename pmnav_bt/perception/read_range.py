@@ -165,6 +165,15 @@ def entity_plate_kind(building: Building, entity: Entity) -> str:
     return plate_kind(sign_text(building, entity))
 
 
+def landmark_ranges(config: Config) -> dict[str, float] | None:
+    """How far (m) the configured grounder reliably names each plate kind: the range
+    within which a landmark counts as readable, e.g. for Table 3's start classes. None for
+    the oracle: the priori-map's own ``visibility.READ_RANGE_M`` for every plate."""
+    if _oracle(config):
+        return None
+    return {k: sign_read_range(config, kind=k) for k in PLATE_KINDS}
+
+
 class SearchRanges:
     """The tree's search distances per plate kind (``search_settings``), looked up by the
     entity a step looks for: how close to go to read that entity's sign."""

@@ -79,3 +79,14 @@ def test_show_pose(capsys, pose, tmp_path):
     )
     assert code == 2
     one_line(err, "--pose")
+
+
+@pytest.mark.parametrize("value", ["far", "", "STACK", "9.5"])
+def test_table3_class_range_is_stack_or_map(capsys, tmp_path, value):
+    TRIED["CLI: sim table3 --class-range"] += 1
+    code, _, err = pmnav_cli(
+        capsys, "sim", "table3", "--class-range", value, "--out", tmp_path / "t3"
+    )
+    assert code != 0
+    one_line(err, "pmnav: error:")
+    assert "--class-range" in err and not (tmp_path / "t3" / "results.jsonl").exists()
