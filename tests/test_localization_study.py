@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from pmnav_bt.config import load_config
 from pmnav_bt.experiments.localization_study import (
     PAPER,
     LocResult,
@@ -11,7 +12,6 @@ from pmnav_bt.experiments.localization_study import (
     classified_starts,
     table,
 )
-from pmnav_bt.config import load_config
 from pmnav_bt.map.building import load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.perception.read_range import entity_plate_kind, landmark_ranges

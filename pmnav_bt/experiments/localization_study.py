@@ -7,9 +7,10 @@ priori-map's readability model (``pmnav_bt.pose.visibility``: line of sight with
 corridors) with the read range of the perception under test: the OCR reader's reliable
 range per plate kind (``read_range.landmark_ranges``: a sign 6 m away that it cannot read
 is not a landmark the robot has), or ``READ_RANGE_M`` for the oracle and for the
-map's-range classes of earlier rounds (``ranges=None``). A run succeeds when the subtree ends in SUCCESS with the
-estimated pose within ``SUCCESS_POS_M`` and ``SUCCESS_YAW_DEG`` of the truth; d is the
-number of panoramas it took (``fix_attempts``), and SDF = S * 2 / max(2, d).
+map's-range classes of earlier rounds (``ranges=None``). A run succeeds when the subtree
+ends in SUCCESS with the estimated pose within ``SUCCESS_POS_M`` and ``SUCCESS_YAW_DEG``
+of the truth; d is the number of panoramas it took (``fix_attempts``), and
+SDF = S * 2 / max(2, d).
 
 Imports the simulator and the tree lazily (the experiments layer joins them).
 """
@@ -93,7 +94,9 @@ def classified_starts(
     for cls, pts in by_class.items():
         for i, (p, readable) in enumerate(rng.sample(pts, min(n, len(pts)))):
             h = pm.segments[p.segment - 1].heading + (math.pi if rng.random() < 0.5 else 0.0)
-            out.append(LocStart(building, p.xy[0], p.xy[1], h, cls.value, readable, seed * 1000 + i))
+            out.append(
+                LocStart(building, p.xy[0], p.xy[1], h, cls.value, readable, seed * 1000 + i)
+            )
     return out
 
 
@@ -103,8 +106,7 @@ def _within(building, pm, point, ranges: Mapping[str, float] | None) -> int:
         return len(point.readable)
     here = np.array(point.xy)
     return sum(
-        np.linalg.norm(np.array(entity_xy(pm, e)) - here)
-        <= ranges[entity_plate_kind(building, e)]
+        np.linalg.norm(np.array(entity_xy(pm, e)) - here) <= ranges[entity_plate_kind(building, e)]
         for e in point.readable
     )
 
