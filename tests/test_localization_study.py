@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import math
+from dataclasses import asdict
 
 from pmnav_bt.config import load_config
 from pmnav_bt.experiments.localization_study import (
@@ -56,6 +58,7 @@ def test_with_the_readers_ranges_a_sign_beyond_its_plate_kinds_range_is_no_landm
         assert density_class(len(near)).value == s.density
         fewer += len(near) < vis.n_readable((s.x, s.y))
     assert fewer  # the map's 9.5 m would have counted more signs at some starts
+    json.dumps([asdict(s) for s in starts])  # stored with the results
     assert classified_starts("sign_sparse_0", n=4, seed=2, ranges=ranges) == starts
 
 

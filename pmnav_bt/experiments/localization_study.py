@@ -104,7 +104,7 @@ def _within(building, pm, point, ranges: Mapping[str, float] | None) -> int:
     """How many of the signs in sight of a lattice point are within their kind's range."""
     if ranges is None:
         return len(point.readable)
-    here = np.array(point.xy)
+    here = point.xy
     return sum(
         np.linalg.norm(np.array(entity_xy(pm, e)) - here) <= ranges[entity_plate_kind(building, e)]
         for e in point.readable
