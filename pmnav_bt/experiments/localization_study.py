@@ -104,9 +104,8 @@ def _within(building, pm, point, ranges: Mapping[str, float] | None) -> int:
     """How many of the signs in sight of a lattice point are within their kind's range."""
     if ranges is None:
         return len(point.readable)
-    here = point.xy
     return sum(
-        np.linalg.norm(np.array(entity_xy(pm, e)) - here) <= ranges[entity_plate_kind(building, e)]
+        math.dist(entity_xy(pm, e), point.xy) <= ranges[entity_plate_kind(building, e)]
         for e in point.readable
     )
 
