@@ -7,9 +7,11 @@ digits). A reading matches a key by string similarity (difflib), or as a fragmen
 digit sequence of the reading must equal the key's, so "108 Pharmacy" never matches
 "102 Pharmacy", and a bare number matches only the room whose sign starts with exactly
 that number. Letters commonly read for digits inside a number ("1O5", "l12") are mapped
-to digits first. Digits read with a low recogniser score are not trusted at all: such a
-reading matches nothing. The best entity must beat the runner-up by a margin, else the
-reading is ambiguous and matches nothing.
+to digits first; a reading that then matches nothing is tried as read (a lettered room
+number, "D103") and with its leading digit as a look-alike letter ("0103" for "D103",
+when only one such reading names an entity). Digits read with a low recogniser score are
+not trusted at all: such a reading matches nothing. The best entity must beat the
+runner-up by a margin, else the reading is ambiguous and matches nothing.
 """
 
 from __future__ import annotations
@@ -30,6 +32,9 @@ MIN_DIGIT_SCORE = 0.85  # recogniser score a line with digits needs
 _NUMBER = re.compile(r"^[A-Za-z]?\d+[A-Za-z]?$")
 # Letters an OCR model reads for digits, fixed only inside tokens that are mostly digits.
 _DIGIT_LOOKALIKES = str.maketrans({"O": "0", "o": "0", "D": "0", "I": "1", "l": "1", "|": "1"})
+# Digits an OCR model reads for the letter of a lettered room number ("0103" for "D103"),
+# tried only when a reading matches nothing as read.
+_LETTER_LOOKALIKES = {"0": "doq", "1": "il", "2": "z", "4": "a", "5": "s", "6": "g", "8": "b"}
 
 
 def normalise(text: str) -> str:
@@ -50,6 +55,18 @@ def fix_numbers(text: str) -> str:
             tok = tok.translate(_DIGIT_LOOKALIKES)
         out.append(tok)
     return " ".join(out)
+
+
+def lettered(text: str) -> list[str]:
+    """The readings of ``text`` with the first digit of one all-digit token (3 or more
+    digits) read as a look-alike letter: the wing letter of "D103" is often read "0"."""
+    toks = text.split()
+    out = []
+    for i, tok in enumerate(toks):
+        if len(tok) >= 3 and tok.isdigit():
+            for c in _LETTER_LOOKALIKES.get(tok[0], ""):
+                out.append(" ".join([*toks[:i], c + tok[1:], *toks[i + 1 :]]))
+    return out
 
 
 def sign_number(sign_text: str) -> str | None:
@@ -105,7 +122,7 @@ class SignMatcher:
         """
         if any(digits(normalise(fix_numbers(t))) and s < MIN_DIGIT_SCORE for t, s in lines):
             return None  # digits we do not trust: never guess a number
-        whole = self._match_key(normalise(fix_numbers(" ".join(t for t, _ in lines))))
+        whole = self._match_whole(" ".join(t for t, _ in lines))
         if whole is not None or len(lines) < 2:
             return whole
         read_digits = [digits(normalise(fix_numbers(t))) for t, _ in lines]
@@ -117,6 +134,23 @@ class SignMatcher:
         if all(d in number for d in read_digits if d):
             return Match(part.entity, 0.9 * part.score, part.key)
         return None
+
+    def _match_whole(self, text: str) -> Match | None:
+        """``text`` with look-alike letters in numbers read as digits ("1O5"); failing
+        that, as read (a lettered number, "D103", is not "0103"); failing that, with a
+        leading digit read as a look-alike letter ("0103"), when exactly one such reading
+        names an entity."""
+        fixed = fix_numbers(text)
+        for reading in (fixed, text):
+            m = self._match_key(normalise(reading))
+            if m is not None:
+                return m
+        found: dict[Entity, Match] = {}
+        for reading in lettered(fixed):
+            m = self._match_key(normalise(reading))
+            if m is not None and m.entity not in found:
+                found[m.entity] = Match(m.entity, 0.9 * m.score, m.key)
+        return next(iter(found.values())) if len(found) == 1 else None
 
     def _match_key(self, key: str) -> Match | None:
         if not key:

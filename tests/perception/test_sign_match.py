@@ -25,6 +25,21 @@ def test_look_alike_letters_in_numbers(matcher):
     assert matcher.match([("1O5", 0.95)]).entity == Entity.room("room5")
 
 
+def test_lettered_room_numbers_and_their_wing_letter_read_as_a_digit():
+    """The sign-sparse family's wings are lettered (A101, D103): "D" is a look-alike of
+    "0", so a perfect reading of "D103" used to be mapped to "0103" and match nothing."""
+    from pmnav_bt.map.generate import generate_sign_sparse
+
+    m = SignMatcher(generate_sign_sparse(0))
+    by_sign = {r.sign_text: Entity.room(r.id) for r in generate_sign_sparse(0).rooms}
+    assert m.match([("D103", 0.95)]).entity == by_sign["D103"]
+    assert m.match([("0103", 0.95)]).entity == by_sign["D103"]  # the wing letter read "0"
+    assert m.match([("8102", 0.95)]).entity == by_sign["B102"]
+    assert m.match([("0103", 0.95)]).score < m.match([("D103", 0.95)]).score
+    assert m.match([("1103", 0.95)]) is None  # "I103" / "L103": no such wing
+    assert m.match([("D109", 0.95)]) is None  # the digits still must agree
+
+
 def test_a_misread_digit_never_names_another_room(fig2, matcher):
     """Every one-digit misreading of every room number (alone and with the room's name)
     names nothing, or exactly the room whose sign carries the misread number."""
