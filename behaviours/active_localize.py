@@ -18,7 +18,7 @@ from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance
-from pmnav_bt.perception.read_range import sign_visible_range
+from pmnav_bt.perception.read_range import sign_recall, sign_visible_range
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
@@ -111,7 +111,12 @@ class UpdateBelief(PmNavBehaviour):
         views = self.get("views") or []
         belief = self.get("belief")
         if belief is None:
-            belief = CorridorBelief(self.ctx.pm, read_range=sign_visible_range(self.ctx.config))
+            cfg, pm = self.ctx.config, self.ctx.pm
+            belief = CorridorBelief(
+                pm,
+                read_range=sign_visible_range(cfg),
+                recall=sign_recall(cfg, pm.building),
+            )
             tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
             if tf is not None:
                 sigma = tracker.sigma(self.ctx.odometer.distance) if tracker else 3.0

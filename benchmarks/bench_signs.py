@@ -12,7 +12,12 @@ includes waiting for a core: the load average is printed with it.
 Recall is also given per plate kind (``read_range.plate_kind``: a bare number, a name with
 short lines, a name with a long line set smaller); ``--kind`` renders views of one kind only.
 
+Recall per angle off the plate's normal is printed too; ``--angles 0,88`` samples views
+beyond the default 0-70 deg (a plate seen along its wall, e.g. from a junction), and
+``--widths 640`` measures one camera size only.
+
 Run: python benchmarks/bench_signs.py [--views 160] [--seed 0] [--kind "long name"]
+     [--angles 0,70] [--widths 320,640]
 Target: read_signs p50 < 150 ms and p95 < 400 ms per 320x240 frame on 2 cores.
 """
 
@@ -34,6 +39,7 @@ from pmnav_bt.sim.sign_views import sample_views
 from pmnav_bt.sim.world import SimWorld
 
 BANDS = ((1.5, 2.5), (2.5, 3.5), (3.5, 4.5), (4.5, 6.0))
+ANGLE_BANDS = ((0, 30), (30, 50), (50, 60), (60, 70), (70, 75), (75, 80), (80, 90))  # deg
 
 
 def shows(obs, entity, box) -> bool:
@@ -48,11 +54,19 @@ def band_of(d: float) -> int:
     return next(i for i, (a, b) in enumerate(BANDS) if a <= d < b or (i == len(BANDS) - 1))
 
 
-def run(width: int, height: int, views: int, seed: int, kind: str | None = None) -> None:
+def run(
+    width: int,
+    height: int,
+    views: int,
+    seed: int,
+    kind: str | None = None,
+    angles: tuple[float, float] = (0.0, 70.0),
+) -> None:
     names = builtin_buildings()
     per = math.ceil(views / len(names))
     stats = defaultdict(lambda: defaultdict(int))
     kinds = defaultdict(lambda: defaultdict(int))  # (plate kind, band) -> views, hits
+    by_angle = defaultdict(lambda: defaultdict(int))  # (angle band, band) -> views, hits
     times: list[float] = []
     cpu: list[float] = []
     total = 0
@@ -60,7 +74,15 @@ def run(width: int, height: int, views: int, seed: int, kind: str | None = None)
         world = SimWorld(name)
         g = OcrGrounder(world.building)
         select = None if kind is None else (lambda text: plate_kind(text) == kind)
-        views_k = sample_views(world, per, width=width, height=height, seed=seed + k, select=select)
+        views_k = sample_views(
+            world,
+            per,
+            width=width,
+            height=height,
+            seed=seed + k,
+            select=select,
+            angles=(math.radians(angles[0]), math.radians(angles[1])),
+        )
         for v in views_k:
             obs = v.observation
             t0, c0 = time.perf_counter(), time.process_time()
@@ -73,6 +95,11 @@ def run(width: int, height: int, views: int, seed: int, kind: str | None = None)
             kd = kinds[(plate_kind(v.text), band_of(v.distance))]
             kd["views"] += 1
             kd["hit"] += any(d.entity == v.entity for d in dets)
+            deg = math.degrees(v.angle)
+            ab = next(i for i, (a, b) in enumerate(ANGLE_BANDS) if a <= deg < b or b == 90)
+            ad = by_angle[(ab, band_of(v.distance))]
+            ad["views"] += 1
+            ad["hit"] += any(d.entity == v.entity for d in dets)
             for d in dets:
                 s["named"] += 1
                 s["right"] += shows(obs, d.entity, d.box)
@@ -82,7 +109,8 @@ def run(width: int, height: int, views: int, seed: int, kind: str | None = None)
     cpu_ms = np.array(cpu) * 1000
     only = "" if kind is None else f", {kind} plates only"
     print(
-        f"\n{width}x{height}: {total} views, {len(names)} buildings, 0-70 deg off the plate{only}"
+        f"\n{width}x{height}: {total} views, {len(names)} buildings, "
+        f"{angles[0]:g}-{angles[1]:g} deg off the plate{only}"
     )
     print(f"{'distance':>10s} {'views':>6s} {'recall':>7s} {'named':>6s} {'precision':>9s}")
     tot = defaultdict(int)
@@ -107,6 +135,18 @@ def run(width: int, height: int, views: int, seed: int, kind: str | None = None)
                 else "    -       "
             )
         print(f"{kind:>10s} " + "  ".join(cells))
+    print("recall per angle off the plate's normal (rows) and distance band (columns):")
+    for i, (a, b) in enumerate(ANGLE_BANDS):
+        cells = []
+        for j in range(len(BANDS)):
+            ad = by_angle[(i, j)]
+            cells.append(
+                f"{100 * ad['hit'] / ad['views']:5.1f}% of {ad['views']:3d}"
+                if ad["views"]
+                else "    -       "
+            )
+        if any(by_angle[(i, j)]["views"] for j in range(len(BANDS))):
+            print(f"{a:>3d}-{b:<2d} deg " + "  ".join(cells))
     for what, v in (("wall time", ms), ("CPU time", cpu_ms)):
         print(
             f"read_signs {what}: p50 {np.percentile(v, 50):.0f} ms, "
@@ -120,9 +160,14 @@ def main() -> None:
     ap.add_argument("--views", type=int, default=160, help="views per resolution")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--kind", choices=PLATE_KINDS, help="views of this plate kind only")
+    ap.add_argument("--angles", default="0,70", help="deg off the plate's normal: LO,HI")
+    ap.add_argument("--widths", default="320,640", help="camera widths (4:3 frames)")
     args = ap.parse_args()
-    for w, h in ((320, 240), (640, 480)):
-        run(w, h, args.views, args.seed, args.kind)
+    lo, hi = (float(v) for v in args.angles.split(","))
+    if not 0.0 <= lo < hi < 90.0:
+        ap.error(f"--angles must be LO,HI with 0 <= LO < HI < 90, not {args.angles!r}")
+    for w in (int(v) for v in args.widths.split(",")):
+        run(w, w * 3 // 4, args.views, args.seed, args.kind, (lo, hi))
 
 
 if __name__ == "__main__":

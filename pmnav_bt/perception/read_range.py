@@ -14,12 +14,15 @@ reads to its ``grounder.max_range``.
 From the read range follow (``search_settings``, ``SearchRanges`` per plate kind): how
 close the tree goes to a target before searching for its sign (``tree.search_range``),
 how far it moves on before searching again (``tree.research_distance``), and the range
-the localization belief expects signs (all kinds) to be read from (``pose.visibility``).
+the localization belief expects signs (all kinds) to be read from (``pose.visibility``),
+and how likely each sign is read from a given distance (``sign_recall``: a sign not read
+is evidence only where the reader would have read it).
 Values set in the config win.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -52,8 +55,13 @@ OCR_RECALL_BY_KIND: dict[str, dict[int, tuple[tuple[float, float, float], ...]]]
         640: ((1.5, 2.5, 0.960), (2.5, 3.5, 0.744), (3.5, 4.5, 0.391), (4.5, 6.0, 0.0)),
     },
 }
+# bench_signs.py --views 320 --angles 0,88 --widths 640 (2026-11): recall falls off past
+# 70 deg off the plate's normal whatever the distance (at 1.5-2.5 m: 85 % at 60-70 deg,
+# 50 % at 70-75, none of 14 views beyond 75; at 2.5-3.5 m: 73 / 33 / 0 of 24): the share
+# of the 0-70 deg tables' recall kept up to each angle (deg).
+ANGLE_RECALL = ((70.0, 1.0), (75.0, 0.4), (90.0, 0.0))
 RELIABLE_RECALL = 0.75  # the tree searches where signs are read this often
-POSSIBLE_RECALL = 0.25  # beyond where signs are read this often, a reading is unexpected
+POSSIBLE_RECALL = 0.1  # beyond where signs are read this often, a reading is unexpected
 # The oracle's search settings (a sign read to 9 m): the tree's settings before the reader.
 MAX_SEARCH_RANGE_M = 4.5
 MAX_RESEARCH_DISTANCE_M = 2.0
@@ -102,6 +110,40 @@ def ocr_read_range(width: int, recall: float = RELIABLE_RECALL, kind: str | None
     return measured_range(widths[-1], recall, kind)
 
 
+def measured_recall(width: int, distance: float, kind: str | None = None) -> float:
+    """The share of plates (of ``kind``, None: all) read from ``distance`` m at a measured
+    ``width``: its band's recall; nearer than the first band, the first band's; beyond
+    the last, none."""
+    bands = OCR_RECALL_BY_KIND.get(kind or "", OCR_RECALL)[width]
+    if distance < bands[0][0]:
+        return bands[0][2]
+    for _, end, r in bands:
+        if distance <= end:
+            return r
+    return 0.0
+
+
+def ocr_recall(width: int, distance: float, kind: str | None = None) -> float:
+    """The share of plates (of ``kind``) the OCR reader names from ``distance`` m with a
+    camera ``width`` pixels wide: between measured widths interpolated; below the
+    smallest, at the distance scaled up (the text is that many pixels smaller); above the
+    largest, as the largest (crops are upscaled anyway)."""
+    widths = sorted(OCR_RECALL)
+    if width <= widths[0]:
+        return measured_recall(widths[0], distance * widths[0] / width, kind)
+    for lo, hi in zip(widths, widths[1:], strict=False):
+        if width <= hi:
+            a, b = measured_recall(lo, distance, kind), measured_recall(hi, distance, kind)
+            return a + (b - a) * (width - lo) / (hi - lo)
+    return measured_recall(widths[-1], distance, kind)
+
+
+def angle_share(angle: float) -> float:
+    """The share of the tables' recall kept ``angle`` rad off the plate's normal."""
+    deg = abs(math.degrees(angle))
+    return next((share for upto, share in ANGLE_RECALL if deg <= upto), 0.0)
+
+
 def _oracle(config: Config) -> bool:
     from pmnav_bt.registry import GROUNDERS
 
@@ -129,6 +171,26 @@ def sign_visible_range(config: Config, width: int | None = None) -> float | None
     if _oracle(config):
         return None
     return ocr_read_range(width or reading_width(config), POSSIBLE_RECALL)
+
+
+def sign_recall(config: Config, building: Building, width: int | None = None):
+    """``recall(entity, distance, angle)``: how likely the configured grounder names
+    ``entity``'s sign (by its plate kind) from ``distance`` m and ``angle`` rad off the
+    plate's normal, for the localization belief's misses (a sign 4 m off that OCR reads one
+    time in three, or one seen along its wall, is no evidence when not read). None for the
+    oracle: its misses are the belief's constant ``P_MISS``."""
+    if _oracle(config):
+        return None
+    w = width or reading_width(config)
+    kinds: dict = {}
+
+    def recall(entity: Entity, distance: float, angle: float = 0.0) -> float:
+        kind = kinds.get(entity)
+        if kind is None:
+            kind = kinds[entity] = entity_plate_kind(building, entity)
+        return ocr_recall(w, distance, kind) * angle_share(angle)
+
+    return recall
 
 
 @dataclass(frozen=True)

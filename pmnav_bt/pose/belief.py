@@ -19,6 +19,7 @@ different signs.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import networkx as nx
@@ -101,9 +102,14 @@ class CorridorBelief:
     _last_way: int | None = None  # the way (0-3 from the axis) the last lead chose
     _drift: float = 0.0  # odometry heading drift since the reference, from the walls
     read_range: float | None = None  # m, signs are read to (None: visibility.READ_RANGE_M)
+    # recall(entity, distance m, angle rad off the plate's normal): how likely that sign is
+    # read from there (None: 1 - P_MISS within read_range); a sign the map says is in sight
+    # but not read costs 1 - recall.
+    recall: Callable[[Entity, float, float], float] | None = None
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm, self.read_range)
+        self._miss = self._miss_logs()
         self._floor = shapely.buffer(self.vis.corridors, RAY_SLACK_M)  # a little tolerance
         shapely.prepare(self._floor)
         self._build()
@@ -133,6 +139,26 @@ class CorridorBelief:
             self._weigh_prior(*self.prior)
         for g in self.glimpses:
             self._weigh(g)
+
+    def _miss_logs(self) -> list[dict[Entity, float]] | None:
+        """Per lattice point, the log-probability that each sign in sight is not read."""
+        if self.recall is None:
+            return None
+        vis = self.vis
+        plate = {
+            e: (xy, n) for e, xy, n in zip(vis.entities, vis.sign_xy, vis.sign_normal, strict=True)
+        }
+        out = []
+        for p in vis.lattice_points:
+            logs = {}
+            for e in p.readable:
+                xy, normal = plate[e]
+                v = np.asarray(p.xy) - xy
+                d = float(np.linalg.norm(v))
+                off = math.acos(min(1.0, max(-1.0, float(v @ normal) / max(d, 1e-9))))
+                logs[e] = math.log(max(P_MISS, 1.0 - self.recall(e, d, off)))
+            out.append(logs)
+        return out
 
     def _weigh_prior(self, map_T_odom: tuple[float, float, float], sigma: float) -> None:
         """Hypotheses near where the earlier estimate puts the reference are likelier."""
@@ -287,8 +313,13 @@ class CorridorBelief:
         map_xy = {e: np.array(entity_xy(self.pm, e)) for e in seen}
         seen_map = {e: _apply_many(tfs, xy) for e, xy in g.seen.items()}  # (N, 2) per sign
         d_seen = {e: np.linalg.norm(seen_map[e] - map_xy[e], axis=1) for e in seen}
+        miss = self._miss
         for i, r in enumerate(readable):
-            lw = len(r - seen) * math.log(P_MISS)
+            if miss is None:
+                lw = len(r - seen) * math.log(P_MISS)
+            else:
+                m = miss[near[i]]
+                lw = sum(m[e] for e in r - seen)
             for e in seen:
                 if e in r:
                     lw += max(-0.5 * (d_seen[e][i] / sigma) ** 2, MISREAD)

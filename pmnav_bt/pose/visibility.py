@@ -73,6 +73,18 @@ class Visibility:
         self._xy = np.array([entity_xy(pm, e) for e in self.entities], dtype=float).reshape(-1, 2)
         self._eye = np.array([self._inset(p) for p in self._xy]).reshape(-1, 2)
 
+    @property
+    def sign_xy(self) -> np.ndarray:
+        """(N, 2) where the map puts each of ``entities``' signs."""
+        return self._xy
+
+    @cached_property
+    def sign_normal(self) -> np.ndarray:
+        """(N, 2) unit normals of ``entities``' plates: from the wall into the corridor."""
+        d = self._eye - self._xy
+        n = np.linalg.norm(d, axis=1, keepdims=True)
+        return np.where(n > 1e-9, d / np.maximum(n, 1e-9), 0.0)
+
     @classmethod
     def of(cls, pm: PrioriMap, read_range: float | None = None) -> Visibility:
         """The cached Visibility of ``pm`` for signs read to ``read_range`` (None:

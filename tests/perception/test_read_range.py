@@ -61,7 +61,7 @@ def test_the_localization_belief_expects_signs_where_the_reader_can_read_them(fi
     cfg = load_config(None, ["grounder.backend=ocr", "sim.reading_width=0"])
     belief = CorridorBelief(fig2_map, read_range=sign_visible_range(cfg))
     assert belief.vis.read_range == 3.5
-    assert sign_visible_range(load_config(None, ["grounder.backend=ocr"])) == 4.5  # at 640
+    assert sign_visible_range(load_config(None, ["grounder.backend=ocr"])) == 6.0  # 14 % at 640
     assert CorridorBelief(fig2_map).vis.read_range == 9.5  # the oracle's
     near = belief.vis.readable_from((16.0, 0.0))
     assert near and near < CorridorBelief(fig2_map).vis.readable_from((16.0, 0.0))

@@ -346,3 +346,75 @@ def test_a_sign_fit_the_walls_refute_is_not_taken_and_the_belief_fixes_instead()
     assert abs(math.degrees(wrap_angle(fix[0][2] - truth[2]))) < 2.0
     here = se2_apply(fix[0], (g.odom.x, g.odom.y))
     assert np.hypot(*(np.asarray(here) - true[:2])) < 0.5
+
+
+def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_read(fig2):
+    """OCR names a plate 5 m off one time in seven: not reading it there must not count
+    against the true place as a sign 2 m off does (the constant P_MISS made a bare
+    corridor's mirror image look likelier than the truth beside far signs)."""
+    from pmnav_bt.config import load_config
+    from pmnav_bt.perception.read_range import ocr_recall, sign_recall, sign_visible_range
+
+    assert ocr_recall(640, 2.0) > 0.9 and ocr_recall(640, 5.0) < 0.2
+    assert ocr_recall(640, 7.0) == 0.0  # beyond the last measured band
+    assert ocr_recall(640, 3.0, "name") < ocr_recall(640, 3.0, "number")
+    assert ocr_recall(160, 1.5) == ocr_recall(320, 3.0)  # half the pixels: twice as far
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    assert sign_recall(load_config(None, ["grounder.backend=sim_gt"]), fig2.building) is None
+    b = CorridorBelief(
+        fig2, read_range=sign_visible_range(cfg), recall=sign_recall(cfg, fig2.building)
+    )
+    flat = CorridorBelief(fig2, read_range=sign_visible_range(cfg))
+    vis, where = b.vis, dict(zip(b.vis.entities, b.vis.sign_xy, strict=True))
+    near = far = None
+    for p in vis.lattice_points:
+        for e in p.readable:
+            d = math.dist(p.xy, where[e])
+            if d < 2.0 and near is None:
+                near = (p, e)
+            if 4.6 < d < 5.8 and far is None:
+                far = (p, e)
+    assert near and far
+    assert b._miss[near[0].index][near[1]] == pytest.approx(math.log(0.25))  # P_MISS
+    assert b._miss[far[0].index][far[1]] > math.log(0.8)
+    # One bare glimpse at a place whose only signs in sight are far: with the reader's
+    # recall the place keeps nearly all its weight, with a constant miss it loses 4x a sign.
+    p = next(
+        q
+        for q in vis.lattice_points
+        if q.readable and all(math.dist(q.xy, where[e]) > 4.6 for e in q.readable)
+    )
+    g = glimpse(fig2, (*p.xy, fig2.segments[p.segment - 1].heading), ())
+    for belief in (b, flat):
+        belief.observe(g)
+    i = int(np.argmin(np.linalg.norm(b.xy - np.array(p.xy), axis=1)))
+    bare = [j for j, q in enumerate(b.lattice) if not vis.lattice_points[q].readable]
+    lost = b.logw[bare].max() - b.logw[i]
+    lost_flat = flat.logw[bare].max() - flat.logw[i]
+    assert lost < 0.5 and lost_flat >= math.log(4.0) - 1e-9
+
+
+def test_a_plate_seen_along_its_wall_is_no_evidence_when_not_read(fig2):
+    """OCR read none of 44 plates seen more than 75 deg off their normal
+    (bench_signs.py --angles 0,88): a plate along the wall beside the robot is not missed."""
+    from pmnav_bt.config import load_config
+    from pmnav_bt.perception.read_range import angle_share, sign_recall
+
+    assert angle_share(0.0) == angle_share(math.radians(70)) == 1.0
+    assert 0.0 < angle_share(math.radians(72)) < 1.0 == angle_share(math.radians(-40))
+    assert angle_share(math.radians(80)) == 0.0
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    b = CorridorBelief(fig2, read_range=6.0, recall=sign_recall(cfg, fig2.building))
+    vis = b.vis
+    head_on = along = None
+    for p in vis.lattice_points:
+        for e in p.readable:
+            k = vis.entities.index(e)
+            v = np.asarray(p.xy) - vis.sign_xy[k]
+            d = float(np.linalg.norm(v))
+            off = math.degrees(math.acos(float(v @ vis.sign_normal[k]) / d))
+            if d < 2.5 and off < 45 and head_on is None:
+                head_on = b._miss[p.index][e]
+            if off > 77 and along is None:
+                along = b._miss[p.index][e]
+    assert head_on == pytest.approx(math.log(0.25)) and along == 0.0
