@@ -61,12 +61,13 @@ class CaptureViews(PmNavBehaviour):
 
     Blackboard: reads what ``yaws``/``what`` read (``target``, ``last_action``,
     ``map_T_odom``);
-    writes ``views`` (list[View]). Stops early when ``enough(views)`` is true. Ends
+    writes ``views`` (list[View]; with ``extend``, added to the ``views`` already there: one
+    panorama taken in two sweeps). Stops early when ``enough(views)`` is true. Ends
     facing the last view. FAILURE if the body faults or a frame cannot be taken or
     grounded (SENSOR_TIMEOUT for a silent camera, the back end's code otherwise).
     """
 
-    READS = ("target", "last_action", "map_T_odom")
+    READS = ("target", "last_action", "map_T_odom", "views")
     WRITES = ("views",)
     JOBS = ("_job",)
     STOPS_BASE = True
@@ -79,12 +80,14 @@ class CaptureViews(PmNavBehaviour):
         what: Callable[[PmNavBehaviour], Grounding],
         enough: Callable[[list[View]], bool] | None = None,
         sweep: bool = True,
+        extend: bool = False,
     ):
         super().__init__(name, ctx)
         self._yaws = yaws
         self._what = what
         self._enough = enough
         self._sweep = sweep
+        self._extend = extend
         self._job = None
 
     def initialise(self) -> None:
@@ -107,7 +110,8 @@ class CaptureViews(PmNavBehaviour):
             self._views.append(View(rel, obs, dets))
             self._todo.pop(0)
             if not self._todo or (self._enough is not None and self._enough(self._views)):
-                self.bb.set("views", list(self._views))
+                before = list(self.get("views") or []) if self._extend else []
+                self.bb.set("views", before + self._views)
                 return Status.SUCCESS
         goal = self._start_yaw + self._todo[0]
         if not self.face(goal):

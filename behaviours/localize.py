@@ -30,6 +30,25 @@ def enough_doors(views: list[View], n: int = 3) -> bool:
     return sum(e.kind is EntityKind.ROOM for e in distinct_landmarks(views)) >= n
 
 
+class SignsRead(PmNavBehaviour):
+    """SUCCESS when the panorama in ``views`` read at least ``n`` distinct signs, else
+    FAILURE (a condition: the six views' seams can hide a plate, so too few signs calls
+    for the views in between).
+
+    Reads ``views``."""
+
+    READS = ("views",)
+
+    def __init__(self, name: str, ctx: Context, n: int = 2):
+        super().__init__(name, ctx)
+        self.n = n
+
+    def update(self) -> Status:
+        got = len(distinct_landmarks(self.get("views") or []))
+        self.feedback_message = f"{got} sign(s) read (want {self.n})"
+        return Status.SUCCESS if got >= self.n else Status.FAILURE
+
+
 def distinct_landmarks(views: list[View]) -> set[Entity]:
     """The rooms and landmarks whose signs were read in ``views``."""
     return {d.entity for v in views for d in v.detections or () if d.entity is not None}

@@ -1,10 +1,12 @@
 """Active localization and recoveries as explicit subtrees (issue 15).
 
-Localization: take the six-view panorama, add it to the corridor belief, fix the pose
-if the belief allows; otherwise drive along the corridor axis towards where the map
-says signs are readable, and try again. Recoveries (like Nav2's) are chosen by the
-failure that triggered them: BLOCKED backs off the wall and turns onto the corridor
-axis, TARGET_NOT_FOUND turns round to look back, TIMEOUT waits.
+Localization: take the six-view panorama (and the six views between them when it read
+fewer than two signs: a plate on a seam between two 60-degree views is cut in both), add
+it to the corridor belief, fix the pose if the belief allows; otherwise drive along the
+corridor axis towards where the map says signs are readable, and try again. Recoveries
+(like Nav2's) are chosen by the failure that triggered them: BLOCKED backs off the wall
+and turns onto the corridor axis, TARGET_NOT_FOUND turns round to look back, TIMEOUT
+waits.
 """
 
 from __future__ import annotations
@@ -20,11 +22,41 @@ from py_trees.decorators import Retry
 from pmnav_bt.behaviours.active_localize import FixFromBelief, FollowLead, UpdateBelief
 from pmnav_bt.behaviours.capture import CaptureViews
 from pmnav_bt.behaviours.context import Context
-from pmnav_bt.behaviours.localize import enough_doors, localization_yaws, read_signs
+from pmnav_bt.behaviours.localize import SignsRead, enough_doors, localization_yaws, read_signs
 from pmnav_bt.behaviours.recovery import BackUp, FaceCorridor, FailureIs, Spin, Wait
 from pmnav_bt.failures import FailureCode
 
 WAIT_S = 2.0
+
+
+def panorama_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour.Behaviour:
+    """The localization panorama: six views 60 deg apart, stopping once three doors are
+    read; when they read fewer than two signs, the six views half-way between them too
+    (taken on from the last view: the same relative yaws fall between the first six), as a
+    plate on a seam between two 60-degree views is cut in both. Writes ``views``."""
+    return Sequence(
+        f"{name}Panorama",
+        memory=True,
+        children=[
+            CaptureViews(f"{name}Views", ctx, localization_yaws, read_signs, enough=enough_doors),
+            Selector(
+                f"{name}ViewsEnough",
+                memory=True,
+                children=[
+                    SignsRead(f"{name}TwoSignsRead", ctx, n=2),
+                    CaptureViews(
+                        f"{name}ViewsBetween",
+                        ctx,
+                        localization_yaws,
+                        read_signs,
+                        enough=enough_doors,
+                        sweep=False,
+                        extend=True,
+                    ),
+                ],
+            ),
+        ],
+    )
 
 
 def active_localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour.Behaviour:
@@ -34,13 +66,7 @@ def active_localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.be
         f"{name}Once",
         memory=True,
         children=[
-            CaptureViews(
-                f"{name}Views",
-                ctx,
-                localization_yaws,
-                read_signs,
-                enough=enough_doors,
-            ),
+            panorama_subtree(ctx, name),
             UpdateBelief(f"{name}Belief", ctx),
             FixFromBelief(f"{name}Fix", ctx),
         ],

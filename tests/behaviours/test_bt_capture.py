@@ -197,3 +197,53 @@ def test_a_frame_the_grounder_cannot_read_fails_backend_error(make_rig):
     assert rig.failure.code == FailureCode.BACKEND_ERROR
     assert "segmentation" in rig.failure.message
     assert rig.get("views") is None
+
+
+def _panorama(rig):
+    from pmnav_bt.trees.localize import panorama_subtree
+
+    rig.expect(rig.run(panorama_subtree(rig.ctx), max_ticks=800), Status.SUCCESS)
+    return rig.get("views")
+
+
+def test_a_panorama_reading_two_signs_takes_six_views_at_most(make_rig):
+    rig = make_rig(SOUTH_AT_20)  # room2 and room4 either side
+    views = _panorama(rig)
+    assert len(views) <= len(LOCALIZATION_YAWS_DEG)
+    assert len(distinct_landmarks(views)) >= 2
+
+
+def test_a_panorama_reading_fewer_takes_the_six_views_between_the_first(make_rig, pm):
+    """A plate on the seam of two 60-degree views is cut in both: with fewer than two
+    signs read, the panorama goes on round through the directions half-way between."""
+    from pmnav_bt.pose.visibility import Visibility
+
+    vis = Visibility.of(pm, 2.0)  # a reader of short range: no sign within 2 m here
+    bare = next(p for p in vis.lattice_points if not p.readable)
+    start = Pose2D(*bare.xy, pm.segments[bare.segment - 1].heading)
+    rig = make_rig(start, overrides=("grounder.max_range=2.0",))
+    views = _panorama(rig)
+    assert len(distinct_landmarks(views)) < 2
+    assert len(views) == 2 * len(LOCALIZATION_YAWS_DEG)
+    first = [v.observation.pose.yaw for v in views[:6]]
+    between = [v.observation.pose.yaw for v in views[6:]]
+    assert [round(math.degrees(wrap_angle(y - start.yaw))) % 360 for y in first] == pytest.approx(
+        list(LOCALIZATION_YAWS_DEG), abs=3
+    )
+    for y in between:  # each half-way between two of the first six
+        assert min(abs(wrap_angle(y - f)) for f in first) == pytest.approx(
+            math.radians(30), abs=0.06
+        )
+
+
+def test_an_extending_capture_adds_its_views_to_those_on_the_blackboard(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    first = CaptureViews("Views", rig.ctx, lambda b: [0.0], no_query)
+    rig.expect(rig.run(first, max_ticks=100), Status.SUCCESS)
+    more = CaptureViews("More", rig.ctx, lambda b: [math.radians(30)], no_query, extend=True)
+    rig.expect(rig.run(more, max_ticks=300), Status.SUCCESS)
+    views = rig.get("views")
+    assert len(views) == 2 and views[0].relative_yaw == pytest.approx(0.0, abs=TOL)
+    again = CaptureViews("Again", rig.ctx, lambda b: [0.0], no_query)  # not extending
+    rig.expect(rig.run(again, max_ticks=100), Status.SUCCESS)
+    assert len(rig.get("views")) == 1
