@@ -29,7 +29,7 @@ import shapely
 from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose.visibility import Visibility, entity_xy
-from pmnav_bt.seams import Entity, Pose2D
+from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
 P_MISS = 0.25  # a sign the map says is readable is not read
 P_SPURIOUS = 0.005  # a sign is read that the map says cannot be read from there
@@ -38,6 +38,11 @@ DRIFT_PER_M = 0.05  # the sight spread grows with odometry distance from the ref
 FIX_MASS = 0.85  # a cluster holding this much weight is a fix
 MAX_LEVEL = math.radians(15.0)  # a two-sign fit is turned onto the walls' axis up to this
 SIGN_AGREE_M = 1.0  # signs fixing the position together must agree on it this well
+# How far (m, one sigma) a sign's seen place may be from the map's point: a door is found
+# where the map puts it (the grounders return the door, not its plate); an elevator's or
+# a stair's plate hangs beside it, 0.8-2.2 m along the wall in the simulator.
+PLACE_SIGMA_M = {EntityKind.ROOM: 0.2, EntityKind.LANDMARK: 1.0}
+HYPOTHESIS_SIGMA_M = 0.5  # a hypothesis is a lattice point: no surer of the place than a step
 MISREAD = math.log(P_MISS * P_SPURIOUS)  # readable here, but read far from its place
 P_THROUGH_WALL = 0.02  # the robot is where the hypothesis puts it inside a wall
 OFF_CORRIDOR_M = 1.0  # beyond a corridor's half-width by this much: inside a wall
@@ -357,13 +362,14 @@ class CorridorBelief:
         w = self.weights()[idx]
         i = idx[int(np.argmax(w))]
         tf = tuple(self._map_T_odom()[i])
-        src, dst = [], []
+        src, dst, placed = [], [], []
         for g in self.glimpses:
             for e, oxy in g.seen.items():
                 m = np.array(entity_xy(self.pm, e))
                 if np.linalg.norm(se2_apply(tf, oxy) - m) <= 3.0 * SIGHT_SIGMA_M:
                     src.append(oxy)
                     dst.append(m)
+                    placed.append(PLACE_SIGMA_M[e.kind])
         if not src:  # nothing read: the hypothesis as it is, if the belief is tight enough
             spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
             if spread > BLIND_SPREAD_M:
@@ -375,10 +381,15 @@ class CorridorBelief:
             fitted = self.level_with_walls(fit, tuple(np.mean(dst, axis=0)))
         if fitted is not None:
             tf = fitted
-        else:  # signs close together, or a fit the walls refute: the hypothesis's heading
-            shift, res = _sign_shift(tf, src, dst)
-            tf = (tf[0] + float(shift[0]), tf[1] + float(shift[1]), tf[2])
         spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
+        if fitted is None:  # signs close together, or a fit the walls refute: the
+            # hypothesis's heading, its position moved towards what the signs say as far
+            # as they are surer of it than the belief is (an elevator's plate hangs a
+            # metre or two from the map's point; a door is found where the map puts it)
+            shift, res, sure = _sign_shift(tf, src, dst, placed)
+            s2 = max(spread, HYPOTHESIS_SIGMA_M) ** 2
+            shift = shift * (s2 / (s2 + sure**2))
+            tf = (tf[0] + float(shift[0]), tf[1] + float(shift[1]), tf[2])
         tf = self.to_odom((float(tf[0]), float(tf[1]), float(tf[2])))
         return tf, math.hypot(spread, res)
 
@@ -614,24 +625,30 @@ class CorridorBelief:
         return 0.0 if self.ref is None else self.ref.yaw - self.axis_offset
 
 
-def _sign_shift(tf, src, dst) -> tuple[np.ndarray, float]:
+def _sign_shift(tf, src, dst, placed) -> tuple[np.ndarray, float, float]:
     """The shift that puts the signs read (``src``, odometry) on their map places (``dst``)
-    under ``tf``, and its residual (m, RMS over the signs kept).
+    under ``tf``, its residual (m, RMS over the signs kept) and its uncertainty (m) from
+    how far each kept sign may be from its map place (``placed``, m per sighting).
 
-    Each sign's shift is the mean of its sightings'. Signs that disagree by more than
+    Each sign's shift is the mean of its sightings'; the signs kept are weighed by how
+    exactly they are placed. Signs that disagree by more than
     ``SIGN_AGREE_M`` cannot all be right (a sign plate sits beside the door or elevator the
     map places, up to 1.7 m off): those that agree with the sign asking for the smallest
     shift, the one the belief's hypothesis (every sighting, depth, the corridors) already
     agrees with, are kept."""
     per: dict[tuple, list] = {}
-    for s, d in zip(src, dst, strict=True):
+    sigma: dict[tuple, float] = {}
+    for s, d, p in zip(src, dst, placed, strict=True):
         per.setdefault(tuple(d), []).append(d - se2_apply(tf, s))
+        sigma[tuple(d)] = p
     shifts = np.array([np.mean(v, axis=0) for v in per.values()])
+    sig = np.array([sigma[k] for k in per])
     least = shifts[int(np.argmin(np.linalg.norm(shifts, axis=1)))]
-    kept = shifts[np.linalg.norm(shifts - least, axis=1) <= SIGN_AGREE_M]
-    shift = kept.mean(axis=0)
+    keep = np.linalg.norm(shifts - least, axis=1) <= SIGN_AGREE_M
+    kept, wk = shifts[keep], 1.0 / sig[keep] ** 2
+    shift = (kept * wk[:, None]).sum(axis=0) / wk.sum()
     res = float(np.sqrt(np.mean(np.sum((kept - shift) ** 2, axis=1))))
-    return shift, res
+    return shift, res, float(1.0 / math.sqrt(wk.sum()))
 
 
 def _weighted_median(w: np.ndarray, x: np.ndarray) -> float:

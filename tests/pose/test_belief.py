@@ -418,3 +418,25 @@ def test_a_plate_seen_along_its_wall_is_no_evidence_when_not_read(fig2):
             if off > 77 and along is None:
                 along = b._miss[p.index][e]
     assert head_on == pytest.approx(math.log(0.25)) and along == 0.0
+
+
+def test_an_elevators_plate_beside_it_moves_a_belief_fix_little():
+    """The OCR stack read only the elevator's plate, which hangs beside the elevator the
+    map places (sign_sparse_1, Table 3 minimal #0): the belief's best place was the
+    truth, and moving it all the way onto the plate put the fix 1.6 m off. A door is found
+    where the map puts it, an elevator's plate only near it: the fix moves as far as the
+    sign is surer than the belief (here a plate 0.9 m along the wall: 0.9 m off before)."""
+    pm = parse_building(generate_sign_sparse(1))
+    elevator = next(e for e in Visibility.of(pm).entities if e.id == "elevator1")
+    plate = np.add(entity_xy(pm, elevator), (0.9, 0.0))  # along its wall
+    seen = {elevator: tuple(se2_apply(ODOM_T_MAP, plate))}
+    b = CorridorBelief(pm)
+    truth = (0.0, 58.0, -math.pi / 2)
+    for true in (truth, (0.0, 59.5, math.pi / 2)):
+        g = glimpse(pm, true, (), depth=True)
+        axis = wrap_angle(true[2] + ODOM_T_MAP[2])
+        b.observe(Glimpse(g.odom, seen, None, g.free), axis_odom=axis)
+    fix = b.fix()
+    assert fix is not None
+    here = se2_apply(fix[0], se2_apply(ODOM_T_MAP, truth[:2]))
+    assert math.dist(here, truth[:2]) < 0.4
