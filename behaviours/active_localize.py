@@ -18,7 +18,7 @@ from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance
-from pmnav_bt.perception.read_range import sign_recall, sign_visible_range
+from pmnav_bt.perception.read_range import sign_read_range, sign_recall, sign_visible_range
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
@@ -112,10 +112,12 @@ class UpdateBelief(PmNavBehaviour):
         belief = self.get("belief")
         if belief is None:
             cfg, pm = self.ctx.config, self.ctx.pm
+            visible = sign_visible_range(cfg)  # None: the oracle, its own range
             belief = CorridorBelief(
                 pm,
-                read_range=sign_visible_range(cfg),
+                read_range=visible,
                 recall=sign_recall(cfg, pm.building),
+                lead_range=None if visible is None else sign_read_range(cfg),
             )
             tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
             if tf is not None:

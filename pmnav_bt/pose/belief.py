@@ -111,9 +111,16 @@ class CorridorBelief:
     # read from there (None: 1 - P_MISS within read_range); a sign the map says is in sight
     # but not read costs 1 - recall.
     recall: Callable[[Entity, float, float], float] | None = None
+    # m, signs are read reliably to: where to go to read them (None: read_range). A sign
+    # 5 m off that OCR reads one time in seven is no place to drive to.
+    lead_range: float | None = None
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm, self.read_range)
+        # The same lattice, with the signs read reliably from each point (where to go).
+        self.goal = Visibility.of(
+            self.pm, self.read_range if self.lead_range is None else self.lead_range
+        )
         self._miss = self._miss_logs()
         self._floor = shapely.buffer(self.vis.corridors, RAY_SLACK_M)  # a little tolerance
         shapely.prepare(self._floor)
@@ -402,7 +409,7 @@ class CorridorBelief:
         puts it (on the first drive from a diffuse belief, where a fifth does: from a
         bare corridor the median junction is far, and a nearer one passed unlooked-at
         is the place that would have told the position)."""
-        dist, _ = self.vis.towards_signs
+        dist, _ = self.goal.towards_signs
         if not dist:
             return None
         telling = self._telling_lead(odom, max_distance)
@@ -430,11 +437,11 @@ class CorridorBelief:
         for n, (i, j) in enumerate(zip(live, near, strict=True)):
             ways: dict[int, tuple[float, float]] = {}
             for m in {j, *reach.get(n, ())}:
-                for h_map, d in self.vis.exits[m]:
+                for h_map, d in self.goal.exits[m]:
                     k = int(round(wrap_angle(h_map - tfs[i][2] - axis) / (math.pi / 2))) % 4
                     if m != j and k % 2 == 0:
                         continue
-                    r = self.vis.run_lengths[m].get(h_map, 0.0)
+                    r = self.goal.run_lengths[m].get(h_map, 0.0)
                     if k not in ways or d < ways[k][0]:
                         ways[k] = (d, r)
             if 1 in ways or 3 in ways:
@@ -552,7 +559,7 @@ class CorridorBelief:
         looked = np.array([[g_.odom.x, g_.odom.y] for g_ in self.glimpses])
         fresh = np.linalg.norm(q[:, None, :] - looked[None], axis=2).min(1) > TELLING_LOOKED_M
         half = np.array([s.width / 2.0 for s in self.pm.segments])
-        pts = self.vis.lattice_points
+        pts = self.goal.lattice_points  # what each would read there for sure
         hyp = np.array([m[int(np.argmax(w[m]))] for m in modes])  # one per cluster
         preds = []  # per cluster: the signs readable at each candidate (None: a wall)
         for i in hyp:
