@@ -26,6 +26,7 @@ from pmnav_bt.pose.visibility import entity_xy
 from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
 from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation, Pose2D
 
+NO_SIGN_SHARE = 0.05  # below this share of the belief with a sign in reach: a bare stretch
 NO_PROGRESS_S = 6.0  # clock seconds without moving 0.1 m: the drive is blocked
 MIN_BLOCKED_DRIVE_M = 0.2  # blocked sooner: a brush with a wall, not the corridor's end
 SIGN_APPROACH_M = 3.0  # with a sign in view ahead, drive this much further, then look round
@@ -134,6 +135,26 @@ class UpdateBelief(PmNavBehaviour):
             f"{len(seen)} sign(s) read, {len(belief.glimpses)} glimpse(s); best {mass:.0%}"
         )
         return Status.SUCCESS
+
+
+class NoSignInReach(PmNavBehaviour):
+    """SUCCESS when the corridor belief so far says no sign is within reliable reading
+    range here (less than ``NO_SIGN_SHARE`` of it puts one there): in a bare stretch the
+    six views between the panorama's are not worth their turn. FAILURE otherwise, and
+    with no belief yet.
+
+    Reads ``belief``."""
+
+    READS = ("belief",)
+
+    def update(self) -> Status:
+        belief: CorridorBelief | None = self.get("belief")
+        if belief is None or belief.ref is None:
+            self.feedback_message = "no belief yet"
+            return Status.FAILURE
+        share = belief.sign_in_reach(self.ctx.base.pose())
+        self.feedback_message = f"{share:.0%} of the belief puts a sign in reach"
+        return Status.SUCCESS if share < NO_SIGN_SHARE else Status.FAILURE
 
 
 class FixFromBelief(PmNavBehaviour):

@@ -19,7 +19,12 @@ from py_trees.behaviours import Success as AlwaysSucceed
 from py_trees.composites import Selector, Sequence
 from py_trees.decorators import Retry
 
-from pmnav_bt.behaviours.active_localize import FixFromBelief, FollowLead, UpdateBelief
+from pmnav_bt.behaviours.active_localize import (
+    FixFromBelief,
+    FollowLead,
+    NoSignInReach,
+    UpdateBelief,
+)
 from pmnav_bt.behaviours.capture import CaptureViews
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.localize import SignsRead, enough_doors, localization_yaws, read_signs
@@ -33,7 +38,9 @@ def panorama_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour
     """The localization panorama: six views 60 deg apart, stopping once three doors are
     read; when they read fewer than two signs, the six views half-way between them too
     (taken on from the last view: the same relative yaws fall between the first six), as a
-    plate on a seam between two 60-degree views is cut in both. Writes ``views``."""
+    plate on a seam between two 60-degree views is cut in both, unless the belief so far
+    says no sign is in reach here (a bare stretch: the turn would read nothing). Writes
+    ``views``."""
     return Sequence(
         f"{name}Panorama",
         memory=True,
@@ -44,6 +51,7 @@ def panorama_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour
                 memory=True,
                 children=[
                     SignsRead(f"{name}TwoSignsRead", ctx, n=2),
+                    NoSignInReach(f"{name}NoSignInReach", ctx),
                     CaptureViews(
                         f"{name}ViewsBetween",
                         ctx,

@@ -400,6 +400,18 @@ class CorridorBelief:
         tf = self.to_odom((float(tf[0]), float(tf[1]), float(tf[2])))
         return tf, math.hypot(spread, res)
 
+    def sign_in_reach(self, odom: Pose2D) -> float:
+        """The share of the belief under which the map puts a sign within reliable reading
+        range of ``odom`` (1 with no glimpse yet): near 0 in a bare stretch, where looking
+        harder round the same spot reads nothing."""
+        if self.ref is None:
+            return 1.0
+        w = self.weights()
+        p = self._straighten((odom.x, odom.y))
+        near, _ = self.goal.nearest_many(_apply_many(self._map_T_odom(), (p[0], p[1])))
+        pts = self.goal.lattice_points
+        return float(w[np.array([bool(pts[j].readable) for j in near])].sum())
+
     def lead(self, odom: Pose2D, max_distance: float = 8.0) -> Lead | None:
         """Where to drive from ``odom``: one of the ways out along the corridor axis (or
         across it at a junction). It keeps the way it chose last while enough of the belief

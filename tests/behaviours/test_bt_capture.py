@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from concurrent.futures import CancelledError
 
+import numpy as np
 import pytest
 from py_trees.common import Status
 
@@ -247,3 +248,29 @@ def test_an_extending_capture_adds_its_views_to_those_on_the_blackboard(make_rig
     again = CaptureViews("Again", rig.ctx, lambda b: [0.0], no_query)  # not extending
     rig.expect(rig.run(again, max_ticks=100), Status.SUCCESS)
     assert len(rig.get("views")) == 1
+
+
+def test_in_a_bare_stretch_the_belief_skips_the_views_between(make_rig, pm):
+    """Where the belief so far puts no sign in reach, the six views between are not
+    worth their turn: a second panorama there stops at six views."""
+    from pmnav_bt.pose.belief import CorridorBelief
+    from pmnav_bt.pose.visibility import Visibility
+
+    vis = Visibility.of(pm, 2.0)
+    bare = next(p for p in vis.lattice_points if not p.readable)
+    start = Pose2D(*bare.xy, pm.segments[bare.segment - 1].heading)
+    rig = make_rig(start, overrides=("grounder.max_range=2.0",))
+    b = CorridorBelief(pm, read_range=2.0)
+    views = _panorama(rig)
+    assert len(views) == 12  # no belief yet: the views between are taken
+    from pmnav_bt.pose.belief import Glimpse
+
+    b.observe(Glimpse(views[0].observation.pose, {}), axis_odom=start.yaw)  # odom = map
+    b.logw[:] = -50.0  # a belief sure of the place: only the truth is live
+    tfs = b._map_T_odom()
+    truth = np.linalg.norm(tfs[:, :2], axis=1) < 0.3  # odometry is the map here
+    turn = np.abs(np.angle(np.exp(1j * tfs[:, 2])))
+    b.logw[truth & (turn < 0.1)] = 0.0
+    assert b.sign_in_reach(rig.base.pose()) < 1e-6
+    rig.set(belief=b)
+    assert len(_panorama(rig)) == len(LOCALIZATION_YAWS_DEG)
