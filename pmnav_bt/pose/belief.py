@@ -42,6 +42,7 @@ SIGN_AGREE_M = 1.0  # signs fixing the position together must agree on it this w
 # where the map puts it (the grounders return the door, not its plate); an elevator's or
 # a stair's plate hangs beside it, 0.8-2.2 m along the wall in the simulator.
 PLACE_SIGMA_M = {EntityKind.ROOM: 0.2, EntityKind.LANDMARK: 1.0}
+FIX_SPREAD_M = 1.0  # a fix from the belief must know the place this well (weighted RMS)
 HYPOTHESIS_SIGMA_M = 0.5  # a hypothesis is a lattice point: no surer of the place than a step
 MISREAD = math.log(P_MISS * P_SPURIOUS)  # readable here, but read far from its place
 P_THROUGH_WALL = 0.02  # the robot is where the hypothesis puts it inside a wall
@@ -325,6 +326,8 @@ class CorridorBelief:
         map_xy = {e: np.array(entity_xy(self.pm, e)) for e in seen}
         seen_map = {e: _apply_many(tfs, xy) for e, xy in g.seen.items()}  # (N, 2) per sign
         d_seen = {e: np.linalg.norm(seen_map[e] - map_xy[e], axis=1) for e in seen}
+        # An elevator's plate hangs beside it: its sighting tells the place less exactly.
+        sig = {e: math.hypot(sigma, PLACE_SIGMA_M[e.kind]) for e in seen}
         miss = self._miss
         for i, r in enumerate(readable):
             if miss is None:
@@ -334,7 +337,7 @@ class CorridorBelief:
                 lw = sum(m[e] for e in r - seen)
             for e in seen:
                 if e in r:
-                    lw += max(-0.5 * (d_seen[e][i] / sigma) ** 2, MISREAD)
+                    lw += max(-0.5 * (d_seen[e][i] / sig[e]) ** 2, MISREAD)
                 else:
                     lw += math.log(P_SPURIOUS)
             self.logw[i] += lw
@@ -389,6 +392,8 @@ class CorridorBelief:
         if fitted is not None:
             tf = fitted
         spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
+        if fitted is None and spread > FIX_SPREAD_M:
+            return None  # one cluster, but not sure where in it (a lone elevator plate)
         if fitted is None:  # signs close together, or a fit the walls refute: the
             # hypothesis's heading, its position moved towards what the signs say as far
             # as they are surer of it than the belief is (an elevator's plate hangs a

@@ -16,7 +16,7 @@ from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.visibility import Visibility, entity_xy
-from pmnav_bt.seams import Pose2D
+from pmnav_bt.seams import EntityKind, Pose2D
 
 ODOM_T_MAP = (3.0, -2.0, 0.7)  # the odometry frame is anywhere
 
@@ -61,6 +61,11 @@ def test_signs_seen_where_the_map_says_fix_the_pose(fig2, n):
         b = CorridorBelief(fig2)
         b.observe(glimpse(fig2, true, p.readable))
         fix = b.fix()
+        if all(e.kind is EntityKind.LANDMARK for e in p.readable):
+            # A lone elevator plate hangs beside the elevator: no surer of the place
+            # than a metre or so, too loose for a fix (FIX_SPREAD_M).
+            assert fix is None, p
+            continue
         assert fix is not None, p
         np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=0.5)
         assert abs(math.remainder(fix[0][2] - se2_inverse(ODOM_T_MAP)[2], 2 * math.pi)) < 0.05
@@ -469,3 +474,22 @@ def test_the_lead_goes_where_signs_are_read_reliably_not_where_they_may_be_seen(
         ends[lead_range] = se2_apply(se2_inverse(ODOM_T_MAP), end)
     assert sure.n_readable(ends[3.5]) >= 2
     assert sure.n_readable(ends[None]) < 2  # stopped where the signs are only in sight
+
+
+def test_a_lone_elevator_plate_does_not_fix_the_place_along_the_corridor():
+    """t_school, Table 3 redundant #3 with the OCR stack: the first panorama read only the
+    elevator's plate, 1.9 m along the wall from the elevator on the map; the belief took
+    the place it implied and fixed 1.9 m off. Its sighting now tells the place only to
+    about 1.3 m, too loosely for a fix."""
+    pm = parse_building(load_building("t_school"))
+    elevator = next(e for e in Visibility.of(pm).entities if e.id == "elevator1")
+    truth = (17.5, 0.0, 0.0)
+    plate = np.add(entity_xy(pm, elevator), (-1.88, -0.12))
+    g = glimpse(pm, truth, (), depth=True)
+    seen = {elevator: tuple(se2_apply(ODOM_T_MAP, plate))}
+    b = CorridorBelief(pm)
+    b.observe(Glimpse(g.odom, seen, None, g.free), axis_odom=wrap_angle(ODOM_T_MAP[2]))
+    fix = b.fix()
+    if fix is not None:
+        here = se2_apply(fix[0], se2_apply(ODOM_T_MAP, truth[:2]))
+        assert math.dist(here, truth[:2]) < 1.0
