@@ -26,7 +26,10 @@ from pmnav_bt.pose.visibility import entity_xy
 from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
 from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation, Pose2D
 
-NO_SIGN_SHARE = 0.05  # below this share of the belief with a sign in reach: a bare stretch
+# Take the views between a panorama's only where at least this share of the belief puts a
+# sign in reach: a plate across a seam (about one bearing in four) is worth another turn
+# (11 of the action budget's turn-equivalents) only where a sign is likely at all.
+NO_SIGN_SHARE = 0.5
 NO_PROGRESS_S = 6.0  # clock seconds without moving 0.1 m: the drive is blocked
 MIN_BLOCKED_DRIVE_M = 0.2  # blocked sooner: a brush with a wall, not the corridor's end
 SIGN_APPROACH_M = 3.0  # with a sign in view ahead, drive this much further, then look round
@@ -138,10 +141,10 @@ class UpdateBelief(PmNavBehaviour):
 
 
 class NoSignInReach(PmNavBehaviour):
-    """SUCCESS when the corridor belief so far says no sign is within reliable reading
-    range here (less than ``NO_SIGN_SHARE`` of it puts one there): in a bare stretch the
-    six views between the panorama's are not worth their turn. FAILURE otherwise, and
-    with no belief yet.
+    """SUCCESS when the corridor belief so far does not put a sign within reliable reading
+    range here (less than ``NO_SIGN_SHARE`` of it does): in a bare stretch, or where only
+    one of several mirror-image places has a sign, the six views between the panorama's
+    are not worth their turn. FAILURE otherwise, and with no belief yet.
 
     Reads ``belief``."""
 
