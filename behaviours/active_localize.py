@@ -49,8 +49,8 @@ def wall_mask(grounder: Grounder, obs: Observation):
 
 def read_panorama(ctx: Context, views: list):
     """(sightings, corridor axis in odometry or None, the free floor along each view's
-    ``FREE_BEARINGS`` (odometry yaw, m), the odometry's rotation-scale error or None) of a
-    panorama. Worker only.
+    ``FREE_BEARINGS`` (odometry yaw, m), the odometry's rotation-scale error or None, the
+    signs read without a place) of a panorama. Worker only.
 
     A rotation-scale error turns each view's odometry yaw by a share of the turning since:
     the views are put back into the odometry frame of the last one (where the robot is
@@ -70,16 +70,21 @@ def read_panorama(ctx: Context, views: list):
             replace(v, observation=_turned(v.observation, -error * (r - turned[-1])))
             for v, r in zip(views, turned, strict=True)
         ]
-    sightings = [
-        s for v in views for d in v.detections or () if (s := sighting(ctx.pm, v.observation, d))
-    ]
+    sightings, named = [], set()
+    for v in views:
+        for d in v.detections or ():
+            s = sighting(ctx.pm, v.observation, d)
+            if s is not None:
+                sightings.append(s)
+            elif d.entity is not None:
+                named.add(d.entity)  # read, but cut by the border: in sight, place unknown
     angles = [(views[i].observation.pose.yaw, f[0], f[1]) for i, f in fits]
     free = tuple(
         (wrap_angle(v.observation.pose.yaw + b), min(free_distance(v.observation, b), 50.0))
         for v in views
         for b in FREE_BEARINGS
     )
-    return sightings, axis_in_odom(angles), free, error
+    return sightings, axis_in_odom(angles), free, error, frozenset(named)
 
 
 def _turned(obs: Observation, dyaw: float) -> Observation:
@@ -108,7 +113,7 @@ class UpdateBelief(PmNavBehaviour):
         status, read = self.poll(self._job, "reading the panorama")
         if status is not None:
             return status
-        sightings, axis, free, rot_error = read
+        sightings, axis, free, rot_error, named = read
         if rot_error is not None and isinstance(self.ctx.base, CalibratedBase):
             gain = self.ctx.base.calibrate(rot_error)
             self.ctx.log("calibrate", "", rotation_error=rot_error, gain=gain)
@@ -131,7 +136,7 @@ class UpdateBelief(PmNavBehaviour):
         seen: dict[Entity, tuple[float, float]] = {}
         for s in sightings:
             seen.setdefault(s.entity, s.odom_xy)
-        belief.observe(Glimpse(odom, seen, free=free), axis_odom=axis)
+        belief.observe(Glimpse(odom, seen, free=free, named=named), axis_odom=axis)
         self.bb.set("belief", belief)
         _, mass = belief.best_cluster()
         self.feedback_message = (

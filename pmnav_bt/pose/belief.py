@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import networkx as nx
 import numpy as np
@@ -42,7 +42,7 @@ SIGN_AGREE_M = 1.0  # signs fixing the position together must agree on it this w
 # where the map puts it (the grounders return the door, not its plate); an elevator's or
 # a stair's plate hangs beside it, 0.8-2.2 m along the wall in the simulator.
 PLACE_SIGMA_M = {EntityKind.ROOM: 0.2, EntityKind.LANDMARK: 1.0}
-FIX_SPREAD_M = 1.0  # a fix from the belief must know the place this well (weighted RMS)
+FIX_SIGMA_M = 0.5  # a fix from the belief and its signs must know the place this well
 HYPOTHESIS_SIGMA_M = 0.5  # a hypothesis is a lattice point: no surer of the place than a step
 MISREAD = math.log(P_MISS * P_SPURIOUS)  # readable here, but read far from its place
 P_THROUGH_WALL = 0.02  # the robot is where the hypothesis puts it inside a wall
@@ -83,6 +83,8 @@ class Glimpse:
     blocked: float | None = None  # odometry heading of a drive that was just blocked here
     # Free floor (m) seen in depth straight ahead of each view: (odometry yaw, distance).
     free: tuple[tuple[float, float], ...] = ()
+    # Signs read whose place is not known (cut by the image border): in sight, not missed.
+    named: frozenset[Entity] = frozenset()
 
 
 @dataclass(frozen=True)
@@ -194,7 +196,7 @@ class CorridorBelief:
         turned (mod pi/2) is the odometry's heading drift, taken out of the glimpse (the
         belief works in odometry straightened by the walls)."""
         if self.pending_blocked is not None and glimpse.blocked is None:
-            glimpse = Glimpse(glimpse.odom, glimpse.seen, self.pending_blocked, glimpse.free)
+            glimpse = replace(glimpse, blocked=self.pending_blocked)
         self.pending_blocked = None
         if self.ref is None:
             self.ref = glimpse.odom
@@ -224,6 +226,7 @@ class CorridorBelief:
             {e: tuple(self._straighten(xy)) for e, xy in glimpse.seen.items()},
             None if glimpse.blocked is None else wrap_angle(glimpse.blocked - drift),
             tuple((wrap_angle(y - drift), f) for y, f in glimpse.free),
+            glimpse.named,
         )
         self.glimpses.append(g)
         self._weigh(g)
@@ -323,6 +326,7 @@ class CorridorBelief:
         # What the map says is readable at each hypothesis's position for this glimpse.
         readable = [self.vis.lattice_points[j].readable for j in near]
         seen = g.seen.keys()
+        named = g.named - seen
         map_xy = {e: np.array(entity_xy(self.pm, e)) for e in seen}
         seen_map = {e: _apply_many(tfs, xy) for e, xy in g.seen.items()}  # (N, 2) per sign
         d_seen = {e: np.linalg.norm(seen_map[e] - map_xy[e], axis=1) for e in seen}
@@ -331,10 +335,11 @@ class CorridorBelief:
         miss = self._miss
         for i, r in enumerate(readable):
             if miss is None:
-                lw = len(r - seen) * math.log(P_MISS)
+                lw = len(r - seen - named) * math.log(P_MISS)
             else:
                 m = miss[near[i]]
-                lw = sum(m[e] for e in r - seen)
+                lw = sum(m[e] for e in r - seen - named)
+            lw += len(named - r) * math.log(P_SPURIOUS)  # read, but not in sight here
             for e in seen:
                 if e in r:
                     lw += max(-0.5 * (d_seen[e][i] / sig[e]) ** 2, MISREAD)
@@ -392,14 +397,14 @@ class CorridorBelief:
         if fitted is not None:
             tf = fitted
         spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
-        if fitted is None and spread > FIX_SPREAD_M:
-            return None  # one cluster, but not sure where in it (a lone elevator plate)
         if fitted is None:  # signs close together, or a fit the walls refute: the
             # hypothesis's heading, its position moved towards what the signs say as far
             # as they are surer of it than the belief is (an elevator's plate hangs a
             # metre or two from the map's point; a door is found where the map puts it)
             shift, res, sure = _sign_shift(tf, src, dst, placed)
             s2 = max(spread, HYPOTHESIS_SIGMA_M) ** 2
+            if 1.0 / math.sqrt(1.0 / s2 + 1.0 / sure**2) > FIX_SIGMA_M:
+                return None  # one cluster, not sure where in it (a lone elevator plate)
             shift = shift * (s2 / (s2 + sure**2))
             tf = (tf[0] + float(shift[0]), tf[1] + float(shift[1]), tf[2])
         tf = self.to_odom((float(tf[0]), float(tf[1]), float(tf[2])))

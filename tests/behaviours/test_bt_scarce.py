@@ -191,7 +191,7 @@ def test_a_panorama_calibrates_the_odometry_rotation_so_turning_round_is_true(ma
     rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
     # The views are put back into the odometry frame of the last one: the corridor axis
     # they give is the axis as the odometry sees it now (the raw views spread 20 deg).
-    _, axis, _, error = read_panorama(rig.ctx, rig.get("views"))
+    _, axis, _, error, _ = read_panorama(rig.ctx, rig.get("views"))
     now = wrap_angle(rig.ctx.base.pose().yaw - rig.true_pose().yaw) + SOUTH
     assert abs(wrap_angle(2.0 * (axis - now)) / 2.0) < math.radians(2.0)
     assert error == pytest.approx(1.0 - 1.0 / 1.073, abs=0.01)

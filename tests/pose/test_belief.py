@@ -437,7 +437,7 @@ def test_an_elevators_plate_beside_it_moves_a_belief_fix_little():
     seen = {elevator: tuple(se2_apply(ODOM_T_MAP, plate))}
     b = CorridorBelief(pm)
     truth = (0.0, 58.0, -math.pi / 2)
-    for true in (truth, (0.0, 59.5, math.pi / 2)):
+    for true in (truth, (0.0, 59.5, math.pi / 2), (1.5, 60.0, 0.0)):  # a tight belief
         g = glimpse(pm, true, (), depth=True)
         axis = wrap_angle(true[2] + ODOM_T_MAP[2])
         b.observe(Glimpse(g.odom, seen, None, g.free), axis_odom=axis)
@@ -493,3 +493,23 @@ def test_a_lone_elevator_plate_does_not_fix_the_place_along_the_corridor():
     if fix is not None:
         here = se2_apply(fix[0], se2_apply(ODOM_T_MAP, truth[:2]))
         assert math.dist(here, truth[:2]) < 1.0
+
+
+def test_a_sign_read_but_cut_by_the_border_is_in_sight_not_missed(fig2):
+    """A plate cut by the image border is read but not placed (its centre is biased): it
+    says the sign is in sight, so the place where the map puts it in sight is not charged
+    a miss, and places where it cannot be seen are charged a spurious reading."""
+    p = next(q for q in _points(fig2, 1))
+    (e,) = p.readable
+    true = (*p.xy, fig2.segments[p.segment - 1].heading)
+    g = glimpse(fig2, true, ())
+    missed, named = CorridorBelief(fig2), CorridorBelief(fig2)
+    missed.observe(g)
+    named.observe(Glimpse(g.odom, {}, named=frozenset({e})))
+    vis = named.vis
+    i = int(np.argmin(np.linalg.norm(named.xy - np.array(p.xy), axis=1)))
+    elsewhere = [j for j, q in enumerate(named.lattice) if e not in vis.lattice_points[q].readable]
+    assert named.logw[i] == 0.0 and missed.logw[i] == pytest.approx(math.log(0.25))
+    np.testing.assert_allclose(
+        named.logw[elsewhere] - missed.logw[elsewhere], math.log(0.005), atol=1e-9
+    )
