@@ -15,14 +15,14 @@ from pmnav_bt.behaviours.context import Context, thumbnail
 from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.geometry import se2_apply, wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance
-from pmnav_bt.perception.read_range import sign_read_range, sign_recall, sign_visible_range
+from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_visible_range
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
-from pmnav_bt.pose.visibility import entity_xy
+from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
 from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation, Pose2D
 
@@ -121,12 +121,11 @@ class UpdateBelief(PmNavBehaviour):
         belief = self.get("belief")
         if belief is None:
             cfg, pm = self.ctx.config, self.ctx.pm
-            visible = sign_visible_range(cfg)  # None: the oracle, its own range
             belief = CorridorBelief(
                 pm,
-                read_range=visible,
+                read_range=sign_visible_range(cfg),
                 recall=sign_recall(cfg, pm.building),
-                lead_range=None if visible is None else sign_read_range(cfg),
+                lead_range=sign_lead_range(cfg),
             )
             tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
             if tf is not None:
@@ -149,19 +148,29 @@ class NoSignInReach(PmNavBehaviour):
     """SUCCESS when the corridor belief so far does not put a sign within reliable reading
     range here (less than ``NO_SIGN_SHARE`` of it does): in a bare stretch, or where only
     one of several mirror-image places has a sign, the six views between the panorama's
-    are not worth their turn. FAILURE otherwise, and with no belief yet.
+    are not worth their turn. Before the first glimpse the share is that of the last
+    estimate (0 or 1), else of the whole map (a sign-sparse building has signs in reach
+    of a fifth of its corridors). FAILURE otherwise.
 
-    Reads ``belief``."""
+    Reads ``belief``, ``map_T_odom``."""
 
-    READS = ("belief",)
+    READS = ("belief", "map_T_odom")
 
     def update(self) -> Status:
         belief: CorridorBelief | None = self.get("belief")
-        if belief is None or belief.ref is None:
-            self.feedback_message = "no belief yet"
-            return Status.FAILURE
-        share = belief.sign_in_reach(self.ctx.base.pose())
-        self.feedback_message = f"{share:.0%} of the belief puts a sign in reach"
+        pose = self.ctx.base.pose()
+        if belief is not None and belief.ref is not None:
+            share, of = belief.sign_in_reach(pose), "the belief"
+        else:  # before the first glimpse: the last estimate, else anywhere on the map
+            vis = Visibility.of(self.ctx.pm, sign_lead_range(self.ctx.config))
+            tf = self.get("map_T_odom")
+            if tf is not None:
+                share = float(bool(vis.readable_from(se2_apply(tf, (pose.x, pose.y)))))
+                of = "the last estimate"
+            else:
+                share = float(np.mean([bool(p.readable) for p in vis.lattice_points]))
+                of = "the corridors"
+        self.feedback_message = f"{share:.0%} of {of} puts a sign in reach"
         return Status.SUCCESS if share < NO_SIGN_SHARE else Status.FAILURE
 
 

@@ -173,6 +173,15 @@ def sign_visible_range(config: Config, width: int | None = None) -> float | None
     return ocr_read_range(width or reading_width(config), POSSIBLE_RECALL)
 
 
+def sign_lead_range(config: Config, width: int | None = None) -> float | None:
+    """How far the localization belief counts on signs being read (m): where it drives to
+    read them, and where a panorama may have missed one. None for the oracle: the
+    belief's own ``READ_RANGE_M``."""
+    if _oracle(config):
+        return None
+    return sign_read_range(config, width)
+
+
 def sign_recall(config: Config, building: Building, width: int | None = None):
     """``recall(entity, distance, angle)``: how likely the configured grounder names
     ``entity``'s sign (by its plate kind) from ``distance`` m and ``angle`` rad off the

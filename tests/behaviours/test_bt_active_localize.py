@@ -46,3 +46,21 @@ def test_a_start_in_a_sign_less_stretch_localizes_by_driving_along_the_axis(make
 def test_the_sign_sparse_building_parses(pm):
     assert pm.building.name == "sign_sparse_0"
     assert parse_building(generate_sign_sparse(0)).segments == pm.segments
+
+
+def test_before_the_first_glimpse_the_map_says_if_the_views_between_are_worth_a_turn(make_rig, pm):
+    """With no belief yet, the share of the map with a sign in reliable reach decides (the
+    sign-sparse family: under a third of its corridors), or, when there is one, the last
+    estimate: beside a door plate the views between are taken."""
+    from py_trees.common import Status
+
+    from pmnav_bt.behaviours.active_localize import NoSignInReach
+
+    start = Pose2D(60.0, 45.0, math.radians(90.0))
+    rig = make_rig(start, overrides=("sim.reading_width=640", "grounder.backend=sim_gt"))
+    oracle = NoSignInReach("NoSignInReach", rig.ctx)
+    rig.expect(rig.run(oracle), Status.SUCCESS)  # 47 % of the corridors: under half
+    vis = Visibility.of(pm)
+    near = next(p for p in vis.lattice_points if len(p.readable) >= 2)
+    rig.set(map_T_odom=(near.xy[0] - start.x, near.xy[1] - start.y, 0.0))  # "we are there"
+    rig.expect(rig.run(NoSignInReach("NoSignInReach", rig.ctx)), Status.FAILURE)
