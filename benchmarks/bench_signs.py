@@ -54,6 +54,14 @@ def band_of(d: float) -> int:
     return next(i for i, (a, b) in enumerate(BANDS) if a <= d < b or (i == len(BANDS) - 1))
 
 
+def recall_cells(counts: list) -> str:
+    """One table row: recall and views per distance band ("-" where none were taken)."""
+    return "  ".join(
+        f"{100 * c['hit'] / c['views']:5.1f}% of {c['views']:3d}" if c["views"] else "    -       "
+        for c in counts
+    )
+
+
 def run(
     width: int,
     height: int,
@@ -126,27 +134,12 @@ def run(
     print(f"{'all':>10s} {tot['views']:6d} {rec:6.1f}% {tot['named']:6d} {prec:8.1f}%")
     print("recall per plate kind (read_range.plate_kind):")
     for kind in PLATE_KINDS:
-        cells = []
-        for i in range(len(BANDS)):
-            kd = kinds[(kind, i)]
-            cells.append(
-                f"{100 * kd['hit'] / kd['views']:5.1f}% of {kd['views']:3d}"
-                if kd["views"]
-                else "    -       "
-            )
-        print(f"{kind:>10s} " + "  ".join(cells))
+        print(f"{kind:>10s} " + recall_cells([kinds[(kind, i)] for i in range(len(BANDS))]))
     print("recall per angle off the plate's normal (rows) and distance band (columns):")
     for i, (a, b) in enumerate(ANGLE_BANDS):
-        cells = []
-        for j in range(len(BANDS)):
-            ad = by_angle[(i, j)]
-            cells.append(
-                f"{100 * ad['hit'] / ad['views']:5.1f}% of {ad['views']:3d}"
-                if ad["views"]
-                else "    -       "
-            )
-        if any(by_angle[(i, j)]["views"] for j in range(len(BANDS))):
-            print(f"{a:>3d}-{b:<2d} deg " + "  ".join(cells))
+        row = [by_angle[(i, j)] for j in range(len(BANDS))]
+        if any(c["views"] for c in row):
+            print(f"{a:>3d}-{b:<2d} deg " + recall_cells(row))
     for what, v in (("wall time", ms), ("CPU time", cpu_ms)):
         print(
             f"read_signs {what}: p50 {np.percentile(v, 50):.0f} ms, "
