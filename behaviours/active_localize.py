@@ -14,16 +14,18 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, thumbnail
 from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M
+from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose, sighting
-from pmnav_bt.perception.geometry import free_distance
+from pmnav_bt.perception.geometry import free_distance, target_point
 from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_visible_range
+from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
 from pmnav_bt.pose.visibility import Visibility, entity_xy
-from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, wall_points
+from pmnav_bt.pose.walls import axis_in_odom, corridor_centre, fit_wall_angle, wall_points
 from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation, Pose2D
 
 # Take the views between a panorama's only where at least this share of the belief puts a
@@ -32,7 +34,10 @@ from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation, Pose2D
 NO_SIGN_SHARE = 0.5
 NO_PROGRESS_S = 6.0  # clock seconds without moving 0.1 m: the drive is blocked
 MIN_BLOCKED_DRIVE_M = 0.2  # blocked sooner: a brush with a wall, not the corridor's end
-SIGN_APPROACH_M = 3.0  # with a sign in view ahead, drive this much further, then look round
+SIGN_APPROACH_M = 3.0  # with a sign in view ahead, drive at most this much further ...
+SIGN_STOP_M = 2.5  # ... to stop this far short of it (nearer, a plate is seen along its wall)
+CENTRE_LOOKAHEAD_M = 3.0  # steer back onto the corridor's centre line over this distance
+MAX_CENTRE_TURN = math.radians(15.0)  # ... turning at most this far off the axis for it
 WALL_CHECK_S = 1.0  # clock seconds between wall checks while driving along the corridor
 STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
@@ -98,10 +103,12 @@ class UpdateBelief(PmNavBehaviour):
     estimate as its prior when there is one. How the walls' direction moved while the
     panorama turned calibrates the odometry's rotation (``CalibratedBase``).
 
-    Reads ``views``, ``belief``, ``map_T_odom``, ``pose_tracker``; writes ``belief``.
+    The goal room's door is the belief's ``target``: where to look for signs first.
+
+    Reads ``views``, ``belief``, ``map_T_odom``, ``pose_tracker``, ``goal``; writes ``belief``.
     """
 
-    READS = ("views", "belief", "map_T_odom", "pose_tracker")
+    READS = ("views", "belief", "map_T_odom", "pose_tracker", "goal")
     WRITES = ("belief",)
     JOBS = ("_job",)
 
@@ -126,6 +133,7 @@ class UpdateBelief(PmNavBehaviour):
                 read_range=sign_visible_range(cfg),
                 recall=sign_recall(cfg, pm.building),
                 lead_range=sign_lead_range(cfg),
+                target=_goal_xy(pm, self.get("goal")),
             )
             tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
             if tf is not None:
@@ -142,6 +150,16 @@ class UpdateBelief(PmNavBehaviour):
             f"{len(seen)} sign(s) read, {len(belief.glimpses)} glimpse(s); best {mass:.0%}"
         )
         return Status.SUCCESS
+
+
+def _goal_xy(pm, goal) -> tuple[float, float] | None:
+    """The goal room's door (map), or None when there is no goal or it names no room."""
+    if not goal:
+        return None
+    try:
+        return entity_xy(pm, Entity.room(resolve_room(pm, str(goal))))
+    except UnknownNameError:
+        return None
 
 
 class NoSignInReach(PmNavBehaviour):
@@ -235,6 +253,13 @@ class FixFromBelief(PmNavBehaviour):
         return Status.SUCCESS
 
 
+def _ahead(obs: Observation, det) -> float:
+    """How far ahead (m, along the view) a sign read in ``obs`` is; SIGN_STOP_M plus
+    SIGN_APPROACH_M without depth."""
+    p = det.point[:2] if det.point is not None else target_point(obs, det)
+    return SIGN_STOP_M + SIGN_APPROACH_M if p is None else float(p[0])
+
+
 def _map_xy(tf, pose) -> tuple[float, float]:
     c, s = math.cos(tf[2]), math.sin(tf[2])
     return tf[0] + c * pose.x - s * pose.y, tf[1] + s * pose.x + c * pose.y
@@ -282,7 +307,7 @@ class FollowLead(PmNavBehaviour):
         self._driving = False
         self._next_check = -math.inf
         self._best, self._best_t = 0.0, self.ctx.now()
-        self._signs_ahead = 0
+        self._signs_ahead: list[float] = []  # how far ahead (m) each sign read ahead is
         self._free_ahead = math.inf
         self._backing = None
 
@@ -293,9 +318,17 @@ class FollowLead(PmNavBehaviour):
         def measure(cancelled):
             obs = base.observe()
             mask = wall_mask(grounder, obs)
-            fit = None if mask is None else fit_wall_angle(wall_points(obs, mask))
-            signs = len(grounder.read_signs(obs))
-            return obs.pose.yaw, None if fit is None else fit[0], signs, free_distance(obs, 0.0)
+            points = None if mask is None else wall_points(obs, mask)
+            fit = None if points is None else fit_wall_angle(points)
+            centre = None if points is None else corridor_centre(points)
+            ahead = [_ahead(obs, d) for d in grounder.read_signs(obs)]
+            return (
+                obs.pose.yaw,
+                None if fit is None else fit[0],
+                ahead,
+                free_distance(obs, 0.0),
+                centre,
+            )
 
         self._job = self.ctx.worker.submit(measure)
 
@@ -304,12 +337,17 @@ class FollowLead(PmNavBehaviour):
             return
         job, self._job = self._job, None
         try:
-            yaw, angle, signs, free = job.result()
+            yaw, angle, ahead, free, centre = job.result()
         except Exception:  # noqa: BLE001 - a lost wall check: drive on, check again
             return
-        if angle is not None and abs(angle) < ALONG_WALL_MAX:
+        if centre is not None and abs(centre[0]) < ALONG_WALL_MAX:
+            # Along both walls, turning a little towards the centre line: there a plate
+            # on either wall is seen at the angle the map's reading ranges assume.
+            steer = math.atan2(centre[1], CENTRE_LOOKAHEAD_M)
+            self._heading = yaw + centre[0] + max(-MAX_CENTRE_TURN, min(MAX_CENTRE_TURN, steer))
+        elif angle is not None and abs(angle) < ALONG_WALL_MAX:
             self._heading = yaw + angle  # parallel to the wall in view
-        self._signs_ahead = signs
+        self._signs_ahead = ahead
         self._free_ahead = free
 
     def update(self) -> Status:
@@ -341,10 +379,15 @@ class FollowLead(PmNavBehaviour):
         if done_m >= self._distance:
             base.set_velocity(0.0, 0.0)
             return Status.SUCCESS
-        if self._signs_ahead and self._distance > done_m + SIGN_APPROACH_M:
-            # A sign in view ahead: go a little closer (to read it well), then look round.
-            self._distance = done_m + SIGN_APPROACH_M
-            self.feedback_message = f"a sign in view after {done_m:.1f} m: look round soon"
+        ahead = [a for a in self._signs_ahead if a > SIGN_STOP_M]  # nearer: read already
+        if ahead:
+            # A sign read ahead: stop short of it (a plate is read best 2-3 m off, and
+            # seen along its wall from beside it), then look round.
+            stop = done_m + min(SIGN_APPROACH_M, min(ahead) - SIGN_STOP_M)
+            if stop < self._distance:
+                self._distance = stop
+                self.feedback_message = f"a sign in view after {done_m:.1f} m: look round soon"
+            self._signs_ahead = []
         if done_m > self._best + 0.1:
             self._best, self._best_t = done_m, now
         stuck = now - self._best_t > NO_PROGRESS_S

@@ -33,6 +33,7 @@ from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
 P_MISS = 0.25  # a sign the map says is readable is not read
 P_SPURIOUS = 0.005  # a sign is read that the map says cannot be read from there
+P_OCCLUDED = 0.1  # ... from there, but it is within reading range (round a corner)
 SIGHT_SIGMA_M = 0.8  # spread of a sign's seen position around the map's
 DRIFT_PER_M = 0.05  # the sight spread grows with odometry distance from the reference
 FIX_MASS = 0.85  # a cluster holding this much weight is a fix
@@ -117,6 +118,9 @@ class CorridorBelief:
     # m, signs are read reliably to: where to go to read them (None: read_range). A sign
     # 5 m off that OCR reads one time in seven is no place to drive to.
     lead_range: float | None = None
+    # Where the robot is going (map; None: nowhere yet): of two ways towards signs, the
+    # one whose whole trip, finding the place and then going on, is shorter.
+    target: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm, self.read_range)
@@ -124,7 +128,12 @@ class CorridorBelief:
         self.goal = Visibility.of(
             self.pm, self.read_range if self.lead_range is None else self.lead_range
         )
-        self._miss = self._miss_logs()
+        self._plate = {  # each sign's plate: where the map puts it and its wall's normal
+            e: (xy, n)
+            for e, xy, n in zip(
+                self.vis.entities, self.vis.sign_xy, self.vis.sign_normal, strict=True
+            )
+        }
         self._floor = shapely.buffer(self.vis.corridors, RAY_SLACK_M)  # a little tolerance
         shapely.prepare(self._floor)
         self._build()
@@ -155,25 +164,17 @@ class CorridorBelief:
         for g in self.glimpses:
             self._weigh(g)
 
-    def _miss_logs(self) -> list[dict[Entity, float]] | None:
-        """Per lattice point, the log-probability that each sign in sight is not read."""
-        if self.recall is None:
-            return None
-        vis = self.vis
-        plate = {
-            e: (xy, n) for e, xy, n in zip(vis.entities, vis.sign_xy, vis.sign_normal, strict=True)
-        }
-        out = []
-        for p in vis.lattice_points:
-            logs = {}
-            for e in p.readable:
-                xy, normal = plate[e]
-                v = np.asarray(p.xy) - xy
-                d = float(np.linalg.norm(v))
-                off = math.acos(min(1.0, max(-1.0, float(v @ normal) / max(d, 1e-9))))
-                logs[e] = math.log(max(P_MISS, 1.0 - self.recall(e, d, off)))
-            out.append(logs)
-        return out
+    def _miss_log(self, entity: Entity, xy: np.ndarray) -> float:
+        """The log-probability that ``entity``'s sign, in sight, is not read from ``xy``
+        (map): by the reader's recall from that distance and angle off the plate's normal.
+        From where the hypothesis puts the robot, not its lattice point on the centre
+        line: a plate on the wall the robot drives beside is seen along the wall (no
+        evidence when not read), the same plate from the centre line at 50 degrees."""
+        plate, normal = self._plate[entity]
+        v = xy - plate
+        d = float(math.hypot(v[0], v[1]))
+        off = math.acos(min(1.0, max(-1.0, float(v @ normal) / max(d, 1e-9))))
+        return math.log(max(P_MISS, 1.0 - self.recall(entity, d, off)))
 
     def _weigh_prior(self, map_T_odom: tuple[float, float, float], sigma: float) -> None:
         """Hypotheses near where the earlier estimate puts the reference are likelier."""
@@ -332,14 +333,25 @@ class CorridorBelief:
         d_seen = {e: np.linalg.norm(seen_map[e] - map_xy[e], axis=1) for e in seen}
         # An elevator's plate hangs beside it: its sighting tells the place less exactly.
         sig = {e: math.hypot(sigma, PLACE_SIGMA_M[e.kind]) for e in seen}
-        miss = self._miss
+        # Read, but the map says out of sight here: unlikely. A plate read but cut by the
+        # image border, whose place is not known, much less so within reading range: the
+        # plate hangs a metre beside the door the map's sight line ends at, and round a
+        # corner one of the two is in sight when the other is not.
+        spurious = {
+            e: np.where(
+                np.linalg.norm(here_xy - np.array(entity_xy(self.pm, e)), axis=1)
+                <= self.vis.read_range,
+                math.log(P_OCCLUDED),
+                math.log(P_SPURIOUS),
+            )
+            for e in named
+        }
         for i, r in enumerate(readable):
-            if miss is None:
+            if self.recall is None:
                 lw = len(r - seen - named) * math.log(P_MISS)
             else:
-                m = miss[near[i]]
-                lw = sum(m[e] for e in r - seen - named)
-            lw += len(named - r) * math.log(P_SPURIOUS)  # read, but not in sight here
+                lw = sum(self._miss_log(e, here_xy[i]) for e in r - seen - named)
+            lw += sum(spurious[e][i] for e in named - r)
             for e in seen:
                 if e in r:
                     lw += max(-0.5 * (d_seen[e][i] / sig[e]) ** 2, MISREAD)
@@ -364,12 +376,15 @@ class CorridorBelief:
 
     def fix(self) -> tuple[tuple[float, float, float], float] | None:
         """(map_T_odom, spread in metres) once one cluster holds FIX_MASS of the belief, a
-        sign was read or ``MIN_BLIND_GLIMPSES`` glimpses were taken (the corridors' shape
-        alone, the ends met and the turns taken, can tell where the robot is); refined on
-        the signs read under that hypothesis."""
+        sign was read, the belief began from an earlier estimate (``prior``: re-localizing
+        after a blocked corner, the estimate and the walls seen can be enough) or
+        ``MIN_BLIND_GLIMPSES`` glimpses were taken (the corridors' shape alone, the ends
+        met and the turns taken, can tell where the robot is); refined on the signs read
+        under that hypothesis."""
         if not self.glimpses:
             return None
-        if not any(g.seen for g in self.glimpses) and len(self.glimpses) < MIN_BLIND_GLIMPSES:
+        blind = not any(g.seen for g in self.glimpses)
+        if blind and self.prior is None and len(self.glimpses) < MIN_BLIND_GLIMPSES:
             return None
         idx, mass = self.best_cluster()
         if mass < FIX_MASS:
@@ -427,10 +442,11 @@ class CorridorBelief:
         across it at a junction). It keeps the way it chose last while enough of the belief
         says that way goes on (so it explores one way to the end, then the other), else the
         open way with the least expected corridor distance to where the map says two
-        signs are readable. The drive stops at the next junction, where half the belief
-        puts it (on the first drive from a diffuse belief, where a fifth does: from a
-        bare corridor the median junction is far, and a nearer one passed unlooked-at
-        is the place that would have told the position)."""
+        signs are readable (with a ``target``: to the target by way of such signs, so the
+        search for signs heads where the robot is going). The drive stops at the next
+        junction, where half the belief puts it (on the first drive from a diffuse
+        belief, where a fifth does: from a bare corridor the median junction is far, and
+        a nearer one passed unlooked-at is the place that would have told the position)."""
         dist, _ = self.goal.towards_signs
         if not dist:
             return None
@@ -445,7 +461,9 @@ class CorridorBelief:
         near, _ = self.vis.nearest_many(here)
         axis = self._axis()
         open_mass = np.zeros(4)  # belief that each way (along/across the axis) is open
-        cost = np.zeros(4)
+        cost = np.zeros(4)  # expected distance to signs each way
+        trip = np.zeros(4)  # ... and to the target by way of signs (the whole trip)
+        onward = None if self.target is None else self.goal.exits_to(self.target)
         run = [[] for _ in range(4)]  # (weight, distance to the next junction) per way
         side_mass = 0.0  # belief that the robot is at a junction with a side corridor
         # Side corridors of a junction within reach count (it is easy to stop a little off
@@ -457,25 +475,28 @@ class CorridorBelief:
         for a, b in pairs.T:
             reach.setdefault(int(a), []).append(int(b))
         for n, (i, j) in enumerate(zip(live, near, strict=True)):
-            ways: dict[int, tuple[float, float]] = {}
+            ways: dict[int, tuple[float, float, float]] = {}
             for m in {j, *reach.get(n, ())}:
                 for h_map, d in self.goal.exits[m]:
                     k = int(round(wrap_angle(h_map - tfs[i][2] - axis) / (math.pi / 2))) % 4
                     if m != j and k % 2 == 0:
                         continue
                     r = self.goal.run_lengths[m].get(h_map, 0.0)
+                    t = d if onward is None else onward[m].get(h_map, math.inf)
                     if k not in ways or d < ways[k][0]:
-                        ways[k] = (d, r)
+                        ways[k] = (d, r, t)
             if 1 in ways or 3 in ways:
                 side_mass += w[i]
-            for k, (d, r) in ways.items():
+            for k, (d, r, t) in ways.items():
                 open_mass[k] += w[i]
                 cost[k] += w[i] * min(d, WALL_COST_M)
+                trip[k] += w[i] * min(t, 2.0 * WALL_COST_M)
                 run[k].append((w[i], r))
         total = float(w[live].sum())
         open_mass /= total
         side_mass /= total
         cost = np.where(open_mass > 0, cost / np.maximum(open_mass * total, 1e-12), np.inf)
+        trip = np.where(open_mass > 0, trip / np.maximum(open_mass * total, 1e-12), np.inf)
         # Across the axis only where the belief is sure of a junction (it is easy to be a
         # metre or two short of one); along it while a third of the belief says it goes on,
         # except at a junction, where the way is chosen afresh.
@@ -494,7 +515,7 @@ class CorridorBelief:
             if back in ok and SWITCH_COST_RATIO * cost[back] < cost[k]:
                 k = back
         elif len(ok):
-            k = int(ok[np.argmin(cost[ok])])
+            k = int(ok[np.argmin(trip[ok])])
             _, mass = self.best_cluster()
             near = [j for j in ok if ends[j] <= NEAR_JUNCTION_M]
             if mass < DIFFUSE_MASS and near and len(self.glimpses) <= 1:
@@ -547,7 +568,8 @@ class CorridorBelief:
 
     def _telling_lead(self, odom: Pose2D, max_distance: float) -> Lead | None:
         """Towards the nearest place where the few likely hypotheses predict different
-        signs (the most information per metre driven), when the belief is split between
+        signs (the most information per metre driven; with a ``target``, the place with
+        the shortest expected trip there and on to it), when the belief is split between
         a few clusters, e.g. the mirror images of a symmetric corridor: a glimpse there
         tells them apart, where driving towards signs that every hypothesis puts alike
         (both ends of the corridor) cannot. The first leg of the way there, along or
@@ -584,18 +606,24 @@ class CorridorBelief:
         pts = self.goal.lattice_points  # what each would read there for sure
         hyp = np.array([m[int(np.argmax(w[m]))] for m in modes])  # one per cluster
         preds = []  # per cluster: the signs readable at each candidate (None: a wall)
-        for i in hyp:
+        to_target = None if self.target is None else self.goal.distance_to(self.target)
+        onward = np.zeros(len(cand))  # expected way on from each candidate to the target
+        for i, ms in zip(hyp, mass, strict=True):
             c, s_ = math.cos(tfs[i][2]), math.sin(tfs[i][2])
             there = np.stack(
                 [tfs[i][0] + c * q[:, 0] - s_ * q[:, 1], tfs[i][1] + s_ * q[:, 0] + c * q[:, 1]], 1
             )
             near, off = self.vis.nearest_many(there)
+            if to_target is not None:
+                onward += ms * np.array([to_target.get(int(n), WALL_COST_M) for n in near])
             preds.append(
                 [
                     pts[n].readable if o <= half[pts[n].segment - 1] else None
                     for n, o in zip(near, off, strict=True)
                 ]
             )
+        onward /= mass.sum()
+        best_c, best_trip = None, math.inf
         for c_i, m in enumerate(cand):
             if not fresh[c_i] or reach[int(m)] < 1.0:
                 continue
@@ -607,10 +635,16 @@ class CorridorBelief:
                 groups[r] = groups.get(r, 0.0) + float(ms)
             if max(groups.values()) >= FIX_MASS * mass.sum():
                 continue
-            return self._leg_towards(
-                here, paths[int(m)], tfs[best], float(mass.sum()), max_distance
-            )
-        return None
+            if to_target is None:  # the nearest
+                best_c = int(m)
+                break
+            # With a target: the least expected trip, there and on to the target.
+            t = reach[int(m)] + float(onward[c_i])
+            if t < best_trip:
+                best_c, best_trip = int(m), t
+        if best_c is None:
+            return None
+        return self._leg_towards(here, paths[best_c], tfs[best], float(mass.sum()), max_distance)
 
     def _leg_towards(self, here, path, tf, support: float, max_distance: float) -> Lead | None:
         """The first straight leg from ``here`` (map) along a lattice path: the first

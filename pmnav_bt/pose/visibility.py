@@ -205,32 +205,38 @@ class Visibility:
     def run_lengths(self) -> list[dict[float, float]]:
         """For each lattice point and way out (keyed like ``exits``): how far straight on
         to the next junction or corridor end."""
-        g, xy, exits = self.lattice_graph, self.lattice_xy, self.exits
-
-        def step(m: int, key: float) -> tuple[int, float] | None:
-            group = {m} | {k for k in g[m] if g[m][k]["length"] == 0.0}
-            for a in group:
-                for k in g[a]:
-                    length = g[a][k]["length"]
-                    if length == 0.0 or k in group:
-                        continue
-                    h = math.atan2(xy[k][1] - xy[a][1], xy[k][0] - xy[a][0])
-                    if abs(math.remainder(h - key, 2 * math.pi)) < 0.05:
-                        return k, length
-            return None
-
         out: list[dict[float, float]] = []
-        for j in range(len(xy)):
+        for j in range(len(self.lattice_xy)):
             runs = {}
-            for key, _ in exits[j]:
-                d, m = 0.0, j
-                while (nxt := step(m, key)) is not None:
-                    m, d = nxt[0], d + nxt[1]
-                    if len(exits[m]) != 2:
-                        break
-                runs[key] = d
+            for key, _ in self.exits[j]:
+                runs[key] = max((d for _, d in self._run(j, key)), default=0.0)
             out.append(runs)
         return out
+
+    def _step(self, m: int, key: float) -> tuple[int, float] | None:
+        """The next lattice point from ``m`` along the way out keyed ``key`` (map heading,
+        as in ``exits``) and the distance to it; None at a corridor end."""
+        g, xy = self.lattice_graph, self.lattice_xy
+        group = {m} | {k for k in g[m] if g[m][k]["length"] == 0.0}
+        for a in group:
+            for k in g[a]:
+                length = g[a][k]["length"]
+                if length == 0.0 or k in group:
+                    continue
+                h = math.atan2(xy[k][1] - xy[a][1], xy[k][0] - xy[a][0])
+                if abs(math.remainder(h - key, 2 * math.pi)) < 0.05:
+                    return k, length
+        return None
+
+    def _run(self, j: int, key: float):
+        """The lattice points (and distances) from ``j`` straight on along way ``key`` up
+        to the next junction or corridor end, which is the last."""
+        d, m = 0.0, j
+        while (nxt := self._step(m, key)) is not None:
+            m, d = nxt[0], d + nxt[1]
+            yield m, d
+            if len(self.exits[m]) != 2:
+                break
 
     def nearest_lattice(self, xy) -> int:
         return int(self.nearest_many(np.asarray(xy, dtype=float).reshape(1, 2))[0][0])
@@ -261,3 +267,59 @@ class Visibility:
         dist, paths = nx.multi_source_dijkstra(g, good, weight="length")
         nxt = {i: (path[-2] if len(path) > 1 else i) for i, path in paths.items()}
         return dist, nxt
+
+    def distance_to(self, target: tuple[float, float]) -> dict[int, float]:
+        """Corridor distance from each lattice point to the one nearest ``target`` (map)."""
+        key = (round(float(target[0]), 2), round(float(target[1]), 2))
+        cache = self.__dict__.setdefault("_distance_to", {})
+        if key not in cache:
+            cache[key] = nx.single_source_dijkstra_path_length(
+                self.lattice_graph, self.nearest_lattice(key), weight="length"
+            )
+        return cache[key]
+
+    def via_signs_to(self, target: tuple[float, float]) -> dict[int, float]:
+        """For each lattice point: the corridor distance to ``target`` (map) by way of a
+        point where at least two signs are readable (the robot finds where it is, then goes
+        on): the least, over such points, of the way there plus the way on to the target."""
+        to_target = self.distance_to(target)
+        good = [
+            p.index for p in self.lattice_points if len(p.readable) >= 2 and p.index in to_target
+        ]
+        if not good:
+            return {}
+        g = self.lattice_graph.copy()
+        src = -1  # joined to each sign point by the way on from it to the target
+        for i in good:
+            g.add_edge(src, i, length=float(to_target[i]))
+        dist = nx.single_source_dijkstra_path_length(g, src, weight="length")
+        dist.pop(src)
+        return dist
+
+    def exits_to(self, target: tuple[float, float]) -> list[dict[float, float]]:
+        """For each lattice point and way out (keyed like ``exits``): the corridor distance
+        to ``target`` (map) for a robot that goes that way and first finds where it is:
+        the least of reading signs on the way straight on and going on to the target from
+        there, or going on to the next junction or corridor end and from there by way of
+        the best signs (``via_signs_to``, which may lead back)."""
+        key = (round(float(target[0]), 2), round(float(target[1]), 2))
+        cache = self.__dict__.setdefault("_exits_to", {})
+        if key in cache:
+            return cache[key]
+        to_target, via = self.distance_to(key), self.via_signs_to(key)
+        pts = self.lattice_points
+        out: list[dict[float, float]] = []
+        for j in range(len(pts)):
+            ways = {}
+            for way, _ in self.exits[j]:
+                best = math.inf
+                m, d = j, 0.0
+                for m, d in self._run(j, way):
+                    if len(pts[m].readable) >= 2:
+                        best = min(best, d + to_target.get(m, math.inf))
+                if m != j:
+                    best = min(best, d + via.get(m, math.inf))
+                ways[way] = best
+            out.append(ways)
+        cache[key] = out
+        return out

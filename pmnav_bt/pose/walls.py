@@ -21,6 +21,8 @@ MAX_RANGE_M = 6.0  # wall points farther than this are too noisy
 MIN_INLIERS = 60
 INLIER_M = 0.05
 ITERATIONS = 60
+MAX_PARALLEL = math.radians(10.0)  # a corridor's two walls: this parallel ...
+MIN_WIDTH_M, MAX_WIDTH_M = 1.0, 6.0  # ... and this far apart
 
 
 def wall_points(obs: Observation, wall: np.ndarray, stride: int = 2) -> np.ndarray:
@@ -85,6 +87,26 @@ def fit_wall_line(points: np.ndarray, seed: int = 0) -> WallLine | None:
     normal = np.array([-d[1], d[0]]) if d[0] >= 0 else np.array([d[1], -d[0]])
     offset = float(mean @ normal)
     return WallLine(wrap_angle(2.0 * a) / 2.0, offset, int(best_in.sum()), float(np.ptp(along)))
+
+
+def corridor_centre(points: np.ndarray) -> tuple[float, float] | None:
+    """(axis direction, centre-line offset) from both walls of the corridor in view: the
+    strongest wall line and a second one parallel to it on the robot's other side, the
+    offset (m, positive: the centre line is on the left) half-way between them. None
+    without two such walls (a junction, a wall ahead, one wall out of view)."""
+    first = fit_wall_line(points)
+    if first is None:
+        return None
+    normal = np.array([-math.sin(first.angle), math.cos(first.angle)])
+    rest = points[np.abs(points @ normal - first.offset) > 3.0 * INLIER_M]
+    second = fit_wall_line(rest, seed=1)
+    if second is None or first.offset * second.offset >= 0.0:
+        return None
+    if abs(wrap_angle(2.0 * (first.angle - second.angle))) / 2.0 > MAX_PARALLEL:
+        return None
+    if not MIN_WIDTH_M <= abs(first.offset - second.offset) <= MAX_WIDTH_M:
+        return None
+    return first.angle, (first.offset + second.offset) / 2.0
 
 
 def wall_angle(obs: Observation, wall: np.ndarray) -> float | None:

@@ -16,7 +16,7 @@ from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.visibility import Visibility, entity_xy
-from pmnav_bt.seams import EntityKind, Pose2D
+from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
 ODOM_T_MAP = (3.0, -2.0, 0.7)  # the odometry frame is anywhere
 
@@ -77,6 +77,29 @@ def test_nothing_seen_is_no_fix():
     b = CorridorBelief(pm)
     b.observe(glimpse(pm, (*p.xy, pm.segments[p.segment - 1].heading), ()))
     assert b.fix() is None
+
+
+def test_an_earlier_estimate_and_the_walls_seen_fix_the_pose_without_a_sign():
+    """sign_sparse_2 hard #4: after a 50 m leg the robot met the end wall of a T junction
+    before the turn it expected (1 m of drift), and the relocalization, sure of the
+    place from the last estimate and the junction seen in depth (97 %), still wanted
+    four glimpses or a sign: 110 actions later the budget ran out a door short."""
+    pm = parse_building(generate_sign_sparse(2))
+    truth = (60.0, 30.0, 0.0)  # at branch3, facing the end wall
+    odom = se2_compose(ODOM_T_MAP, truth)
+    rays = np.radians(np.arange(0.0, 360.0, 20.0))  # as the panorama's views measure
+    free = tuple((truth[2] + a + ODOM_T_MAP[2], _free(pm, truth, truth[2] + a)) for a in rays)
+    g = Glimpse(Pose2D(*odom), {}, None, free)
+    est = se2_compose((1.2, 0.0, 0.0), se2_inverse(ODOM_T_MAP))  # 1.2 m short of it
+    fixes = {}
+    for prior in (None, (est, 1.2)):
+        b = CorridorBelief(pm, prior=prior)
+        b.observe(g, axis_odom=g.odom.yaw)
+        fixes[prior is None] = b.fix()
+    assert fixes[True] is None  # no sign, one glimpse, no earlier estimate
+    fix = fixes[False]
+    assert fix is not None
+    np.testing.assert_allclose(fix[0][:2], se2_inverse(ODOM_T_MAP)[:2], atol=0.75)
 
 
 def test_sightings_of_earlier_glimpses_are_kept():
@@ -380,8 +403,8 @@ def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_r
             if 4.6 < d < 5.8 and far is None:
                 far = (p, e)
     assert near and far
-    assert b._miss[near[0].index][near[1]] == pytest.approx(math.log(0.25))  # P_MISS
-    assert b._miss[far[0].index][far[1]] > math.log(0.8)
+    assert b._miss_log(near[1], np.array(near[0].xy)) == pytest.approx(math.log(0.25))
+    assert b._miss_log(far[1], np.array(far[0].xy)) > math.log(0.8)
     # One bare glimpse at a place whose only signs in sight are far: with the reader's
     # recall the place keeps nearly all its weight, with a constant miss it loses 4x a sign.
     p = next(
@@ -419,10 +442,36 @@ def test_a_plate_seen_along_its_wall_is_no_evidence_when_not_read(fig2):
             d = float(np.linalg.norm(v))
             off = math.degrees(math.acos(float(v @ vis.sign_normal[k]) / d))
             if d < 2.5 and off < 45 and head_on is None:
-                head_on = b._miss[p.index][e]
+                head_on = b._miss_log(e, np.asarray(p.xy))
             if off > 77 and along is None:
-                along = b._miss[p.index][e]
+                along = b._miss_log(e, np.asarray(p.xy))
     assert head_on == pytest.approx(math.log(0.25)) and along == 0.0
+
+
+def test_a_miss_is_judged_from_where_the_hypothesis_puts_the_robot_not_the_centre_line():
+    """sign_sparse_2, hard #0 with the OCR stack: driving 0.7 m north of the centre line,
+    the robot looked round 1.5 m past room9's plate on the north wall (seen 72 deg off
+    its normal: not read). Judged from the centre line (51 deg) that was a sure miss, and
+    six bare glimpses fixed the pose at the building's mirror image, where no plate is."""
+    from pmnav_bt.config import load_config
+    from pmnav_bt.perception.read_range import sign_recall
+
+    pm = parse_building(generate_sign_sparse(2))
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    b = CorridorBelief(pm, read_range=6.0, recall=sign_recall(cfg, pm.building))
+    room9 = Entity.room("room9")
+    assert b._miss_log(room9, np.array([10.0, 30.0])) == pytest.approx(math.log(0.25))
+    assert b._miss_log(room9, np.array([10.0, 30.7])) > 0.5 * math.log(0.25)
+    # Bare glimpses on the centre line 4 m east, then there: the truth is charged no
+    # more than the far plate's likely miss and the near one's partial miss.
+    b.observe(glimpse(pm, (14.0, 30.0, math.pi), ()), axis_odom=math.pi + ODOM_T_MAP[2])
+    b.observe(glimpse(pm, (10.0, 30.7, math.pi), ()), axis_odom=math.pi + ODOM_T_MAP[2])
+    truth = np.nonzero(
+        (np.linalg.norm(b.xy - np.array([14.0, 30.0]), axis=1) < 0.1)
+        & (np.abs(np.angle(np.exp(1j * (b.yaw - math.pi)))) < 0.1)
+    )[0]
+    assert len(truth) == 1
+    assert b.logw[truth[0]] - b.logw.max() > math.log(0.25)
 
 
 def test_an_elevators_plate_beside_it_moves_a_belief_fix_little():
@@ -498,7 +547,11 @@ def test_a_lone_elevator_plate_does_not_fix_the_place_along_the_corridor():
 def test_a_sign_read_but_cut_by_the_border_is_in_sight_not_missed(fig2):
     """A plate cut by the image border is read but not placed (its centre is biased): it
     says the sign is in sight, so the place where the map puts it in sight is not charged
-    a miss, and places where it cannot be seen are charged a spurious reading."""
+    a miss, and places where it cannot be seen are charged a spurious reading: places
+    out of reading range in full, places within range but out of the sight line to the
+    door the map places less (the plate hangs a metre beside it: sign_sparse_0 hard #2
+    read room14 round the corner of a junction, and the truth lost 200:1 to a place the
+    building's shape mirrors)."""
     p = next(q for q in _points(fig2, 1))
     (e,) = p.readable
     true = (*p.xy, fig2.segments[p.segment - 1].heading)
@@ -510,6 +563,32 @@ def test_a_sign_read_but_cut_by_the_border_is_in_sight_not_missed(fig2):
     i = int(np.argmin(np.linalg.norm(named.xy - np.array(p.xy), axis=1)))
     elsewhere = [j for j, q in enumerate(named.lattice) if e not in vis.lattice_points[q].readable]
     assert named.logw[i] == 0.0 and missed.logw[i] == pytest.approx(math.log(0.25))
-    np.testing.assert_allclose(
-        named.logw[elsewhere] - missed.logw[elsewhere], math.log(0.005), atol=1e-9
-    )
+    here = named.xy[elsewhere]  # at the reference glimpse, the lattice points
+    near = np.linalg.norm(here - np.array(entity_xy(fig2, e)), axis=1) <= vis.read_range
+    assert near.any() and (~near).any()
+    gain = named.logw[elsewhere] - missed.logw[elsewhere]
+    np.testing.assert_allclose(gain[~near], math.log(0.005), atol=1e-9)
+    np.testing.assert_allclose(gain[near], math.log(0.1), atol=1e-9)
+
+
+@pytest.mark.parametrize(("room", "east"), [("room14", True), ("room1", False)])
+def test_the_search_for_signs_heads_where_the_robot_is_going(room, east):
+    """sign_sparse_2, 10 m into the bare corridor east of the west wing: the nearest
+    signs are 11 m back west; with the goal in the east wing the trip by way of the east
+    wing's signs is 20 m shorter, and the lead goes east. Without a target, or with the
+    goal in the west wing, it goes west."""
+    pm = parse_building(generate_sign_sparse(2))
+    truth = (19.5, 30.0, 0.0)
+    g = glimpse(pm, truth, (), depth=True)
+    heads = {}
+    for target in (None, entity_xy(pm, Entity.room(room))):
+        b = CorridorBelief(pm, read_range=6.0, lead_range=3.5, target=target)
+        b.observe(g, axis_odom=wrap_angle(truth[2] + ODOM_T_MAP[2]))
+        tfs = b._map_T_odom()  # a belief sure of the place, as with a prior
+        here = np.linalg.norm(tfs[:, :2] - np.array(se2_inverse(ODOM_T_MAP)[:2]), axis=1)
+        turn = np.abs(np.angle(np.exp(1j * (tfs[:, 2] - se2_inverse(ODOM_T_MAP)[2]))))
+        b.logw = np.where((here < 0.3) & (turn < 0.1), 0.0, -50.0)
+        lead = b.lead(g.odom, max_distance=16.0)
+        heads[target is None] = math.cos(lead.heading - ODOM_T_MAP[2]) > 0.9  # east
+    assert heads[True] is False  # no target: to the nearest signs, west
+    assert heads[False] is east

@@ -12,7 +12,12 @@ from pmnav_bt.map.building import load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.correction import TOLERANCE_MIN_M, PoseTracker, Verified
 from pmnav_bt.pose.snap import OffMapError, snap_to_corridor
-from pmnav_bt.pose.walls import axis_in_odom, fit_wall_angle, heading_correction
+from pmnav_bt.pose.walls import (
+    axis_in_odom,
+    corridor_centre,
+    fit_wall_angle,
+    heading_correction,
+)
 from pmnav_bt.seams import Pose2D
 
 
@@ -60,6 +65,26 @@ def test_wall_line_fit_gives_the_angle_to_the_corridor_axis():
     assert math.remainder(axis - a, math.pi) == pytest.approx(0.0, abs=1e-6)
     # The correction that lines the measured axis up with a corridor heading of pi.
     assert heading_correction(axis, 0.0, math.pi) == pytest.approx(-a, abs=1e-6)
+
+
+@pytest.mark.parametrize("lateral", [-0.7, 0.0, 0.5])
+def test_both_walls_give_the_way_back_to_the_corridors_centre_line(lateral):
+    """A robot ``lateral`` m left of the centre line of a 2.4 m corridor, 8 deg off its
+    axis: the two walls in view say the centre line is ``-lateral`` m to its left; one
+    wall alone (a side corridor's mouth opposite) says nothing."""
+    rng = np.random.default_rng(1)
+    a = math.radians(8.0)
+    u, n = np.array([math.cos(a), -math.sin(a)]), np.array([math.sin(a), math.cos(a)])
+
+    def wall(y):  # a wall y m left of the centre line, in the robot's frame
+        s = rng.uniform(0.8, 5.5, 250)
+        return s[:, None] * u + (y - lateral) * n + rng.normal(0, 0.01, (250, 2))
+
+    clutter = rng.uniform(-1, 5, (40, 2))
+    angle, offset = corridor_centre(np.vstack([wall(1.2), wall(-1.2), clutter]))
+    assert angle == pytest.approx(-a, abs=math.radians(1.0))
+    assert offset == pytest.approx(-lateral, abs=0.05)
+    assert corridor_centre(np.vstack([wall(1.2), clutter])) is None
 
 
 @pytest.fixture(scope="module")

@@ -75,3 +75,23 @@ def test_towards_signs_leads_from_every_bare_point(sparse):
             assert dist[p.index] == 0.0
         elif p.index in dist:
             assert dist[nxt[p.index]] < dist[p.index] + 1e-9
+
+
+def test_the_trip_to_a_target_by_way_of_signs_is_never_shorter_than_the_route():
+    """``exits_to``: each way's trip (find signs, then go on to the target) is at least
+    the corridor route from the point, and for a point between a bare stretch and signs
+    the way with the target behind the bare stretch can be the shorter trip."""
+    pm = parse_building(generate_sign_sparse(2))
+    vis = Visibility.of(pm, 3.5)
+    target = entity_xy(pm, Entity.room("room14"))  # top of the east wing
+    direct, trips = vis.distance_to(target), vis.exits_to(target)
+    for p in vis.lattice_points[::7]:
+        for t in trips[p.index].values():
+            assert t >= direct[p.index] - 1e-6
+    # Mid-way along the bare corridor from the west wing (signs 11 m west) to the
+    # middle: the nearest signs are west, but the trip to room14 is shorter east.
+    mid = vis.nearest_lattice((19.5, 30.0))
+    east, west = trips[mid][0.0], trips[mid][3.14]
+    near = dict(vis.exits[mid])
+    assert near[3.14] < near[0.0]
+    assert east < west - 10.0
