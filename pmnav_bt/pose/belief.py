@@ -66,6 +66,7 @@ CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
 DIFFUSE_MASS = 0.3  # below this (best cluster), the belief is diffuse: look close by first
 NEAR_JUNCTION_M = 6.0  # ... at a junction or corridor end this close (its shape tells much)
 FIRST_JUNCTION_QUANTILE = 0.2  # diffuse, first drive: stop where this share puts a junction
+LEAD_QUANTILE = 0.25  # drive to where this share of the belief has signs in reach
 SWITCH_COST_RATIO = 2.0  # turn back when the other way is expected this much shorter
 TELLING_MIN_WEIGHT = 0.05  # hypotheses this likely (of the best) must be told apart ...
 TELLING_MAX_MODES = 4  # ... when they form at most this many clusters ...
@@ -465,6 +466,7 @@ class CorridorBelief:
         trip = np.zeros(4)  # ... and to the target by way of signs (the whole trip)
         onward = None if self.target is None else self.goal.exits_to(self.target)
         run = [[] for _ in range(4)]  # (weight, distance to the next junction) per way
+        reads = [[] for _ in range(4)]  # (weight, distance to signs) per way
         side_mass = 0.0  # belief that the robot is at a junction with a side corridor
         # Side corridors of a junction within reach count (it is easy to stop a little off
         # its centre); along the axis only the nearest point's ways (a dead end stays one).
@@ -492,6 +494,7 @@ class CorridorBelief:
                 cost[k] += w[i] * min(d, WALL_COST_M)
                 trip[k] += w[i] * min(t, 2.0 * WALL_COST_M)
                 run[k].append((w[i], r))
+                reads[k].append((w[i], min(d, WALL_COST_M)))
         total = float(w[live].sum())
         open_mass /= total
         side_mass /= total
@@ -524,7 +527,13 @@ class CorridorBelief:
         else:
             k = int(np.argmax(open_mass[::2]) * 2)
         self._last_way = k
-        go = float(np.clip(cost[k] + 1.0, 1.0, max_distance)) if np.isfinite(cost[k]) else 1.0
+        # As far as where a share of the belief has signs in reach: the mean distance of a
+        # split belief (signs 3 m on under some hypotheses, 30 m under others) is where
+        # none has any.
+        go = 1.0
+        if reads[k]:
+            near_signs = _weighted_quantile(*np.array(reads[k]).T, LEAD_QUANTILE)
+            go = float(np.clip(near_signs + 1.0, 1.0, max_distance))
         # Drive past the places already looked round from in that direction.
         h = axis + k * math.pi / 2
         u = np.array([math.cos(h), math.sin(h)])

@@ -592,3 +592,38 @@ def test_the_search_for_signs_heads_where_the_robot_is_going(room, east):
         heads[target is None] = math.cos(lead.heading - ODOM_T_MAP[2]) > 0.9  # east
     assert heads[True] is False  # no target: to the nearest signs, west
     assert heads[False] is east
+
+
+def test_a_split_belief_drives_to_where_a_share_of_it_has_signs_not_to_the_mean():
+    """sign_sparse_2 hard #5 crept 19.6, 3 and 8 m up a bare corridor: the lead drove to
+    the belief's mean distance to signs, which for a split belief (signs 3 m on under
+    some hypotheses, 20 m or more under others) is where none has any. It drives to
+    where a quarter of the belief has signs in reach, and looks round there."""
+    pm = parse_building(generate_sign_sparse(2))
+    vis = Visibility.of(pm, 3.5)
+    runs = vis.run_lengths
+
+    def ways(lo, hi, bare, run):  # signs lo-hi m on, no junction for ``run`` m
+        for p in vis.lattice_points:
+            for h, d in vis.exits[p.index]:
+                if lo <= d <= hi and runs[p.index][h] > run and not (bare and p.readable):
+                    yield p.index, h
+
+    near = next(ways(2.5, 3.5, False, 9.0))
+    far = []
+    for j, h in ways(15.0, 40.0, True, 9.0):
+        if all(np.linalg.norm(vis.lattice_xy[j] - vis.lattice_xy[k]) > 6.0 for k, _ in far):
+            far.append((j, h))
+    far = far[:4]  # five clusters: too many to tell apart, no telling place
+    assert len(far) == 4
+    b = CorridorBelief(pm, read_range=6.0, lead_range=3.5)
+    g = glimpse(pm, (0.0, 11.5, -math.pi / 2), ())
+    b.observe(g, axis_odom=g.odom.yaw)
+    logw = np.full(len(b.logw), -50.0)
+    for (j, h), w in [(near, 0.3)] + [(f, 0.175) for f in far]:
+        i = np.nonzero((b.lattice == j) & (np.abs(np.angle(np.exp(1j * (b.yaw - h)))) < 0.1))[0]
+        logw[i] = math.log(w)
+    b.logw = logw
+    lead = b.lead(g.odom, max_distance=16.0)
+    assert abs(math.remainder(lead.heading - g.odom.yaw, 2 * math.pi)) < 0.1  # straight on
+    assert lead.distance <= 3.5 + 1.0  # where the near hypothesis reads its signs
