@@ -444,10 +444,11 @@ class CorridorBelief:
         says that way goes on (so it explores one way to the end, then the other), else the
         open way with the least expected corridor distance to where the map says two
         signs are readable (with a ``target``: to the target by way of such signs, so the
-        search for signs heads where the robot is going). The drive stops at the next
-        junction, where half the belief puts it (on the first drive from a diffuse
-        belief, where a fifth does: from a bare corridor the median junction is far, and
-        a nearer one passed unlooked-at is the place that would have told the position)."""
+        search for signs heads where the robot is going), as far as where a quarter of the
+        belief has signs in reach. The drive stops at the next junction, where half the
+        belief puts it (on the first drive from a diffuse belief, where a fifth does: from
+        a bare corridor the median junction is far, and a nearer one passed unlooked-at is
+        the place that would have told the position)."""
         dist, _ = self.goal.towards_signs
         if not dist:
             return None
