@@ -181,25 +181,34 @@ class Visibility:
         """For each lattice point: (map heading, corridor distance to signs) of every way
         out of it (two mid-corridor, more at a junction, one at a dead end); infinite for
         a way whose nearest signs lie back through the point."""
-        g = self.lattice_graph
         dist, nxt = self.towards_signs
-        xy = self.lattice_xy
         out: list[list[tuple[float, float]]] = []
-        for j in range(len(xy)):
-            group = {j} | {k for k in g[j] if g[j][k]["length"] == 0.0}
+        for j in range(len(self.lattice_xy)):
+            group = self._group(j)
             ways = {}
-            for m in group:
-                for k in g[m]:
-                    length = g[m][k]["length"]
-                    if length == 0.0 or k in group:
-                        continue
-                    h = math.atan2(xy[k][1] - xy[m][1], xy[k][0] - xy[m][0])
-                    key = round(h, 2)
-                    # The nearest signs that way, unless the way there comes back (a dead end).
-                    d = length + dist.get(k, math.inf) if nxt.get(k) not in group else math.inf
-                    ways[key] = min(ways.get(key, math.inf), d)
+            for k, length, h in self._ways_out(group):
+                key = round(h, 2)
+                # The nearest signs that way, unless the way there comes back (a dead end).
+                d = length + dist.get(k, math.inf) if nxt.get(k) not in group else math.inf
+                ways[key] = min(ways.get(key, math.inf), d)
             out.append(sorted(ways.items()))
         return out
+
+    def _group(self, m: int) -> set[int]:
+        """Lattice point ``m`` and the points on the same spot (a node's segment ends)."""
+        g = self.lattice_graph
+        return {m} | {k for k in g[m] if g[m][k]["length"] == 0.0}
+
+    def _ways_out(self, group: set[int]):
+        """Each step out of a ``_group``: the next lattice point, the distance to it and
+        its map heading."""
+        g, xy = self.lattice_graph, self.lattice_xy
+        for a in group:
+            for k in g[a]:
+                length = g[a][k]["length"]
+                if length == 0.0 or k in group:
+                    continue
+                yield k, length, math.atan2(xy[k][1] - xy[a][1], xy[k][0] - xy[a][0])
 
     @cached_property
     def run_lengths(self) -> list[dict[float, float]]:
@@ -216,16 +225,9 @@ class Visibility:
     def _step(self, m: int, key: float) -> tuple[int, float] | None:
         """The next lattice point from ``m`` along the way out keyed ``key`` (map heading,
         as in ``exits``) and the distance to it; None at a corridor end."""
-        g, xy = self.lattice_graph, self.lattice_xy
-        group = {m} | {k for k in g[m] if g[m][k]["length"] == 0.0}
-        for a in group:
-            for k in g[a]:
-                length = g[a][k]["length"]
-                if length == 0.0 or k in group:
-                    continue
-                h = math.atan2(xy[k][1] - xy[a][1], xy[k][0] - xy[a][0])
-                if abs(math.remainder(h - key, 2 * math.pi)) < 0.05:
-                    return k, length
+        for k, length, h in self._ways_out(self._group(m)):
+            if abs(math.remainder(h - key, 2 * math.pi)) < 0.05:
+                return k, length
         return None
 
     def _run(self, j: int, key: float):
