@@ -28,6 +28,7 @@ import shapely
 
 from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.pose.lookahead import expected_trip
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
@@ -617,41 +618,50 @@ class CorridorBelief:
         hyp = np.array([m[int(np.argmax(w[m]))] for m in modes])  # one per cluster
         preds = []  # per cluster: the signs readable at each candidate (None: a wall)
         to_target = None if self.target is None else self.goal.distance_to(self.target)
-        onward = np.zeros(len(cand))  # expected way on from each candidate to the target
-        for i, ms in zip(hyp, mass, strict=True):
+        onward = np.zeros((len(hyp), len(cand)))  # way on from each candidate, per cluster
+        for k, i in enumerate(hyp):
             c, s_ = math.cos(tfs[i][2]), math.sin(tfs[i][2])
             there = np.stack(
                 [tfs[i][0] + c * q[:, 0] - s_ * q[:, 1], tfs[i][1] + s_ * q[:, 0] + c * q[:, 1]], 1
             )
             near, off = self.vis.nearest_many(there)
             if to_target is not None:
-                onward += ms * np.array([to_target.get(int(n), WALL_COST_M) for n in near])
+                onward[k] = [to_target.get(int(n), WALL_COST_M) for n in near]
             preds.append(
                 [
                     pts[n].readable if o <= half[pts[n].segment - 1] else None
                     for n, o in zip(near, off, strict=True)
                 ]
             )
-        onward /= mass.sum()
-        best_c, best_trip = None, math.inf
-        for c_i, m in enumerate(cand):
-            if not fresh[c_i] or reach[int(m)] < 1.0:
-                continue
-            seen = [pr[c_i] for pr in preds]
-            if any(r is None for r in seen):
-                continue  # a wall under some hypothesis: no safe place to look from
-            groups: dict[frozenset, float] = {}
-            for r, ms in zip(seen, mass, strict=True):
-                groups[r] = groups.get(r, 0.0) + float(ms)
-            if max(groups.values()) >= FIX_MASS * mass.sum():
-                continue
-            if to_target is None:  # the nearest
-                best_c = int(m)
-                break
-            # With a target: the least expected trip, there and on to the target.
-            t = reach[int(m)] + float(onward[c_i])
-            if t < best_trip:
-                best_c, best_trip = int(m), t
+        dist = np.array([reach[int(m)] for m in cand])
+        usable = fresh & (dist >= 1.0)
+        if to_target is None:  # the nearest place that tells the clusters apart
+            best_c = None
+            for c_i, m in enumerate(cand):
+                seen = [pr[c_i] for pr in preds]
+                if not usable[c_i] or any(r is None for r in seen):
+                    continue  # a wall under some hypothesis: no safe place to look from
+                groups: dict[frozenset, float] = {}
+                for r, ms in zip(seen, mass, strict=True):
+                    groups[r] = groups.get(r, 0.0) + float(ms)
+                if max(groups.values()) < FIX_MASS * mass.sum():
+                    best_c = int(m)
+                    break
+        else:  # with a target: the least expected whole trip, looking again if need be
+            ids: dict[frozenset, int] = {}
+            sees = np.array(
+                [[-1 if r is None else ids.setdefault(r, len(ids)) for r in pr] for pr in preds]
+            )
+            trip = expected_trip(
+                dist,
+                self.vis.distances_between(cand),
+                sees,
+                onward,
+                mass,
+                usable,
+                FIX_MASS,
+            )
+            best_c = int(cand[int(np.argmin(trip))]) if np.isfinite(trip).any() else None
         if best_c is None:
             return None
         return self._leg_towards(here, paths[best_c], tfs[best], float(mass.sum()), max_distance)

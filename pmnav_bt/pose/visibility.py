@@ -16,6 +16,8 @@ from functools import cached_property
 
 import networkx as nx
 import numpy as np
+import scipy.sparse
+import scipy.sparse.csgraph
 import shapely
 
 from pmnav_bt.map.priori_map import PrioriMap
@@ -175,6 +177,25 @@ class Visibility:
             if i < j:
                 g.add_edge(int(i), int(j), length=0.0)
         return g
+
+    @cached_property
+    def _lattice_csgraph(self):
+        """The lattice graph as a sparse matrix (scipy's shortest paths; zero-length edges,
+        two points on one spot, are kept as a micrometre)."""
+        n = len(self.lattice_points)
+        rows, cols, lengths = [], [], []
+        for i, j, d in self.lattice_graph.edges(data="length"):
+            rows += [i, j]
+            cols += [j, i]
+            lengths += [max(d, 1e-6)] * 2
+        return scipy.sparse.csr_matrix((lengths, (rows, cols)), shape=(n, n))
+
+    def distances_between(self, points) -> np.ndarray:
+        """Corridor distance (m) between every pair of the lattice points ``points``
+        (inf where not connected), shape (len(points), len(points))."""
+        idx = np.asarray(points, dtype=int)
+        d = scipy.sparse.csgraph.dijkstra(self._lattice_csgraph, directed=False, indices=idx)
+        return d[:, idx]
 
     @cached_property
     def exits(self) -> list[list[tuple[float, float]]]:
