@@ -50,6 +50,7 @@ MISREAD = math.log(P_MISS * P_SPURIOUS)  # readable here, but read far from its 
 P_THROUGH_WALL = 0.02  # the robot is where the hypothesis puts it inside a wall
 OFF_CORRIDOR_M = 1.0  # beyond a corridor's half-width by this much: inside a wall
 BLOCK_PROBE_M = 1.5  # a blocked drive: the hypothesis's corridor must end within this
+BLOCKED_NEAR_M = 1.0  # ... and from this close to where it was blocked, that way is shut
 WALL_COST_M = 100.0  # a way with no signs ever ahead counts as this far
 KEEP_WAY_MASS = 0.3  # keep exploring the same way while this much belief says it goes on
 CROSS_WAY_MASS = 0.7  # turn into a side corridor only when this much belief says it is there
@@ -453,8 +454,9 @@ class CorridorBelief:
         dist, _ = self.goal.towards_signs
         if not dist:
             return None
+        blocked = self._blocked_ways(odom)
         telling = self._telling_lead(odom, max_distance)
-        if telling is not None:
+        if telling is not None and self._last_way not in blocked:
             return telling
         w = self.weights()
         tfs = self._map_T_odom()
@@ -511,6 +513,7 @@ class CorridorBelief:
         for j, r in enumerate(run):
             if r:
                 ends[j] = _weighted_median(*np.array(r).T)
+        open_mass[list(blocked)] = 0.0  # not into the wall this spot's drive just met
         ok = np.nonzero(open_mass >= need)[0]
         k = self._last_way
         if k is not None and open_mass[k] >= need[k] and side_mass < CROSS_WAY_MASS:
@@ -560,6 +563,19 @@ class CorridorBelief:
                 go = to_junction
         heading = wrap_angle(h + self._drift)  # back to odometry
         return Lead(heading, go, float(open_mass[k]))
+
+    def _blocked_ways(self, odom: Pose2D) -> set[int]:
+        """The ways (0-3 from the axis) that a drive from within ``BLOCKED_NEAR_M`` of
+        ``odom`` met a wall on: whatever the hypotheses say, that way is shut from here (a
+        belief that puts the robot at the wrong junction would drive into it again)."""
+        p = self._straighten((odom.x, odom.y))
+        axis = self._axis()
+        return {
+            int(round(wrap_angle(g.blocked - axis) / (math.pi / 2))) % 4
+            for g in self.glimpses
+            if g.blocked is not None
+            and math.hypot(g.odom.x - p[0], g.odom.y - p[1]) < BLOCKED_NEAR_M
+        }
 
     def _modes(self, idx: np.ndarray) -> list[list[int]]:
         """Hypotheses ``idx`` (best first) grouped greedily into clusters."""

@@ -239,17 +239,21 @@ def _drive_straight(pm, xy, map_heading: float, distance: float):
     return p
 
 
+@pytest.mark.parametrize("goal", [None, "room3", "room12"])
 @pytest.mark.parametrize("start_y", [37.9, 21.95])
-def test_a_mirror_symmetric_corridor_is_told_apart_by_looking_into_a_side_corridor(start_y):
+def test_a_mirror_symmetric_corridor_is_told_apart_by_looking_into_a_side_corridor(
+    start_y, goal
+):
     # sign_sparse_2: the central corridor (branch2 at (30, 30) between two bare 30 m dead
     # ends) looks the same from either end; only the wings differ (room7-9 readable 12 m
     # or more west of branch2, nothing as far east). Driving end to end keeps the two
     # mirror hypotheses 50/50; the lead must go where they predict different signs.
-    # The starts are two of the hard tier's (37.9 shuttled end to end before).
+    # The starts are two of the hard tier's (37.9 shuttled end to end before). With a
+    # goal the telling places are scored by the expected whole trip (pose/lookahead.py).
     pm = parse_building(generate_sign_sparse(2))
     vis = Visibility.of(pm)
     xy, yaw = np.array([30.0, start_y]), math.pi / 2
-    b = CorridorBelief(pm)
+    b = CorridorBelief(pm, target=None if goal is None else entity_xy(pm, Entity.room(goal)))
     blocked = None
     for _ in range(14):
         g = glimpse(pm, (*xy, yaw), vis.readable_from(xy), blocked, depth=True)
@@ -627,3 +631,27 @@ def test_a_split_belief_drives_to_where_a_share_of_it_has_signs_not_to_the_mean(
     lead = b.lead(g.odom, max_distance=16.0)
     assert abs(math.remainder(lead.heading - g.odom.yaw, 2 * math.pi)) < 0.1  # straight on
     assert lead.distance <= 3.5 + 1.0  # where the near hypothesis reads its signs
+
+
+def test_a_way_blocked_here_is_not_driven_into_again():
+    """sign_sparse_2 hard #4: a relocalization belief sure of the wrong junction led
+    into the same wall 20 times ("a wall ahead after 0.0 m"), as every hypothesis it held
+    had that way open. A way a drive from here was blocked on is shut from here, whatever
+    the hypotheses say: here a crowd blocks the way east out of branch2, towards the goal."""
+    pm = parse_building(generate_sign_sparse(2))
+    truth = (30.0, 30.0, 0.0)
+    east = wrap_angle(truth[2] + ODOM_T_MAP[2])
+    heads = []
+    for blocked in (None, east):
+        b = CorridorBelief(
+            pm, read_range=6.0, lead_range=3.5, target=entity_xy(pm, Entity.room("room14"))
+        )
+        g = glimpse(pm, truth, (), blocked=blocked, depth=True)
+        b.observe(g, axis_odom=east)
+        tfs = b._map_T_odom()  # a belief sure of the place
+        here = np.linalg.norm(tfs[:, :2] - np.array(se2_inverse(ODOM_T_MAP)[:2]), axis=1)
+        turn = np.abs(np.angle(np.exp(1j * (tfs[:, 2] - se2_inverse(ODOM_T_MAP)[2]))))
+        b.logw = np.where((here < 0.3) & (turn < 0.1), 0.0, -50.0)
+        heads.append(math.cos(b.lead(g.odom, max_distance=16.0).heading - east))
+    assert heads[0] > 0.9  # open: east, towards the goal
+    assert heads[1] < 0.5  # blocked there: another way
