@@ -189,6 +189,10 @@ def check_yaml_shape(text: str, path: str | Path) -> None:
                     )
     except yaml.YAMLError as err:
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        if "nesting depth" in problem:  # PyYAML 6.0.3+ stops deeper nesting in its scanner
+            raise InputFileError(
+                path, f"nested deeper than {MAX_DEPTH} levels", _yaml_where(err)
+            ) from None
         raise InputFileError(path, f"not valid YAML: {problem}", _yaml_where(err)) from None
 
 
