@@ -27,30 +27,33 @@ from __future__ import annotations
 import numpy as np
 
 
-def commit(mass: np.ndarray, onward: np.ndarray, sees: np.ndarray, ks: list[int]) -> np.ndarray:
-    """Expected trip on from every place for the clusters ``ks`` told apart only as far as
-    what they read there (``sees``): each group of clusters that read alike commits to the
-    way on of the member that makes the wrong guess cheapest; a wrong guess costs that way
-    there and back. Shape (N,)."""
-    total = np.zeros(onward.shape[1])
-    for k in ks:
-        total += mass[k] * onward[k]
-    share = {k: np.zeros(onward.shape[1]) for k in ks}  # mass of k's group at each place
-    for k in ks:
-        for j in ks:
-            share[k] += np.where(sees[j] == sees[k], mass[j], 0.0)
-    wrong = {k: (share[k] - mass[k]) * onward[k] for k in ks}  # others' mass, k's way
-    for k in ks:
-        # k is the guess of its group where no groupmate's wrong guess is cheaper.
-        chosen = np.ones(onward.shape[1], dtype=bool)
-        for j in ks:
-            if j == k:
-                continue
-            same = sees[j] == sees[k]
-            cheaper = (wrong[j] < wrong[k]) | ((wrong[j] == wrong[k]) & (j < k))
-            chosen &= ~(same & cheaper)
-        total += np.where(chosen, 2.0 * wrong[k], 0.0)
-    return total
+def _group_mass(sees: np.ndarray, mass: np.ndarray) -> np.ndarray:
+    """(K, N): at each place, the mass of the clusters that read what cluster k reads."""
+    same = sees[:, None, :] == sees[None, :, :]  # (j, k, N)
+    return (same * mass[:, None, None]).sum(axis=0)
+
+
+def telling(sees: np.ndarray, mass: np.ndarray, usable: np.ndarray, fix_share: float):
+    """(N,) bool: places a first look may be taken from: usable (not looked from yet),
+    floor under every cluster, and leaving no group of clusters that read alike with
+    ``fix_share`` of the mass (the look tells something)."""
+    floor = (sees >= 0).all(axis=0)
+    return usable & floor & (_group_mass(sees, mass).max(axis=0) < fix_share * mass.sum())
+
+
+def commit(mass: np.ndarray, onward: np.ndarray, sees: np.ndarray) -> np.ndarray:
+    """Expected trip on from every place for clusters told apart only as far as what they
+    read there (``sees``, (K, N)): each group of clusters that read alike commits to the
+    way on of the member whose wrong guess is cheapest (ties: the first); a wrong guess
+    costs that way there and back. Shape (N,)."""
+    wrong = (_group_mass(sees, mass) - mass[:, None]) * onward  # others' mass, k's way
+    same = sees[:, None, :] == sees[None, :, :]  # (j, k, N)
+    order = np.arange(len(mass))
+    cheaper = (wrong[:, None, :] < wrong[None, :, :]) | (
+        (wrong[:, None, :] == wrong[None, :, :]) & (order[:, None] < order[None, :])[:, :, None]
+    )
+    guessed = ~(same & cheaper).any(axis=0)  # no groupmate's wrong guess is cheaper
+    return (mass[:, None] * onward).sum(axis=0) + 2.0 * np.where(guessed, wrong, 0.0).sum(axis=0)
 
 
 def expected_trip(
@@ -71,39 +74,34 @@ def expected_trip(
     cluster k; ``mass`` (K,); ``usable`` (N,): not looked from yet. A first look must be
     floor under every cluster and leave no group holding ``fix_share`` of the mass (it
     tells something); others are inf."""
-    k_all = list(range(len(mass)))
     total = float(mass.sum())
-    floor = (sees >= 0).all(axis=0)
     second: dict[tuple[int, ...], np.ndarray] = {}  # per group: cost of its best next look
+    stay: dict[tuple[int, ...], np.ndarray] = {}  # per group: committing with no more look
 
     def look_again(ks: tuple[int, ...]) -> np.ndarray:
         """For the group ``ks``: a second look's cost from each place, before the drive."""
         if ks not in second:
             sub = sees[list(ks)]
             splits = (sub != sub[0]).any(axis=0) & (sub >= 0).all(axis=0) & usable
-            second[ks] = np.where(splits, commit(mass, onward, sees, list(ks)), np.inf)
+            cost = commit(mass[list(ks)], onward[list(ks)], sub)
+            second[ks] = np.where(splits, cost, np.inf)
         return second[ks]
 
-    stay = {}  # per group: committing from each place without a second look
     cost = np.full(len(reach), np.inf)
-    for c in np.nonzero(usable & floor)[0]:
+    for c in np.nonzero(telling(sees, mass, usable, fix_share))[0]:
         groups: dict[int, list[int]] = {}
-        for k in k_all:
+        for k in range(len(mass)):
             groups.setdefault(int(sees[k, c]), []).append(k)
-        if max(float(mass[g].sum()) for g in groups.values()) >= fix_share * total:
-            continue  # tells (next to) nothing
         trip = total * float(reach[c])
         for ks in groups.values():
             key = tuple(ks)
             if len(ks) == 1:
                 trip += float(mass[ks[0]] * onward[ks[0], c])
                 continue
-            if key not in stay:
-                same = np.zeros_like(sees[list(ks)])  # one group: nothing told apart
-                idx = list(ks)
-                stay[key] = commit(mass[idx], onward[idx], same, list(range(len(ks))))
-            again = look_again(key)
+            if key not in stay:  # one group: nothing told apart
+                stay[key] = commit(mass[ks], onward[ks], np.zeros_like(sees[ks]))
             m = float(mass[ks].sum())
-            trip += min(float(stay[key][c]), float(np.min(m * between[c] + again)))
+            again = float(np.min(m * between[c] + look_again(key)))
+            trip += min(float(stay[key][c]), again)
         cost[c] = trip
     return cost

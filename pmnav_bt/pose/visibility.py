@@ -16,7 +16,6 @@ from functools import cached_property
 
 import networkx as nx
 import numpy as np
-import scipy.sparse
 import scipy.sparse.csgraph
 import shapely
 
@@ -180,15 +179,12 @@ class Visibility:
 
     @cached_property
     def _lattice_csgraph(self):
-        """The lattice graph as a sparse matrix (scipy's shortest paths; zero-length edges,
-        two points on one spot, are kept as a micrometre)."""
+        """The lattice graph as a sparse matrix for scipy's shortest paths (its explicit
+        zeros, two points on one spot, are edges there)."""
         n = len(self.lattice_points)
-        rows, cols, lengths = [], [], []
-        for i, j, d in self.lattice_graph.edges(data="length"):
-            rows += [i, j]
-            cols += [j, i]
-            lengths += [max(d, 1e-6)] * 2
-        return scipy.sparse.csr_matrix((lengths, (rows, cols)), shape=(n, n))
+        return nx.to_scipy_sparse_array(
+            self.lattice_graph, nodelist=range(n), weight="length", format="csr"
+        )
 
     def distances_between(self, points) -> np.ndarray:
         """Corridor distance (m) between every pair of the lattice points ``points``
