@@ -28,7 +28,7 @@ import shapely
 
 from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.pose.lookahead import expected_trip
+from pmnav_bt.pose.lookahead import expected_trip, telling
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
@@ -651,32 +651,16 @@ class CorridorBelief:
             )
         dist = np.array([reach[int(m)] for m in cand])
         usable = fresh & (dist >= 1.0)
+        ids: dict[frozenset, int] = {}  # what each cluster reads there, as an id (-1: a wall)
+        sees = np.array(
+            [[-1 if r is None else ids.setdefault(r, len(ids)) for r in pr] for pr in preds]
+        )
         if to_target is None:  # the nearest place that tells the clusters apart
-            best_c = None
-            for c_i, m in enumerate(cand):
-                seen = [pr[c_i] for pr in preds]
-                if not usable[c_i] or any(r is None for r in seen):
-                    continue  # a wall under some hypothesis: no safe place to look from
-                groups: dict[frozenset, float] = {}
-                for r, ms in zip(seen, mass, strict=True):
-                    groups[r] = groups.get(r, 0.0) + float(ms)
-                if max(groups.values()) < FIX_MASS * mass.sum():
-                    best_c = int(m)
-                    break
+            ok = np.nonzero(telling(sees, mass, usable, FIX_MASS))[0]
+            best_c = int(cand[ok[0]]) if len(ok) else None
         else:  # with a target: the least expected whole trip, looking again if need be
-            ids: dict[frozenset, int] = {}
-            sees = np.array(
-                [[-1 if r is None else ids.setdefault(r, len(ids)) for r in pr] for pr in preds]
-            )
-            trip = expected_trip(
-                dist,
-                self.vis.distances_between(cand),
-                sees,
-                onward,
-                mass,
-                usable,
-                FIX_MASS,
-            )
+            between = self.vis.distances_between(cand)
+            trip = expected_trip(dist, between, sees, onward, mass, usable, FIX_MASS)
             best_c = int(cand[int(np.argmin(trip))]) if np.isfinite(trip).any() else None
         if best_c is None:
             return None
