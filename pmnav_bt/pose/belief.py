@@ -455,9 +455,12 @@ class CorridorBelief:
         if not dist:
             return None
         blocked = self._blocked_ways(odom)
+        kept = self._last_way
         telling = self._telling_lead(odom, max_distance)
-        if telling is not None and self._last_way not in blocked:
-            return telling
+        if telling is not None:
+            if self._last_way not in blocked:
+                return telling
+            self._last_way = kept  # its way is shut from here: choose as if it had none
         w = self.weights()
         tfs = self._map_T_odom()
         live = np.nonzero(w > 1e-4 * w.max())[0]
