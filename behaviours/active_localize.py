@@ -270,6 +270,7 @@ class FollowLead(PmNavBehaviour):
     belief's lead), or, without a belief, towards the most open view. The heading is kept
     parallel to the walls seen in depth (odometry's rotation error does not steer it into a
     wall). A blocked drive is remembered by the belief (the corridor ends or turns there).
+    The lead, a search over the map's corridors, is worked out in the worker.
 
     Reads ``belief``, ``views``; writes nothing (the belief notes a blocked drive).
     SUCCESS when the distance is covered (shortened when a sign comes into view ahead:
@@ -278,7 +279,7 @@ class FollowLead(PmNavBehaviour):
     """
 
     READS = ("belief", "views")
-    JOBS = ("_job",)
+    JOBS = ("_job", "_lead_job")
     STOPS_BASE = True
 
     def __init__(self, name: str, ctx: Context, max_distance: float):
@@ -288,20 +289,13 @@ class FollowLead(PmNavBehaviour):
     def initialise(self) -> None:
         pose = self.ctx.base.pose()
         belief: CorridorBelief | None = self.get("belief")
-        lead = belief.lead(pose, self.max_distance) if belief is not None else None
-        if lead is not None:
-            self._heading, self._distance = lead.heading, lead.distance
-            self.feedback_message = (
-                f"{lead.distance:.1f} m along the corridor ({lead.support:.0%} of the belief)"
-            )
+        self._lead_job = None
+        if belief is not None:  # which way: a search over the map, in the worker
+            self._lead_job = self.ctx.worker.submit(lambda c: belief.lead(pose, self.max_distance))
+            self._heading, self._distance = pose.yaw, 0.0
+            self.feedback_message = "choosing the way"
         else:
-            self._heading, best = pose.yaw, -1.0
-            for v in self.get("views") or []:
-                free = free_distance(v.observation, 0.0)
-                if free > best:
-                    best, self._heading = free, v.observation.pose.yaw
-            self._distance = min(2.0, self.max_distance)
-            self.feedback_message = "towards the most open view"
+            self._aim(None, pose)
         self._start = (pose.x, pose.y)
         self._job = None
         self._driving = False
@@ -310,6 +304,22 @@ class FollowLead(PmNavBehaviour):
         self._signs_ahead: list[float] = []  # how far ahead (m) each sign read ahead is
         self._free_ahead = math.inf
         self._backing = None
+
+    def _aim(self, lead, pose: Pose2D) -> None:
+        """Drive along the belief's ``lead``, or, without one, 2 m towards the most open view."""
+        if lead is not None:
+            self._heading, self._distance = lead.heading, lead.distance
+            self.feedback_message = (
+                f"{lead.distance:.1f} m along the corridor ({lead.support:.0%} of the belief)"
+            )
+            return
+        self._heading, best = pose.yaw, -1.0
+        for v in self.get("views") or []:
+            free = free_distance(v.observation, 0.0)
+            if free > best:
+                best, self._heading = free, v.observation.pose.yaw
+        self._distance = min(2.0, self.max_distance)
+        self.feedback_message = "towards the most open view"
 
     def _check_walls(self) -> None:
         """Measure the wall direction in view (worker); re-aim along it when it comes."""
@@ -353,6 +363,12 @@ class FollowLead(PmNavBehaviour):
     def update(self) -> Status:
         base, now = self.ctx.base, self.ctx.now()
         pose = base.pose()
+        if self._lead_job is not None:
+            status, lead = self.poll(self._lead_job, "choosing the way")
+            if status is not None:
+                return status
+            self._lead_job = None
+            self._aim(lead, pose)
         if self._backing is not None:  # off the wall it ran into, then done
             x, y, t, sent = self._backing
             refused = sent and base.motion_status() == MotionStatus.BLOCKED  # backup limit
