@@ -40,6 +40,9 @@ CENTRE_LOOKAHEAD_M = 3.0  # steer back onto the corridor's centre line over this
 MAX_CENTRE_TURN = math.radians(15.0)  # ... turning at most this far off the axis for it
 WALL_CHECK_S = 1.0  # clock seconds between wall checks while driving along the corridor
 STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
+RAY_SPACING_M = 1.0  # while driving, add the free floor ahead to the belief this often
+RETHINK_SHARE = 0.2  # ... and work the lead out again once it has ruled out this much of it,
+RETHINK_EVERY_M = 3.0  # ... or every so far (passing a junction where the way turns)
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
 # Bearings in each view along which the free floor is measured: three rays a view, so
 # a six-view panorama looks every 20 deg (a side corridor's opening is seen from a
@@ -279,7 +282,7 @@ class FollowLead(PmNavBehaviour):
     """
 
     READS = ("belief", "views")
-    JOBS = ("_job", "_lead_job")
+    JOBS = ("_job", "_lead_job", "_rethink_job")
     STOPS_BASE = True
 
     def __init__(self, name: str, ctx: Context, max_distance: float):
@@ -304,6 +307,10 @@ class FollowLead(PmNavBehaviour):
         self._signs_ahead: list[float] = []  # how far ahead (m) each sign read ahead is
         self._free_ahead = math.inf
         self._backing = None
+        self._last_ray = self._start
+        self._ruled_out = 0.0  # share of the belief the drive's depth has ruled out
+        self._rethink_job = None
+        self._thought_at = self._start
 
     def _aim(self, lead, pose: Pose2D) -> None:
         """Drive along the belief's ``lead``, or, without one, 2 m towards the most open view."""
@@ -333,10 +340,10 @@ class FollowLead(PmNavBehaviour):
             centre = None if points is None else corridor_centre(points)
             ahead = [_ahead(obs, d) for d in grounder.read_signs(obs)]
             return (
-                obs.pose.yaw,
+                obs.pose,
                 None if fit is None else fit[0],
                 ahead,
-                free_distance(obs, 0.0),
+                free_distance(obs, 0.0) if obs.depth is not None else None,
                 centre,
             )
 
@@ -347,9 +354,11 @@ class FollowLead(PmNavBehaviour):
             return
         job, self._job = self._job, None
         try:
-            yaw, angle, ahead, free, centre = job.result()
+            seen_from, angle, ahead, free, centre = job.result()
         except Exception:  # noqa: BLE001 - a lost wall check: drive on, check again
             return
+        yaw = seen_from.yaw
+        self._note_ray(seen_from, free)
         if centre is not None and abs(centre[0]) < ALONG_WALL_MAX:
             # Along both walls, turning a little towards the centre line: there a plate
             # on either wall is seen at the angle the map's reading ranges assume.
@@ -358,7 +367,40 @@ class FollowLead(PmNavBehaviour):
         elif angle is not None and abs(angle) < ALONG_WALL_MAX:
             self._heading = yaw + angle  # parallel to the wall in view
         self._signs_ahead = ahead
-        self._free_ahead = free
+        self._free_ahead = math.inf if free is None else free
+
+    def _note_ray(self, seen_from: Pose2D, free: float | None) -> None:
+        """Add the free floor ahead to the belief every ``RAY_SPACING_M`` of the drive; note
+        when it rules out much of the belief the lead was chosen for."""
+        belief: CorridorBelief | None = self.get("belief")
+        if belief is None or free is None or not self._driving or self._rethink_job is not None:
+            return  # (not while the lead is worked out again on the belief, in the worker)
+        x, y = self._last_ray
+        if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:
+            return
+        self._last_ray = (seen_from.x, seen_from.y)
+        self._ruled_out += belief.observe_ray(seen_from, min(free, 50.0))
+
+    def _rethink(self, pose: Pose2D) -> bool:
+        """Whether the lead, worked out again (worker) once the depth ahead has ruled out
+        ``RETHINK_SHARE`` of the belief, now goes another way."""
+        belief: CorridorBelief | None = self.get("belief")
+        if self._rethink_job is not None:
+            if not self._rethink_job.done():
+                return False
+            job, self._rethink_job = self._rethink_job, None
+            try:
+                return job.result() is not None
+            except Exception:  # noqa: BLE001 - a lost rethink: keep to the lead
+                return False
+        moved = math.hypot(pose.x - self._thought_at[0], pose.y - self._thought_at[1])
+        if belief is not None and (self._ruled_out >= RETHINK_SHARE or moved >= RETHINK_EVERY_M):
+            self._ruled_out, self._thought_at = 0.0, (pose.x, pose.y)
+            heading, most = self._heading, self.max_distance
+            self._rethink_job = self.ctx.worker.submit(
+                lambda c: belief.turned_lead(pose, heading, most)
+            )
+        return False
 
     def update(self) -> Status:
         base, now = self.ctx.base, self.ctx.now()
@@ -394,6 +436,14 @@ class FollowLead(PmNavBehaviour):
         done_m = math.hypot(pose.x - self._start[0], pose.y - self._start[1])
         if done_m >= self._distance:
             base.set_velocity(0.0, 0.0)
+            return Status.SUCCESS
+        if self._rethink(pose):
+            # The belief now says another way: look again from here.
+            base.set_velocity(0.0, 0.0)
+            self.feedback_message = (
+                f"depth ahead ruled out much of the belief after {done_m:.1f} m: it now says "
+                "another way, look again"
+            )
             return Status.SUCCESS
         ahead = [a for a in self._signs_ahead if a > SIGN_STOP_M]  # nearer: read already
         if ahead:

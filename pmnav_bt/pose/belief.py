@@ -63,6 +63,7 @@ MAX_RAY_M = 8.0  # free floor seen in depth is checked along the view up to this
 RAY_SLACK_M = 0.4  # ... short of where it ends, this far outside the corridors (and a
 # probe beyond a near wall must be this far inside one to count against a hypothesis)
 P_DEPTH = 0.1  # a hypothesis that disagrees with one such depth reading
+RULED_OUT_LOG = math.log(0.2)  # a reading that cuts a hypothesis's weight this much rules it out
 JUNCTION_REACH_M = 1.0  # side corridors of a junction this close are the robot's
 CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
 DIFFUSE_MASS = 0.3  # below this (best cluster), the belief is diffuse: look close by first
@@ -111,6 +112,9 @@ class CorridorBelief:
     # A prior from an earlier estimate: map_T_odom and its position uncertainty (m).
     prior: tuple[tuple[float, float, float], float] | None = None
     pending_blocked: float | None = None  # a drive was blocked heading this way (odometry)
+    # The free floor seen straight ahead while driving between glimpses (straightened
+    # odometry): depth only, no look round, so no sign is missed in them.
+    rays: list[Glimpse] = field(default_factory=list)
     _last_way: int | None = None  # the way (0-3 from the axis) the last lead chose
     _drift: float = 0.0  # odometry heading drift since the reference, from the walls
     read_range: float | None = None  # m, signs are read to (None: visibility.READ_RANGE_M)
@@ -138,6 +142,9 @@ class CorridorBelief:
             )
         }
         self._floor = shapely.buffer(self.vis.corridors, RAY_SLACK_M)  # a little tolerance
+        self._half_width = np.array(  # per lattice point: its corridor's half-width
+            [self.pm.segments[p.segment - 1].width / 2.0 for p in self.vis.lattice_points]
+        )
         shapely.prepare(self._floor)
         self._build()
 
@@ -166,6 +173,9 @@ class CorridorBelief:
             self._weigh_prior(*self.prior)
         for g in self.glimpses:
             self._weigh(g)
+        tfs = self._map_T_odom()
+        for r in self.rays:
+            self._weigh_depth(r, tfs)
 
     def _miss_log(self, entity: Entity, xy: np.ndarray) -> float:
         """The log-probability that ``entity``'s sign, in sight, is not read from ``xy``
@@ -235,6 +245,23 @@ class CorridorBelief:
         self.glimpses.append(g)
         self._weigh(g)
 
+    def observe_ray(self, odom: Pose2D, free: float) -> float:
+        """Add the free floor (m) seen in depth straight ahead from ``odom`` while driving,
+        and return the share of the belief it ruled out: a corridor end coming into depth
+        range tells a dead end from a junction (or one arm of a cross from another) metres
+        before the drive gets there. No sign is read or missed (the view is along the
+        corridor, not round it)."""
+        if self.ref is None:
+            return 0.0
+        p = self._straighten((odom.x, odom.y))
+        yaw = wrap_angle(odom.yaw - self._drift)
+        ray = Glimpse(Pose2D(float(p[0]), float(p[1]), yaw), {}, free=((yaw, free),))
+        before, old = self.weights(), self.logw.copy()
+        self._weigh_depth(ray, self._map_T_odom())
+        self.rays.append(ray)
+        change = self.logw - old
+        return float(before[change - change.max() < RULED_OUT_LOG].sum())
+
     def _straighten_tf(self) -> tuple[float, float, float]:
         """straightened_T_odom at the last glimpse."""
         if self.ref is None:
@@ -290,28 +317,24 @@ class CorridorBelief:
             1,
         )
 
-    def _weigh(self, g: Glimpse) -> None:
-        tfs = self._map_T_odom()
-        ref = self.ref
-        travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
-        sigma = math.hypot(SIGHT_SIGMA_M, DRIFT_PER_M * travelled)
+    def _weigh_depth(self, g: Glimpse, tfs: np.ndarray) -> np.ndarray:
+        """Reweigh by what a glimpse saw in depth (and where it was): the robot inside a
+        wall, a blocked drive, walls close ahead, free floor along each ray. Returns where
+        each hypothesis puts the robot (map)."""
         here = _apply_many(tfs, (g.odom.x, g.odom.y))
         near, off = self.vis.nearest_many(here)
-        half = np.array(
-            [self.pm.segments[p.segment - 1].width / 2.0 for p in self.vis.lattice_points]
-        )
+        half = self._half_width[near]
         # A hypothesis that puts the robot inside a wall is unlikely.
-        self.logw += np.where(off > half[near] + OFF_CORRIDOR_M, math.log(P_THROUGH_WALL), 0.0)
+        self.logw += np.where(off > half + OFF_CORRIDOR_M, math.log(P_THROUGH_WALL), 0.0)
         if g.blocked is not None:  # the corridor must end (or turn) just ahead
             d = BLOCK_PROBE_M
             probe = _apply_many(
                 tfs, (g.odom.x + d * math.cos(g.blocked), g.odom.y + d * math.sin(g.blocked))
             )
             pn, poff = self.vis.nearest_many(probe)
-            self.logw += np.where(poff <= half[pn], math.log(P_THROUGH_WALL), 0.0)
+            self.logw += np.where(poff <= self._half_width[pn], math.log(P_THROUGH_WALL), 0.0)
         # Depth: a wall close ahead of a view must be a wall on the map; the free floor seen
         # along each view (the whole ray, e.g. into a side corridor) must be floor on it.
-        here_xy = _apply_many(tfs, (g.odom.x, g.odom.y))
         for yaw, free in g.free:
             c, s_ = math.cos(yaw), math.sin(yaw)
             if free < NEAR_WALL_M:
@@ -320,13 +343,23 @@ class CorridorBelief:
                 pn, poff = self.vis.nearest_many(probe)
                 # Clearly inside a corridor: an oblique view puts the probe only a little
                 # beyond the wall, and the hypothesis is a lattice point on the centre line.
-                self.logw += np.where(poff <= half[pn] - RAY_SLACK_M, math.log(P_DEPTH), 0.0)
+                inside = poff <= self._half_width[pn] - RAY_SLACK_M
+                self.logw += np.where(inside, math.log(P_DEPTH), 0.0)
             reach = min(free, MAX_RAY_M) - RAY_SLACK_M
             if reach > 1.0:
                 end = _apply_many(tfs, (g.odom.x + reach * c, g.odom.y + reach * s_))
-                rays = shapely.linestrings(np.stack([here_xy, end], 1))
+                rays = shapely.linestrings(np.stack([here, end], 1))
                 floor = shapely.covers(self._floor, rays)
                 self.logw += np.where(floor, 0.0, math.log(P_DEPTH))
+        return here
+
+    def _weigh(self, g: Glimpse) -> None:
+        tfs = self._map_T_odom()
+        ref = self.ref
+        travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
+        sigma = math.hypot(SIGHT_SIGMA_M, DRIFT_PER_M * travelled)
+        here_xy = self._weigh_depth(g, tfs)
+        near, _ = self.vis.nearest_many(here_xy)
         # What the map says is readable at each hypothesis's position for this glimpse.
         readable = [self.vis.lattice_points[j].readable for j in near]
         seen = g.seen.keys()
@@ -566,6 +599,17 @@ class CorridorBelief:
                 go = to_junction
         heading = wrap_angle(h + self._drift)  # back to odometry
         return Lead(heading, go, float(open_mass[k]))
+
+    def turned_lead(self, odom: Pose2D, heading: float, max_distance: float = 8.0) -> Lead | None:
+        """The lead from ``odom`` when it is not along ``heading`` (odometry; more than 45
+        deg off: the belief now says another way), else None and the belief's memory of
+        the way it keeps is left as it was (a drive under way goes on its way)."""
+        kept = self._last_way
+        new = self.lead(odom, max_distance)
+        if new is not None and abs(wrap_angle(new.heading - heading)) > math.pi / 4:
+            return new
+        self._last_way = kept
+        return None
 
     def _blocked_ways(self, odom: Pose2D) -> set[int]:
         """The ways (0-3 from the axis) that a drive from within ``BLOCKED_NEAR_M`` of

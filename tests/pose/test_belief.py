@@ -241,9 +241,7 @@ def _drive_straight(pm, xy, map_heading: float, distance: float):
 
 @pytest.mark.parametrize("goal", [None, "room3", "room12"])
 @pytest.mark.parametrize("start_y", [37.9, 21.95])
-def test_a_mirror_symmetric_corridor_is_told_apart_by_looking_into_a_side_corridor(
-    start_y, goal
-):
+def test_a_mirror_symmetric_corridor_is_told_apart_by_looking_into_a_side_corridor(start_y, goal):
     # sign_sparse_2: the central corridor (branch2 at (30, 30) between two bare 30 m dead
     # ends) looks the same from either end; only the wings differ (room7-9 readable 12 m
     # or more west of branch2, nothing as far east). Driving end to end keeps the two
@@ -655,3 +653,65 @@ def test_a_way_blocked_here_is_not_driven_into_again():
         heads.append(math.cos(b.lead(g.odom, max_distance=16.0).heading - east))
     assert heads[0] > 0.9  # open: east, towards the goal
     assert heads[1] < 0.5  # blocked there: another way
+
+
+def _weight_near(b: CorridorBelief, odom, xy, yaw) -> float:
+    """The weight of the hypothesis that puts the robot nearest ``xy`` facing ``yaw`` (map)."""
+    tfs = b._map_T_odom()
+    here = np.stack([se2_apply(tuple(t), (odom.x, odom.y)) for t in tfs])
+    err = np.linalg.norm(here - np.asarray(xy), axis=1) + 3.0 * np.abs(
+        np.angle(np.exp(1j * (tfs[:, 2] + odom.yaw - yaw)))
+    )
+    return float(b.weights()[int(np.argmin(err))])
+
+
+def test_the_depth_ahead_while_driving_rules_out_places_where_the_corridor_would_end():
+    """sign_sparse_2: a look round in the bare north arm of the central cross leaves the
+    belief on every bare stretch. Driving on north, depth sees free floor far ahead: the
+    places from which the map has a wall within depth range ahead (the last metres before
+    any corridor end) are ruled out, the true place is not, and the reading is kept like a
+    glimpse's (a rebuilt belief weighs it again) without counting as a look round."""
+    pm = parse_building(generate_sign_sparse(2))
+    start = (30.0, 40.0, math.pi / 2)
+    b = CorridorBelief(pm)
+    g = glimpse(pm, start, (), depth=True)
+    b.observe(g, axis_odom=g.odom.yaw)
+    there = (30.0, 44.0, math.pi / 2)
+    odom = Pose2D(*se2_compose(ODOM_T_MAP, there))
+    near_end = (30.0, 57.0)  # the same drive from 13 m further up: the wall 4 m ahead
+    w_end = _weight_near(b, odom, near_end, math.pi / 2)
+    w_true = _weight_near(b, odom, there[:2], there[2])
+    assert w_end > 0.5 * w_true  # the look round could not tell them apart
+    share = b.observe_ray(odom, _free(pm, there, there[2]))
+    assert share > 0.05
+    ratio = _weight_near(b, odom, near_end, math.pi / 2) / _weight_near(
+        b, odom, there[:2], there[2]
+    )
+    assert ratio < 0.2 * w_end / w_true  # ruled out
+    assert _weight_near(b, odom, there[:2], there[2]) >= w_true  # the truth gains
+    assert (len(b.glimpses), len(b.rays)) == (1, 1)  # not a look round: no sign missed
+    before = b.weights()
+    b._build()
+    np.testing.assert_allclose(b.weights(), before, atol=1e-9)
+
+
+def test_a_lead_worked_out_again_on_the_way_only_turns_when_the_belief_says_another_way():
+    """``turned_lead``: the drive under way goes on (and the belief still remembers its
+    way) while the lead is along it; a lead the other way is returned."""
+    pm = parse_building(generate_sign_sparse(2))
+    truth = (30.0, 30.0, 0.0)  # branch2, facing east, where room14 is
+    east = wrap_angle(truth[2] + ODOM_T_MAP[2])
+    b = CorridorBelief(
+        pm, read_range=6.0, lead_range=3.5, target=entity_xy(pm, Entity.room("room14"))
+    )
+    g = glimpse(pm, truth, (), depth=True)
+    b.observe(g, axis_odom=east)
+    tfs = b._map_T_odom()
+    here = np.linalg.norm(tfs[:, :2] - np.array(se2_inverse(ODOM_T_MAP)[:2]), axis=1)
+    turn = np.abs(np.angle(np.exp(1j * (tfs[:, 2] - se2_inverse(ODOM_T_MAP)[2]))))
+    b.logw = np.where((here < 0.3) & (turn < 0.1), 0.0, -50.0)  # sure of the place
+    b._last_way = 2  # the way it drove last (west), remembered
+    assert b.turned_lead(g.odom, east, 16.0) is None  # going east: on it goes
+    assert b._last_way == 2
+    lead = b.turned_lead(g.odom, wrap_angle(east + math.pi), 16.0)  # going west: turn
+    assert lead is not None and math.cos(lead.heading - east) > 0.9
