@@ -40,14 +40,15 @@ CENTRE_LOOKAHEAD_M = 3.0  # steer back onto the corridor's centre line over this
 MAX_CENTRE_TURN = math.radians(15.0)  # ... turning at most this far off the axis for it
 WALL_CHECK_S = 1.0  # clock seconds between wall checks while driving along the corridor
 STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
-RAY_SPACING_M = 1.0  # while driving, add the free floor ahead to the belief this often
-RETHINK_SHARE = 0.2  # ... and work the lead out again once it has ruled out this much of it,
-RETHINK_EVERY_M = 3.0  # ... or every so far (passing a junction where the way turns)
+RAY_SPACING_M = 1.0  # while driving, add the free floor ahead to the belief this often ...
+RETHINK_EVERY_M = 3.0  # ... and work the lead out again every so far (a junction passed)
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
-# Bearings in each view along which the free floor is measured: three rays a view, so
-# a six-view panorama looks every 20 deg (a side corridor's opening is seen from a
-# junction's mouth, where one ray per view can miss it between two views).
-FREE_BEARINGS = tuple(math.radians(b) for b in (-20.0, 0.0, 20.0))
+# Bearings in each view along which the free floor is measured: twelve thin rays a view,
+# so a six-view panorama looks every 5 deg. From a bare corridor a side opening a few
+# metres off is seen only through a narrow window of bearings (4 m off: 11-19 deg from
+# the axis), and only a thin ray that passes it ends beyond the corridor's side walls.
+FREE_BEARINGS = tuple(math.radians(b) for b in np.arange(-27.5, 28.0, 5.0))
+RAY_HALF_WIDTH_M = 0.05  # a thin ray: the floor along a line, not the body's swept strip
 
 
 def wall_mask(grounder: Grounder, obs: Observation):
@@ -88,7 +89,10 @@ def read_panorama(ctx: Context, views: list):
                 named.add(d.entity)  # read, but cut by the border: in sight, place unknown
     angles = [(views[i].observation.pose.yaw, f[0], f[1]) for i, f in fits]
     free = tuple(
-        (wrap_angle(v.observation.pose.yaw + b), min(free_distance(v.observation, b), 50.0))
+        (
+            wrap_angle(v.observation.pose.yaw + b),
+            min(free_distance(v.observation, b, half_width=RAY_HALF_WIDTH_M), 50.0),
+        )
         for v in views
         for b in FREE_BEARINGS
     )
@@ -308,7 +312,6 @@ class FollowLead(PmNavBehaviour):
         self._free_ahead = math.inf
         self._backing = None
         self._last_ray = self._start
-        self._ruled_out = 0.0  # share of the belief the drive's depth has ruled out
         self._rethink_job = None
         self._thought_at = self._start
 
@@ -370,8 +373,7 @@ class FollowLead(PmNavBehaviour):
         self._free_ahead = math.inf if free is None else free
 
     def _note_ray(self, seen_from: Pose2D, free: float | None) -> None:
-        """Add the free floor ahead to the belief every ``RAY_SPACING_M`` of the drive; note
-        when it rules out much of the belief the lead was chosen for."""
+        """Add the free floor ahead to the belief every ``RAY_SPACING_M`` of the drive."""
         belief: CorridorBelief | None = self.get("belief")
         if belief is None or free is None or not self._driving or self._rethink_job is not None:
             return  # (not while the lead is worked out again on the belief, in the worker)
@@ -379,11 +381,11 @@ class FollowLead(PmNavBehaviour):
         if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:
             return
         self._last_ray = (seen_from.x, seen_from.y)
-        self._ruled_out += belief.observe_ray(seen_from, min(free, 50.0))
+        belief.observe_ray(seen_from, min(free, 50.0))
 
     def _rethink(self, pose: Pose2D) -> bool:
-        """Whether the lead, worked out again (worker) once the depth ahead has ruled out
-        ``RETHINK_SHARE`` of the belief, now goes another way."""
+        """Whether the lead, worked out again (worker) every ``RETHINK_EVERY_M`` of the drive
+        with what the depth ahead has told the belief since, now goes another way."""
         belief: CorridorBelief | None = self.get("belief")
         if self._rethink_job is not None:
             if not self._rethink_job.done():
@@ -394,8 +396,8 @@ class FollowLead(PmNavBehaviour):
             except Exception:  # noqa: BLE001 - a lost rethink: keep to the lead
                 return False
         moved = math.hypot(pose.x - self._thought_at[0], pose.y - self._thought_at[1])
-        if belief is not None and (self._ruled_out >= RETHINK_SHARE or moved >= RETHINK_EVERY_M):
-            self._ruled_out, self._thought_at = 0.0, (pose.x, pose.y)
+        if belief is not None and moved >= RETHINK_EVERY_M:
+            self._thought_at = (pose.x, pose.y)
             heading, most = self._heading, self.max_distance
             self._rethink_job = self.ctx.worker.submit(
                 lambda c: belief.turned_lead(pose, heading, most)
@@ -441,8 +443,7 @@ class FollowLead(PmNavBehaviour):
             # The belief now says another way: look again from here.
             base.set_velocity(0.0, 0.0)
             self.feedback_message = (
-                f"depth ahead ruled out much of the belief after {done_m:.1f} m: it now says "
-                "another way, look again"
+                f"after {done_m:.1f} m the belief says another way: look again"
             )
             return Status.SUCCESS
         ahead = [a for a in self._signs_ahead if a > SIGN_STOP_M]  # nearer: read already

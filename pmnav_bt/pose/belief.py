@@ -63,7 +63,9 @@ MAX_RAY_M = 8.0  # free floor seen in depth is checked along the view up to this
 RAY_SLACK_M = 0.4  # ... short of where it ends, this far outside the corridors (and a
 # probe beyond a near wall must be this far inside one to count against a hypothesis)
 P_DEPTH = 0.1  # a hypothesis that disagrees with one such depth reading
-RULED_OUT_LOG = math.log(0.2)  # a reading that cuts a hypothesis's weight this much rules it out
+# ... one reading ahead while driving: weak alone (after a long drive the odometry's drift
+# puts even the true hypothesis a metre off), telling when many agree
+P_DRIVE_RAY = 0.5
 JUNCTION_REACH_M = 1.0  # side corridors of a junction this close are the robot's
 CLUSTER_M = 4.0  # hypotheses this close (and facing alike) form one cluster
 DIFFUSE_MASS = 0.3  # below this (best cluster), the belief is diffuse: look close by first
@@ -175,7 +177,7 @@ class CorridorBelief:
             self._weigh(g)
         tfs = self._map_T_odom()
         for r in self.rays:
-            self._weigh_depth(r, tfs)
+            self._weigh_ray(r, tfs)
 
     def _miss_log(self, entity: Entity, xy: np.ndarray) -> float:
         """The log-probability that ``entity``'s sign, in sight, is not read from ``xy``
@@ -245,22 +247,19 @@ class CorridorBelief:
         self.glimpses.append(g)
         self._weigh(g)
 
-    def observe_ray(self, odom: Pose2D, free: float) -> float:
-        """Add the free floor (m) seen in depth straight ahead from ``odom`` while driving,
-        and return the share of the belief it ruled out: a corridor end coming into depth
-        range tells a dead end from a junction (or one arm of a cross from another) metres
-        before the drive gets there. No sign is read or missed (the view is along the
-        corridor, not round it)."""
+    def observe_ray(self, odom: Pose2D, free: float) -> None:
+        """Add the free floor (m) seen in depth straight ahead from ``odom`` while driving:
+        a hypothesis under which the map has a wall within that reach is a little less
+        likely (``P_DRIVE_RAY``), so readings along a drive tell apart places where the
+        corridor ahead ends sooner. No sign is read or missed (the view is along the
+        corridor, not round it), and it is no look round."""
         if self.ref is None:
-            return 0.0
+            return
         p = self._straighten((odom.x, odom.y))
         yaw = wrap_angle(odom.yaw - self._drift)
         ray = Glimpse(Pose2D(float(p[0]), float(p[1]), yaw), {}, free=((yaw, free),))
-        before, old = self.weights(), self.logw.copy()
-        self._weigh_depth(ray, self._map_T_odom())
+        self._weigh_ray(ray, self._map_T_odom())
         self.rays.append(ray)
-        change = self.logw - old
-        return float(before[change - change.max() < RULED_OUT_LOG].sum())
 
     def _straighten_tf(self) -> tuple[float, float, float]:
         """straightened_T_odom at the last glimpse."""
@@ -316,6 +315,18 @@ class CorridorBelief:
             ],
             1,
         )
+
+    def _weigh_ray(self, r: Glimpse, tfs: np.ndarray) -> None:
+        """Reweigh by the free floor seen ahead while driving (``observe_ray``)."""
+        here = _apply_many(tfs, (r.odom.x, r.odom.y))
+        for yaw, free in r.free:
+            reach = min(free, MAX_RAY_M) - RAY_SLACK_M
+            if reach > 1.0:
+                end = _apply_many(
+                    tfs, (r.odom.x + reach * math.cos(yaw), r.odom.y + reach * math.sin(yaw))
+                )
+                floor = shapely.covers(self._floor, shapely.linestrings(np.stack([here, end], 1)))
+                self.logw += np.where(floor, 0.0, math.log(P_DRIVE_RAY))
 
     def _weigh_depth(self, g: Glimpse, tfs: np.ndarray) -> np.ndarray:
         """Reweigh by what a glimpse saw in depth (and where it was): the robot inside a
