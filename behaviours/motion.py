@@ -197,18 +197,22 @@ class MoveToward(DriveTo):
 class DriveToWaypoint(DriveTo):
     """Drive to an unseen key waypoint (turn or fork) on the centre line.
 
-    For a turn, the corner check (wall/floor mask ratio ahead) refines where the
-    corner is: once a wall fills the way ahead, the turn point is half a corridor
-    width before it. Reads ``target``, ``map_T_odom``.
+    Where the map has a wall straight beyond the waypoint (a turn, or a fork reached
+    from the stem of a T), the corner check (wall/floor mask ratio ahead) refines where
+    it is: once a wall fills the way ahead, the waypoint is half a corridor width before
+    it (after a long leg on dead reckoning the estimate may be a metre or two behind;
+    by the map alone the drive would end against that wall). Reads ``target``,
+    ``map_T_odom``.
     """
 
     def goal(self) -> tuple[float, float]:
         t = self.get("target")
         self._corner_seen = False
+        self._wall_beyond = t.kind == "turn" or wall_beyond(self.ctx.pm, t.position, t.heading)
         return float(t.position[0]), float(t.position[1])
 
     def inspect(self, obs, est, target) -> dict:
-        if target.kind != "turn" or obs.depth is None:
+        if not self._wall_beyond or obs.depth is None:
             return {}
         if heading_error(est.yaw, target.heading) > math.radians(15):
             return {}  # not looking along the corridor (still turning): no corner to judge
@@ -232,6 +236,15 @@ class DriveToWaypoint(DriveTo):
             self._corner_seen = True
             r = found["ratios"]
             self.ctx.log("corner", t.landmark, thumbnail(obs.rgb), wall=r.wall, floor=r.floor)
+
+
+def wall_beyond(pm, position, heading: float) -> bool:
+    """Whether the map has a wall straight on past ``position`` along ``heading``: no
+    corridor there half a width and half a metre on (a turn, or a T from its stem)."""
+    loc = pm.locate(float(position[0]), float(position[1]))
+    d = loc.segment.width / 2.0 + 0.5
+    probe = pm.locate(position[0] + d * math.cos(heading), position[1] + d * math.sin(heading))
+    return probe.offset > probe.segment.width / 2.0
 
 
 def out_heading(plan, step) -> float:
