@@ -26,6 +26,10 @@ from pmnav_bt.seams import MotionStatus
 NO_PROGRESS_S = 10.0  # clock seconds without getting 0.1 m closer -> blocked
 WATCH_PERIOD_S = 1.0  # clock seconds between obstacle checks from depth
 MAX_BUMPS = 3  # collisions before a drive gives up as blocked
+# A waypoint with a wall just past it is reached when depth shows that wall within half a
+# corridor width and this margin, the estimate at most this far from the waypoint.
+WALL_ARRIVAL_MARGIN_M = 0.4
+WALL_ARRIVAL_NEAR_M = 3.0
 # Depth is checked this far ahead: a 1 m box leaves the 1.6 m camera's view 1.4 m away.
 OBSTACLE_RANGE = 2.0
 
@@ -53,6 +57,11 @@ class DriveTo(PmNavBehaviour):
 
     def on_watch(self, found: dict, obs) -> None:
         """Use what ``inspect`` found, in the tick (cheap)."""
+
+    def arrived_at_wall(self, free: float) -> bool:
+        """Whether a wall ``free`` m ahead, closer than the goal, means the goal is reached
+        (the waypoint lies just before that wall) rather than that the way is blocked."""
+        return False
 
     def initialise(self) -> None:
         self._goal = self.goal()
@@ -117,6 +126,7 @@ class DriveTo(PmNavBehaviour):
                     est = map_pose(tf, obs.pose)
                     found = self.inspect(obs, est, target)
                     found["walls"] = measure_walls(self.ctx.grounder, obs)
+                    found["ahead"] = _toward_goal(obs, est, goal)
                     return obs, _free_ahead(obs, est, goal), found
 
                 self._watch_job = self.ctx.worker.submit(watch)
@@ -131,20 +141,29 @@ class DriveTo(PmNavBehaviour):
         if found.get("walls") is not None:
             keep_on_axis(self, obs.pose, found["walls"])
         self.on_watch(found, obs)
+        ahead = found.get("ahead")
+        if ahead is not None and self.arrived_at_wall(ahead):
+            self.feedback_message = f"at the wall beyond the waypoint ({ahead:.1f} m ahead)"
+            return Status.SUCCESS
         if free is not None:
             self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)
             return self.fail(FailureCode.BLOCKED, f"obstacle {free:.1f} m ahead")
         return None
 
 
-def _free_ahead(obs, est, goal) -> float | None:
-    """The free distance towards ``goal`` when something stands closer than the goal."""
-    to_goal = math.hypot(goal[0] - est.x, goal[1] - est.y)
+def _toward_goal(obs, est, goal) -> float | None:
+    """The free distance (depth) towards ``goal``; None while still turning towards it."""
     bearing = heading((est.x, est.y), goal) - est.yaw
     if abs(wrap_angle(bearing)) > math.radians(25):
         return None  # still turning towards the goal: nothing to judge yet
-    free = free_distance(obs, bearing)
-    return free if free < min(to_goal, OBSTACLE_RANGE) - 0.3 else None
+    return free_distance(obs, bearing)
+
+
+def _free_ahead(obs, est, goal) -> float | None:
+    """The free distance towards ``goal`` when something stands closer than the goal."""
+    free = _toward_goal(obs, est, goal)
+    to_goal = math.hypot(goal[0] - est.x, goal[1] - est.y)
+    return free if free is not None and free < min(to_goal, OBSTACLE_RANGE) - 0.3 else None
 
 
 class Approach(DriveTo):
@@ -225,6 +244,23 @@ class DriveToWaypoint(DriveTo):
         ahead = max(0.0, wall - width / 2.0)
         p = (est.x + ahead * math.cos(target.heading), est.y + ahead * math.sin(target.heading))
         return {"corner": p, "ratios": ratios}
+
+    def arrived_at_wall(self, free: float) -> bool:
+        """Where the map has a wall just past the waypoint, depth showing a wall within
+        half a corridor width (and a margin) ahead, near where the waypoint should be,
+        means the robot is there: a corner placed beyond the wall (the wall measured
+        through a side opening, or an estimate ahead of the truth) must not drive it
+        into the wall."""
+        if not self._wall_beyond:
+            return False
+        t = self.get("target")
+        est = self.estimate()
+        width = self.ctx.pm.segment(t.segment).width
+        near = math.dist((est.x, est.y), t.position) <= WALL_ARRIVAL_NEAR_M
+        if near and free <= width / 2.0 + WALL_ARRIVAL_MARGIN_M:
+            self.ctx.log("at_wall", t.landmark, wall_ahead=free)
+            return True
+        return False
 
     def on_watch(self, found: dict, obs) -> None:
         t = self.get("target")

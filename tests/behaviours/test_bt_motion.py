@@ -164,6 +164,24 @@ def test_drive_to_waypoint_checks_the_corner_of_a_t_junction_reached_from_its_st
     assert [e.label for e in rig.ctx.trace if e.kind == "corner"] == ["branch1"]
 
 
+def test_drive_to_waypoint_stops_at_the_wall_beyond_a_t_junction_it_cannot_place(make_rig):
+    # sign_sparse_2 hard #10 at 5 %: the corner check put the corner 1.6 m past the
+    # waypoint (within the 2 m it trusts) and the drive met the wall beyond the T. Here
+    # the estimate is 2.6 m behind: the corner check refuses it (too far from the map's),
+    # and by the map the goal lies beyond the wall. Depth showing that wall within half a
+    # width of the robot means it is at the waypoint: arrived, not blocked.
+    rig = make_rig(Pose2D(36.0, 14.0, NORTH))
+    plan = rig.plan("36,14,90", "room19")
+    rig.set(plan=plan, target=plan.steps[0], map_T_odom=(0.0, -2.6, 0.0))
+    seen = rig.run(DriveToWaypoint("CornerCheck", rig.ctx), max_ticks=400)
+    rig.expect(seen, Status.SUCCESS)
+    p = rig.true_pose()
+    assert 19.0 < p.y < 21.2 - rig.body.radius
+    assert rig.body.stats.collisions == 0
+    assert rig.stopped()
+    assert [e.label for e in rig.ctx.trace if e.kind == "at_wall"] == ["branch1"]
+
+
 def test_a_wall_beyond_a_waypoint_is_where_no_corridor_goes_straight_on(pm):
     assert wall_beyond(pm, (36.0, 20.0), math.pi / 2)  # branch1 from its stem: a T
     assert not wall_beyond(pm, (36.0, 20.0), 0.0)  # along its bar: on to end1
