@@ -126,8 +126,8 @@ class DriveTo(PmNavBehaviour):
                     est = map_pose(tf, obs.pose)
                     found = self.inspect(obs, est, target)
                     found["walls"] = measure_walls(self.ctx.grounder, obs)
-                    found["ahead"] = _toward_goal(obs, est, goal)
-                    return obs, _free_ahead(obs, est, goal), found
+                    found["ahead"] = ahead = _toward_goal(obs, est, goal)
+                    return obs, _closer_than_goal(ahead, est, goal), found
 
                 self._watch_job = self.ctx.worker.submit(watch)
             return None
@@ -159,9 +159,9 @@ def _toward_goal(obs, est, goal) -> float | None:
     return free_distance(obs, bearing)
 
 
-def _free_ahead(obs, est, goal) -> float | None:
-    """The free distance towards ``goal`` when something stands closer than the goal."""
-    free = _toward_goal(obs, est, goal)
+def _closer_than_goal(free: float | None, est, goal) -> float | None:
+    """``free`` (the free distance towards ``goal``) when something stands closer than the
+    goal, else None."""
     to_goal = math.hypot(goal[0] - est.x, goal[1] - est.y)
     return free if free is not None and free < min(to_goal, OBSTACLE_RANGE) - 0.3 else None
 

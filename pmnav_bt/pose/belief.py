@@ -316,22 +316,27 @@ class CorridorBelief:
             1,
         )
 
+    def _weigh_free(
+        self, tfs: np.ndarray, here: np.ndarray, odom: Pose2D, yaw: float, free: float, p: float
+    ) -> None:
+        """The free floor seen along ``yaw`` from ``odom`` (``here`` under each hypothesis)
+        must be floor on the map: a hypothesis with a wall within that reach gets ``p``."""
+        reach = min(free, MAX_RAY_M) - RAY_SLACK_M
+        if reach > 1.0:
+            end = _apply_many(tfs, (odom.x + reach * math.cos(yaw), odom.y + reach * math.sin(yaw)))
+            floor = shapely.covers(self._floor, shapely.linestrings(np.stack([here, end], 1)))
+            self.logw += np.where(floor, 0.0, math.log(p))
+
     def _weigh_ray(self, r: Glimpse, tfs: np.ndarray) -> None:
         """Reweigh by the free floor seen ahead while driving (``observe_ray``)."""
         here = _apply_many(tfs, (r.odom.x, r.odom.y))
         for yaw, free in r.free:
-            reach = min(free, MAX_RAY_M) - RAY_SLACK_M
-            if reach > 1.0:
-                end = _apply_many(
-                    tfs, (r.odom.x + reach * math.cos(yaw), r.odom.y + reach * math.sin(yaw))
-                )
-                floor = shapely.covers(self._floor, shapely.linestrings(np.stack([here, end], 1)))
-                self.logw += np.where(floor, 0.0, math.log(P_DRIVE_RAY))
+            self._weigh_free(tfs, here, r.odom, yaw, free, P_DRIVE_RAY)
 
-    def _weigh_depth(self, g: Glimpse, tfs: np.ndarray) -> np.ndarray:
+    def _weigh_depth(self, g: Glimpse, tfs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Reweigh by what a glimpse saw in depth (and where it was): the robot inside a
         wall, a blocked drive, walls close ahead, free floor along each ray. Returns where
-        each hypothesis puts the robot (map)."""
+        each hypothesis puts the robot (map) and the lattice point nearest it."""
         here = _apply_many(tfs, (g.odom.x, g.odom.y))
         near, off = self.vis.nearest_many(here)
         half = self._half_width[near]
@@ -356,21 +361,15 @@ class CorridorBelief:
                 # beyond the wall, and the hypothesis is a lattice point on the centre line.
                 inside = poff <= self._half_width[pn] - RAY_SLACK_M
                 self.logw += np.where(inside, math.log(P_DEPTH), 0.0)
-            reach = min(free, MAX_RAY_M) - RAY_SLACK_M
-            if reach > 1.0:
-                end = _apply_many(tfs, (g.odom.x + reach * c, g.odom.y + reach * s_))
-                rays = shapely.linestrings(np.stack([here, end], 1))
-                floor = shapely.covers(self._floor, rays)
-                self.logw += np.where(floor, 0.0, math.log(P_DEPTH))
-        return here
+            self._weigh_free(tfs, here, g.odom, yaw, free, P_DEPTH)
+        return here, near
 
     def _weigh(self, g: Glimpse) -> None:
         tfs = self._map_T_odom()
         ref = self.ref
         travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
         sigma = math.hypot(SIGHT_SIGMA_M, DRIFT_PER_M * travelled)
-        here_xy = self._weigh_depth(g, tfs)
-        near, _ = self.vis.nearest_many(here_xy)
+        here_xy, near = self._weigh_depth(g, tfs)
         # What the map says is readable at each hypothesis's position for this glimpse.
         readable = [self.vis.lattice_points[j].readable for j in near]
         seen = g.seen.keys()
