@@ -43,6 +43,15 @@ STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
 RAY_SPACING_M = 1.0  # while driving, add the free floor ahead to the belief this often ...
 RETHINK_EVERY_M = 3.0  # ... and work the lead out again every so far (a junction passed)
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
+# A wall ahead this early in a drive, with open floor on one side of it, is a corner: the
+# robot stands off-centre at a junction (its hypotheses disagree on the junction's centre
+# by a metre) and the side corridor it turns into opens beside the wall in front of it.
+# Slide past: face the open bearing, drive until SLIDE_ACROSS_M across the heading, face
+# the lead's heading again.
+SLIDE_WITHIN_M = 1.5
+SLIDE_BEARINGS = tuple(math.radians(b) for b in (25.0, 40.0, 55.0))  # either side
+SLIDE_OPEN_M = 2.0  # floor this long along a bearing beside the wall: open
+SLIDE_ACROSS_M = 0.5
 # Bearings in each view along which the free floor is measured: twelve thin rays a view,
 # so a six-view panorama looks every 5 deg. From a bare corridor a side opening a few
 # metres off is seen only through a narrow window of bearings (4 m off: 11-19 deg from
@@ -267,6 +276,20 @@ def _ahead(obs: Observation, det) -> float:
     return SIGN_STOP_M + SIGN_APPROACH_M if p is None else float(p[0])
 
 
+def _open_beside(obs: Observation) -> float | None:
+    """The bearing (rad, body) nearest ahead along which the floor is open for
+    ``SLIDE_OPEN_M`` on one side only (``SLIDE_BEARINGS``), or None: open on both sides
+    (the wall ahead is a corridor's end across a junction) or on neither."""
+    for b in SLIDE_BEARINGS:
+        left = free_distance(obs, b) >= SLIDE_OPEN_M
+        right = free_distance(obs, -b) >= SLIDE_OPEN_M
+        if left != right:
+            return b if left else -b
+        if left:
+            return None
+    return None
+
+
 def _map_xy(tf, pose) -> tuple[float, float]:
     c, s = math.cos(tf[2]), math.sin(tf[2])
     return tf[0] + c * pose.x - s * pose.y, tf[1] + s * pose.x + c * pose.y
@@ -311,6 +334,9 @@ class FollowLead(PmNavBehaviour):
         self._signs_ahead: list[float] = []  # how far ahead (m) each sign read ahead is
         self._free_ahead = math.inf
         self._backing = None
+        self._open_beside: float | None = None  # bearing (body) of open floor beside a wall
+        self._slide: tuple[float, float, float, float] | None = None  # (heading, x, y, t)
+        self._slid = False
         self._last_ray = self._start
         self._rethink_job = None
         self._thought_at = self._start
@@ -342,12 +368,14 @@ class FollowLead(PmNavBehaviour):
             fit = None if points is None else fit_wall_angle(points)
             centre = None if points is None else corridor_centre(points)
             ahead = [_ahead(obs, d) for d in grounder.read_signs(obs)]
+            free = free_distance(obs, 0.0) if obs.depth is not None else None
             return (
                 obs.pose,
                 None if fit is None else fit[0],
                 ahead,
-                free_distance(obs, 0.0) if obs.depth is not None else None,
+                free,
                 centre,
+                _open_beside(obs) if free is not None and free < STOP_BEFORE_M else None,
             )
 
         self._job = self.ctx.worker.submit(measure)
@@ -357,23 +385,27 @@ class FollowLead(PmNavBehaviour):
             return
         job, self._job = self._job, None
         try:
-            seen_from, angle, ahead, free, centre = job.result()
+            seen_from, angle, ahead, free, centre, self._open_beside = job.result()
         except Exception:  # noqa: BLE001 - a lost wall check: drive on, check again
             return
-        yaw = seen_from.yaw
-        self._note_ray(seen_from, free)
+        if self._slide is not None:  # seen while turning to slide: not along the way
+            return
+        yaw, axis = seen_from.yaw, None
         if centre is not None and abs(centre[0]) < ALONG_WALL_MAX:
             # Along both walls, turning a little towards the centre line: there a plate
             # on either wall is seen at the angle the map's reading ranges assume.
+            axis = yaw + centre[0]
             steer = math.atan2(centre[1], CENTRE_LOOKAHEAD_M)
-            self._heading = yaw + centre[0] + max(-MAX_CENTRE_TURN, min(MAX_CENTRE_TURN, steer))
+            self._heading = axis + max(-MAX_CENTRE_TURN, min(MAX_CENTRE_TURN, steer))
         elif angle is not None and abs(angle) < ALONG_WALL_MAX:
-            self._heading = yaw + angle  # parallel to the wall in view
+            axis = self._heading = yaw + angle  # parallel to the wall in view
+        self._note_ray(seen_from, free, axis)
         self._signs_ahead = ahead
         self._free_ahead = math.inf if free is None else free
 
-    def _note_ray(self, seen_from: Pose2D, free: float | None) -> None:
-        """Add the free floor ahead to the belief every ``RAY_SPACING_M`` of the drive."""
+    def _note_ray(self, seen_from: Pose2D, free: float | None, axis: float | None) -> None:
+        """Add the free floor ahead and the walls' axis (odometry; None: not seen) to the
+        belief every ``RAY_SPACING_M`` of the drive."""
         belief: CorridorBelief | None = self.get("belief")
         if belief is None or free is None or not self._driving or self._rethink_job is not None:
             return  # (not while the lead is worked out again on the belief, in the worker)
@@ -381,7 +413,7 @@ class FollowLead(PmNavBehaviour):
         if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:
             return
         self._last_ray = (seen_from.x, seen_from.y)
-        belief.observe_ray(seen_from, min(free, 50.0))
+        belief.observe_ray(seen_from, min(free, 50.0), axis)
 
     def _rethink(self, pose: Pose2D) -> bool:
         """Whether the lead, worked out again (worker) every ``RETHINK_EVERY_M`` of the drive
@@ -404,6 +436,22 @@ class FollowLead(PmNavBehaviour):
             )
         return False
 
+    def _sliding(self, pose: Pose2D) -> bool:
+        """Slide past a corner (along the open bearing beside it, ``SLIDE_ACROSS_M`` across
+        the drive's heading); True once done (then the drive faces its heading and looks at
+        the walls again)."""
+        heading, x, y, t = self._slide
+        if not self.face(heading, pose):
+            return False
+        across = abs(math.sin(heading - self._heading)) * math.hypot(pose.x - x, pose.y - y)
+        blocked = self.ctx.base.motion_status() == MotionStatus.BLOCKED
+        if across >= SLIDE_ACROSS_M or blocked or self.ctx.now() - t > NO_PROGRESS_S + 5.0:
+            self.ctx.base.set_velocity(0.0, 0.0)
+            self._slide, self._next_check = None, -math.inf
+            return True
+        self.ctx.base.set_velocity(self.ctx.limits.linear, 0.0)
+        return False
+
     def update(self) -> Status:
         base, now = self.ctx.base, self.ctx.now()
         pose = base.pose()
@@ -424,6 +472,8 @@ class FollowLead(PmNavBehaviour):
             self._backing = (x, y, t, True)
             return Status.RUNNING
         self._poll_walls()
+        if self._slide is not None and not self._sliding(pose):
+            return Status.RUNNING
         if not self._driving:
             if not self.face(self._heading, pose):
                 return Status.RUNNING
@@ -460,6 +510,12 @@ class FollowLead(PmNavBehaviour):
         stuck = now - self._best_t > NO_PROGRESS_S
         if self._driving and self._free_ahead < STOP_BEFORE_M:  # a wall ahead, seen in depth
             base.set_velocity(0.0, 0.0)
+            beside = self._open_beside
+            if beside is not None and done_m < SLIDE_WITHIN_M and not self._slid:
+                self._slide, self._slid = (pose.yaw + beside, pose.x, pose.y, now), True
+                self._driving, self._free_ahead = False, math.inf
+                self.feedback_message = "a corner ahead: sliding past it"
+                return Status.RUNNING
             belief = self.get("belief")
             if belief is not None:
                 belief.pending_blocked = self._heading

@@ -224,19 +224,9 @@ class CorridorBelief:
             self.glimpses.append(glimpse)
             self._build()
             return
-        drift = self._drift
-        self._last_axis = None
-        if axis_odom is not None:
-            d = wrap_angle(4.0 * (axis_odom - self._ref_axis)) / 4.0  # mod pi/2
-            if abs(wrap_angle(4.0 * (d - drift)) / 4.0) < MAX_DRIFT_STEP:
-                drift = d
-                self._last_axis = wrap_angle(axis_odom - drift)
-        # Straighten the odometry: the leg since the last glimpse turned by the mean drift.
-        raw, mean = glimpse.odom, (self._drift + drift) / 2.0
-        c, s = math.cos(-mean), math.sin(-mean)
-        dx, dy = raw.x - self._raw.x, raw.y - self._raw.y
-        corr = (self._corr[0] + c * dx - s * dy, self._corr[1] + s * dx + c * dy)
-        self._drift, self._raw, self._corr = drift, raw, corr
+        took = self._advance(glimpse.odom, axis_odom)
+        drift, corr, raw = self._drift, self._corr, glimpse.odom
+        self._last_axis = wrap_angle(axis_odom - drift) if took else None
         g = Glimpse(
             Pose2D(corr[0], corr[1], wrap_angle(raw.yaw - drift)),
             {e: tuple(self._straighten(xy)) for e, xy in glimpse.seen.items()},
@@ -247,14 +237,38 @@ class CorridorBelief:
         self.glimpses.append(g)
         self._weigh(g)
 
-    def observe_ray(self, odom: Pose2D, free: float) -> None:
+    def _advance(self, odom: Pose2D, axis_odom: float | None) -> bool:
+        """Carry the straightened odometry on to ``odom``: the walls' axis measured there
+        (odometry, mod pi/2) against the reference's is the heading drift now, unless it
+        jumped more than ``MAX_DRIFT_STEP`` since the last (another corridor's walls), and
+        the leg since the last update turned by the mean drift. Whether the axis was taken.
+        """
+        drift, took = self._drift, False
+        if axis_odom is not None:  # mod pi/2, the value nearest the drift so far
+            step = wrap_angle(4.0 * (axis_odom - self._ref_axis - drift)) / 4.0
+            if abs(step) < MAX_DRIFT_STEP:
+                drift, took = drift + step, True
+        mean = (self._drift + drift) / 2.0
+        c, s = math.cos(-mean), math.sin(-mean)
+        dx, dy = odom.x - self._raw.x, odom.y - self._raw.y
+        self._corr = (self._corr[0] + c * dx - s * dy, self._corr[1] + s * dx + c * dy)
+        self._drift, self._raw = drift, odom
+        return took
+
+    def observe_ray(self, odom: Pose2D, free: float, axis_odom: float | None = None) -> None:
         """Add the free floor (m) seen in depth straight ahead from ``odom`` while driving:
         a hypothesis under which the map has a wall within that reach is a little less
         likely (``P_DRIVE_RAY``), so readings along a drive tell apart places where the
         corridor ahead ends sooner. No sign is read or missed (the view is along the
-        corridor, not round it), and it is no look round."""
+        corridor, not round it), and it is no look round.
+
+        ``axis_odom``: the walls' axis in view there (odometry). Taken in along the drive,
+        it keeps the heading drift current: on a long drive the odometry's heading can
+        drift further between two looks round than a jump the belief would believe
+        (``MAX_DRIFT_STEP``), and the straightened leg bends with the drift as it grows."""
         if self.ref is None:
             return
+        self._advance(odom, axis_odom)
         p = self._straighten((odom.x, odom.y))
         yaw = wrap_angle(odom.yaw - self._drift)
         ray = Glimpse(Pose2D(float(p[0]), float(p[1]), yaw), {}, free=((yaw, free),))

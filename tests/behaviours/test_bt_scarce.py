@@ -202,3 +202,22 @@ def test_a_panorama_calibrates_the_odometry_rotation_so_turning_round_is_true(ma
     rig.expect(rig.run(Spin("TurnRound", rig.ctx, math.pi), 300), Status.SUCCESS)
     turned = abs(wrap_angle(rig.true_pose().yaw - before))
     assert turned == pytest.approx(math.pi, abs=math.radians(3.0))
+
+
+def test_a_drive_that_meets_a_corner_at_its_start_slides_past_it(make_rig):
+    """sign_sparse_2 hard #9 at 5 % drift: at the cross, the robot stood a metre off its
+    centre (its two mirror hypotheses put the centre a metre either way) and the way the
+    belief chose ran into the side corridor beside the wall in front of it: depth saw that
+    wall 0.6 m ahead, "the corridor ends", both ways in turn, and the localization
+    dithered at the cross until the budget ran out. Here at fig2's turn1 (an L: the
+    corridor from the north turns east), 1.15 m north of its centre, facing east with the
+    corner 0.8 m ahead: the drive slides past the corner and goes on east."""
+    from pmnav_bt.behaviours.active_localize import FollowLead
+
+    rig = make_rig(Pose2D(0.4, 1.15, 0.0), width=320, height=240)  # turn1 is at (0, 0)
+    lead = FollowLead("FollowLead", rig.ctx, max_distance=2.5)
+    rig.expect(rig.run(lead, 2000), Status.SUCCESS)
+    true = rig.true_pose()
+    assert true.x > 2.0, (true, lead.feedback_message)  # on, past the corner at x 1.2
+    assert abs(true.y) < 1.0
+    assert rig.body.stats.collisions == 0
