@@ -1,9 +1,10 @@
 """A belief over where on the corridors the robot is, kept across localization attempts.
 
 Each hypothesis is a map pose for the robot at a reference odometry pose (the first
-glimpse): a lattice point of a corridor centre line, facing along the corridor either
-way or across it (the walls seen in depth give the robot's angle to an axis, but near a
-junction the strongest wall may run across the corridor).
+glimpse's, moved onto the centre line the walls showed there): a lattice point of a
+corridor centre line, facing along the corridor either way or across it (the walls seen
+in depth give the robot's angle to an axis, but near a junction the strongest wall may
+run across the corridor).
 Every glimpse (a panorama: the signs read there and where each was seen, in odometry)
 reweights all hypotheses: a sign read where the map puts it under the hypothesis
 supports it, one read elsewhere or one the map says cannot be read there counts
@@ -92,6 +93,8 @@ class Glimpse:
     free: tuple[tuple[float, float], ...] = ()
     # Signs read whose place is not known (cut by the image border): in sight, not missed.
     named: frozenset[Entity] = frozenset()
+    # The way (odometry, m) from the robot to the corridor's centre line, seen in depth.
+    to_centre: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -215,7 +218,10 @@ class CorridorBelief:
             glimpse = replace(glimpse, blocked=self.pending_blocked)
         self.pending_blocked = None
         if self.ref is None:
-            self.ref = glimpse.odom
+            # The hypotheses put the reference on a centre line: where the walls say the
+            # centre line is, not where the robot stands (beside a wall, maybe).
+            dx, dy = glimpse.to_centre or (0.0, 0.0)
+            self.ref = replace(glimpse.odom, x=glimpse.odom.x + dx, y=glimpse.odom.y + dy)
             self._ref_axis = axis_odom if axis_odom is not None else glimpse.odom.yaw
             if axis_odom is not None:
                 self.axis_offset = wrap_angle(2.0 * (self.ref.yaw - axis_odom)) / 2.0

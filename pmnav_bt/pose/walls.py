@@ -89,18 +89,30 @@ def fit_wall_line(points: np.ndarray, seed: int = 0) -> WallLine | None:
     return WallLine(wrap_angle(2.0 * a) / 2.0, offset, int(best_in.sum()), float(np.ptp(along)))
 
 
+def wall_lines(points: np.ndarray, most: int) -> list[WallLine]:
+    """Up to ``most`` wall lines through ``points``, strongest first: each fit on the points
+    the lines before it left."""
+    lines: list[WallLine] = []
+    for seed in range(most):
+        line = fit_wall_line(points, seed=seed)
+        if line is None:
+            break
+        lines.append(line)
+        normal = np.array([-math.sin(line.angle), math.cos(line.angle)])
+        points = points[np.abs(points @ normal - line.offset) > 3.0 * INLIER_M]
+    return lines
+
+
 def corridor_centre(points: np.ndarray) -> tuple[float, float] | None:
     """(axis direction, centre-line offset) from both walls of the corridor in view: the
     strongest wall line and a second one parallel to it on the robot's other side, the
     offset (m, positive: the centre line is on the left) half-way between them. None
     without two such walls (a junction, a wall ahead, one wall out of view)."""
-    first = fit_wall_line(points)
-    if first is None:
+    lines = wall_lines(points, 2)
+    if len(lines) < 2:
         return None
-    normal = np.array([-math.sin(first.angle), math.cos(first.angle)])
-    rest = points[np.abs(points @ normal - first.offset) > 3.0 * INLIER_M]
-    second = fit_wall_line(rest, seed=1)
-    if second is None or first.offset * second.offset >= 0.0:
+    first, second = lines
+    if first.offset * second.offset >= 0.0:
         return None
     if abs(wrap_angle(2.0 * (first.angle - second.angle))) / 2.0 > MAX_PARALLEL:
         return None

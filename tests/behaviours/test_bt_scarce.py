@@ -191,7 +191,8 @@ def test_a_panorama_calibrates_the_odometry_rotation_so_turning_round_is_true(ma
     rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
     # The views are put back into the odometry frame of the last one: the corridor axis
     # they give is the axis as the odometry sees it now (the raw views spread 20 deg).
-    _, axis, _, error, _ = read_panorama(rig.ctx, rig.get("views"))
+    read = read_panorama(rig.ctx, rig.get("views"))
+    axis, error = read.axis, read.rotation_error
     now = wrap_angle(rig.ctx.base.pose().yaw - rig.true_pose().yaw) + SOUTH
     assert abs(wrap_angle(2.0 * (axis - now)) / 2.0) < math.radians(2.0)
     assert error == pytest.approx(1.0 - 1.0 / 1.073, abs=0.01)
@@ -202,6 +203,18 @@ def test_a_panorama_calibrates_the_odometry_rotation_so_turning_round_is_true(ma
     rig.expect(rig.run(Spin("TurnRound", rig.ctx, math.pi), 300), Status.SUCCESS)
     turned = abs(wrap_angle(rig.true_pose().yaw - before))
     assert turned == pytest.approx(math.pi, abs=math.radians(3.0))
+
+
+@pytest.mark.parametrize("off", [0.8, -0.5, 0.0])
+def test_a_panorama_finds_the_way_to_the_corridor_centre_line(make_rig, off):
+    """A look round from beside a wall says where the centre line is (the belief's
+    hypotheses stand on it): across the corridor, from the walls of the views along it."""
+    rig = make_rig(Pose2D(off, 26.5, SOUTH), width=320, height=240)
+    views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
+    rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
+    way = read_panorama(rig.ctx, rig.get("views")).to_centre
+    assert way is not None
+    assert way == pytest.approx((-off, 0.0), abs=0.15)
 
 
 def test_a_drive_that_meets_a_corner_at_its_start_slides_past_it(make_rig):

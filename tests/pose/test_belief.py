@@ -797,3 +797,30 @@ def test_the_walls_seen_while_driving_keep_up_with_the_odometrys_heading_drift(
     else:  # the old way: the drift jumped too far to be believed, the track bent away
         assert off > 4.0
 
+
+@pytest.mark.parametrize("moved_to_centre", [True, False])
+def test_a_look_round_from_beside_a_wall_is_weighed_from_the_centre_line(moved_to_centre):
+    """sign_sparse_2 hard #8 at 5 % drift: blocked against the end wall of the T junction
+    at branch3, the robot looked round 0.8 m off the wing's centre line. The hypotheses
+    stand on centre lines, so at the true place the rays along the wing's far wall ran
+    0.8 m further than the map allows and the belief put the robot at the cross junction
+    (wider everywhere) instead. Moved onto the centre line the walls showed (the
+    glimpse's ``to_centre``), the reference fits the true place."""
+    pm = parse_building(generate_sign_sparse(2))
+    truth = (60.8, 29.9, math.radians(-34.0))  # 0.2 m from branch3's east wall
+    yaws = [truth[2] + math.radians(30.0 + 60.0 * k) for k in range(6)]
+    free = tuple(
+        (y + b + ODOM_T_MAP[2], _free(pm, truth, y + b, half_width=RAY_HALF_WIDTH_M))
+        for y in yaws
+        for b in FREE_BEARINGS
+    )
+    way = np.array([60.0 - truth[0], 30.0 - truth[1]])  # to branch3's centre (map)
+    c, s = math.cos(ODOM_T_MAP[2]), math.sin(ODOM_T_MAP[2])
+    to_centre = (c * way[0] - s * way[1], s * way[0] + c * way[1]) if moved_to_centre else None
+    odom = Pose2D(*se2_compose(ODOM_T_MAP, truth))
+    b = CorridorBelief(pm)
+    b.observe(Glimpse(odom, {}, free=free, to_centre=to_centre), axis_odom=ODOM_T_MAP[2])
+    idx, _ = b.best_cluster()
+    here = _apply(b._map_T_odom()[idx], (odom.x, odom.y)).mean(axis=0)
+    at_branch3 = math.hypot(here[0] - truth[0], here[1] - truth[1]) < 1.5
+    assert at_branch3 == moved_to_centre, here
