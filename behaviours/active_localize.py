@@ -52,6 +52,7 @@ RAY_SPACING_M = 1.0  # while driving, add the free floor ahead to the belief thi
 RETHINK_EVERY_M = 3.0  # ... and work the lead out again every so far (a junction passed)
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
 CENTRE_LINE_MAX = math.radians(10.0)  # a wall line this near the axis runs along it
+MIN_CENTRE_WAY_M = 0.15  # nearer the centre line than this: on it, as far as depth tells
 # A wall ahead this early in a drive, with open floor on one side of it, is a corner: the
 # robot stands off-centre at a junction (its hypotheses disagree on the junction's centre
 # by a metre) and the side corridor it turns into opens beside the wall in front of it.
@@ -136,35 +137,33 @@ class Panorama:
 
 
 def to_centre(lines: list[tuple[float, float]], axis: float | None) -> tuple[float, float] | None:
-    """The way (odometry, m) from the robot to the centre line of the corridor it stands
-    in, from the wall lines its views saw: (odometry direction of the line, its offset,
-    positive on the line's left). Half-way between the nearest wall along the axis on
-    either side is the centre line; at a junction, half-way between the side corridor's
-    walls (across the axis) is the junction's centre. None without an axis or a wall
-    along it on both sides.
+    """The way (odometry, m) across the corridor from the robot to its centre line, from
+    the wall lines its views saw: (odometry direction of the line, its offset, positive
+    on the line's left). Half-way between the nearest walls along the axis on either side
+    is the centre line. None without an axis or such a wall on both sides, or within
+    ``MIN_CENTRE_WAY_M`` of the line (on it: no move).
 
     A robot that stopped against a wall stands most of a corridor's half-width off the
     centre line the belief's hypotheses put it on; its look round, taken from there, fits a
     place with wider corridors better than the true one (sign_sparse_2 hard #8 at 5 %:
-    0.8 m off centre at a T junction, the belief put it at the cross junction)."""
+    0.8 m off centre at a T junction, the belief put it at the cross junction). Along the
+    corridor the hypotheses stand every ``LATTICE_M``: no way along it is needed (and
+    walls across the axis pair up wrongly: an end wall with a door's recess)."""
     if axis is None:
         return None
-    way = np.zeros(2)
-    for k in (0, 1):  # along the axis, then across it
-        a = axis + k * math.pi / 2
-        normal = np.array([-math.sin(a), math.cos(a)])
-        side = []  # each wall's signed distance along the normal
-        for direction, offset in lines:
-            if abs(wrap_angle(2.0 * (direction - a)) / 2.0) < CENTRE_LINE_MAX:
-                side.append(offset * float(normal @ (-math.sin(direction), math.cos(direction))))
-        left = [d for d in side if d > 0.0]
-        right = [d for d in side if d < 0.0]
-        if not left or not right or not MIN_WIDTH_M <= min(left) - max(right) <= MAX_WIDTH_M:
-            if k == 0:
-                return None
-            continue
-        way += normal * (min(left) + max(right)) / 2.0
-    return float(way[0]), float(way[1])
+    normal = np.array([-math.sin(axis), math.cos(axis)])
+    side = []  # each wall's signed distance along the normal
+    for direction, offset in lines:
+        if abs(wrap_angle(2.0 * (direction - axis)) / 2.0) < CENTRE_LINE_MAX:
+            side.append(offset * float(normal @ (-math.sin(direction), math.cos(direction))))
+    left = [d for d in side if d > 0.0]
+    right = [d for d in side if d < 0.0]
+    if not left or not right or not MIN_WIDTH_M <= min(left) - max(right) <= MAX_WIDTH_M:
+        return None
+    across = (min(left) + max(right)) / 2.0
+    if abs(across) < MIN_CENTRE_WAY_M:
+        return None
+    return float(normal[0] * across), float(normal[1] * across)
 
 
 def _turned(obs: Observation, dyaw: float) -> Observation:
