@@ -194,12 +194,10 @@ class UpdateBelief(PmNavBehaviour):
         status, read = self.poll(self._job, "reading the panorama")
         if status is not None:
             return status
-        sightings, axis, free, rot_error, named = (
-            read.sightings, read.axis, read.free, read.rotation_error, read.named
-        )
-        if rot_error is not None and isinstance(self.ctx.base, CalibratedBase):
-            gain = self.ctx.base.calibrate(rot_error)
-            self.ctx.log("calibrate", "", rotation_error=rot_error, gain=gain)
+        error = read.rotation_error
+        if error is not None and isinstance(self.ctx.base, CalibratedBase):
+            gain = self.ctx.base.calibrate(error)
+            self.ctx.log("calibrate", "", rotation_error=error, gain=gain)
         views = self.get("views") or []
         belief = self.get("belief")
         if belief is None:
@@ -217,10 +215,10 @@ class UpdateBelief(PmNavBehaviour):
                 belief.prior = (tf, sigma)
         odom = views[0].observation.pose if views else self.ctx.base.pose()
         seen: dict[Entity, tuple[float, float]] = {}
-        for s in sightings:
+        for s in read.sightings:
             seen.setdefault(s.entity, s.odom_xy)
-        glimpse = Glimpse(odom, seen, free=free, named=named, to_centre=read.to_centre)
-        belief.observe(glimpse, axis_odom=axis)
+        glimpse = Glimpse(odom, seen, free=read.free, named=read.named, to_centre=read.to_centre)
+        belief.observe(glimpse, axis_odom=read.axis)
         self.bb.set("belief", belief)
         _, mass = belief.best_cluster()
         self.feedback_message = (
@@ -360,8 +358,11 @@ class FollowLead(PmNavBehaviour):
     """Drive along the corridor axis towards where the map says signs are readable (the
     belief's lead), or, without a belief, towards the most open view. The heading is kept
     parallel to the walls seen in depth (odometry's rotation error does not steer it into a
-    wall). A blocked drive is remembered by the belief (the corridor ends or turns there).
-    The lead, a search over the map's corridors, is worked out in the worker.
+    wall), and the walls' axis and the free floor ahead go to the belief every metre. A
+    blocked drive is remembered by the belief (the corridor ends or turns there); a wall
+    met in the drive's first metres with open floor on one side of it is a corner, slid
+    past. The lead, a search over the map's corridors, is worked out in the worker and
+    again every few metres of the drive (the belief may now say another way: stop).
 
     Reads ``belief``, ``views``; writes nothing (the belief notes a blocked drive).
     SUCCESS when the distance is covered (shortened when a sign comes into view ahead:
