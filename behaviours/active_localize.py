@@ -26,13 +26,11 @@ from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.pose.walls import (
-    MAX_WIDTH_M,
-    MIN_WIDTH_M,
     axis_in_odom,
-    corridor_centre,
-    fit_wall_angle,
+    centre_between,
     wall_lines,
     wall_points,
+    way_to_centre,
 )
 from pmnav_bt.seams import Entity, Grounder, MotionStatus, Observation, Pose2D
 
@@ -51,8 +49,6 @@ STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
 RAY_SPACING_M = 1.0  # while driving, add the free floor ahead to the belief this often ...
 RETHINK_EVERY_M = 3.0  # ... and work the lead out again every so far (a junction passed)
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
-CENTRE_LINE_MAX = math.radians(10.0)  # a wall line this near the axis runs along it
-MIN_CENTRE_WAY_M = 0.15  # nearer the centre line than this: on it, as far as depth tells
 # A wall ahead this early in a drive, with open floor on one side of it, is a corner: the
 # robot stands off-centre at a junction (its hypotheses disagree on the junction's centre
 # by a metre) and the side corridor it turns into opens beside the wall in front of it.
@@ -108,7 +104,7 @@ def read_panorama(ctx: Context, views: list) -> Panorama:
                 named.add(d.entity)  # read, but cut by the border: in sight, place unknown
     angles = [(views[i].observation.pose.yaw, f[0], f[1]) for i, f in fits]
     axis = axis_in_odom(angles)
-    lines = [(views[i].observation.pose.yaw + w.angle, w.offset) for i, w in walls]
+    seen = [(views[i].observation.pose.yaw + w.angle, w.offset) for i, w in walls]
     free = tuple(
         (
             wrap_angle(v.observation.pose.yaw + b),
@@ -117,7 +113,7 @@ def read_panorama(ctx: Context, views: list) -> Panorama:
         for v in views
         for b in FREE_BEARINGS
     )
-    return Panorama(sightings, axis, free, error, frozenset(named), to_centre(lines, axis))
+    return Panorama(sightings, axis, free, error, frozenset(named), way_to_centre(seen, axis))
 
 
 @dataclass(frozen=True)
@@ -125,7 +121,8 @@ class Panorama:
     """What a panorama tells: the signs read with a place, the corridor axis (odometry,
     mod pi; None: no walls seen), the free floor along each view's ``FREE_BEARINGS``
     ((odometry yaw, m) each), the odometry's rotation-scale error (None: not measured),
-    the signs read without a place, and the way to the corridor centre line (``to_centre``).
+    the signs read without a place, and the way across to the corridor's centre line
+    (``walls.way_to_centre``).
     """
 
     sightings: list[Sighting]
@@ -134,36 +131,6 @@ class Panorama:
     rotation_error: float | None
     named: frozenset[Entity]
     to_centre: tuple[float, float] | None
-
-
-def to_centre(lines: list[tuple[float, float]], axis: float | None) -> tuple[float, float] | None:
-    """The way (odometry, m) across the corridor from the robot to its centre line, from
-    the wall lines its views saw: (odometry direction of the line, its offset, positive
-    on the line's left). Half-way between the nearest walls along the axis on either side
-    is the centre line. None without an axis or such a wall on both sides, or within
-    ``MIN_CENTRE_WAY_M`` of the line (on it: no move).
-
-    A robot that stopped against a wall stands most of a corridor's half-width off the
-    centre line the belief's hypotheses put it on; its look round, taken from there, fits a
-    place with wider corridors better than the true one (sign_sparse_2 hard #8 at 5 %:
-    0.8 m off centre at a T junction, the belief put it at the cross junction). Along the
-    corridor the hypotheses stand every ``LATTICE_M``: no way along it is needed (and
-    walls across the axis pair up wrongly: an end wall with a door's recess)."""
-    if axis is None:
-        return None
-    normal = np.array([-math.sin(axis), math.cos(axis)])
-    side = []  # each wall's signed distance along the normal
-    for direction, offset in lines:
-        if abs(wrap_angle(2.0 * (direction - axis)) / 2.0) < CENTRE_LINE_MAX:
-            side.append(offset * float(normal @ (-math.sin(direction), math.cos(direction))))
-    left = [d for d in side if d > 0.0]
-    right = [d for d in side if d < 0.0]
-    if not left or not right or not MIN_WIDTH_M <= min(left) - max(right) <= MAX_WIDTH_M:
-        return None
-    across = (min(left) + max(right)) / 2.0
-    if abs(across) < MIN_CENTRE_WAY_M:
-        return None
-    return float(normal[0] * across), float(normal[1] * across)
 
 
 def _turned(obs: Observation, dyaw: float) -> Observation:
@@ -427,16 +394,15 @@ class FollowLead(PmNavBehaviour):
             obs = base.observe()
             mask = wall_mask(grounder, obs)
             points = None if mask is None else wall_points(obs, mask)
-            fit = None if points is None else fit_wall_angle(points)
-            centre = None if points is None else corridor_centre(points)
+            lines = [] if points is None else wall_lines(points, 2)  # fitted once, for both
             ahead = [_ahead(obs, d) for d in grounder.read_signs(obs)]
             free = free_distance(obs, 0.0) if obs.depth is not None else None
             return (
                 obs.pose,
-                None if fit is None else fit[0],
+                lines[0].angle if lines else None,
                 ahead,
                 free,
-                centre,
+                centre_between(lines),
                 _open_beside(obs) if free is not None and free < STOP_BEFORE_M else None,
             )
 
@@ -554,9 +520,7 @@ class FollowLead(PmNavBehaviour):
         if self._rethink(pose):
             # The belief now says another way: look again from here.
             base.set_velocity(0.0, 0.0)
-            self.feedback_message = (
-                f"after {done_m:.1f} m the belief says another way: look again"
-            )
+            self.feedback_message = f"after {done_m:.1f} m the belief says another way: look again"
             return Status.SUCCESS
         ahead = [a for a in self._signs_ahead if a > SIGN_STOP_M]  # nearer: read already
         if ahead:
