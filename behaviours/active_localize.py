@@ -234,6 +234,59 @@ class NoSignInReach(PmNavBehaviour):
         return Status.SUCCESS if share < NO_SIGN_SHARE else Status.FAILURE
 
 
+# How a FollowLead drive ended (``drive_end``): after these, a look round that cannot
+# tell the belief's places apart is skipped; after a wall met or a sign seen ahead, never.
+DRIVE_COVERED, DRIVE_RETHOUGHT, DRIVE_SIGN, DRIVE_WALL, DRIVE_BLOCKED = (
+    "covered",
+    "rethought",
+    "sign ahead",
+    "wall ahead",
+    "blocked",
+)
+SKIPPABLE_ENDS = (DRIVE_COVERED, DRIVE_RETHOUGHT)
+
+
+class LookTellsNothing(PmNavBehaviour):
+    """SUCCESS when a look round here cannot tell the belief's places apart
+    (``CorridorBelief.look_tells``: its clusters are the mirror images of a symmetric
+    junction, or stretches of bare corridor, with no sign in sight under any), after a
+    drive that covered its lead or stopped because the belief chose another way: then the
+    panorama (a full turn, eleven actions) is skipped and the lead worked out again.
+    FAILURE (take the look) with no belief, or after a drive that met a wall or saw a
+    sign ahead. The check, a few rays per cluster on the map, runs in the worker.
+
+    Reads ``belief``, ``drive_end``; writes ``drive_end`` (cleared: one skip per drive).
+    """
+
+    READS = ("belief", "drive_end")
+    WRITES = ("drive_end",)
+    JOBS = ("_job",)
+
+    def initialise(self) -> None:
+        belief: CorridorBelief | None = self.get("belief")
+        end = self.get("drive_end")
+        self.bb.set("drive_end", None)
+        self._job = None
+        if belief is not None and end in SKIPPABLE_ENDS:
+            pose = self.ctx.base.pose()
+            self._job = self.ctx.worker.submit(lambda c: belief.look_tells(pose))
+        self._end = end
+
+    def update(self) -> Status:
+        if self._job is None:
+            self.feedback_message = f"look round (drive: {self._end or 'none'})"
+            return Status.FAILURE
+        status, tells = self.poll(self._job, "weighing a look round")
+        if status is not None:
+            return status
+        if tells:
+            self.feedback_message = "a look round here can tell the places apart"
+            return Status.FAILURE
+        self.feedback_message = "every likely place looks alike from here: no look round"
+        self.ctx.log("no look", self.feedback_message)
+        return Status.SUCCESS
+
+
 class FixFromBelief(PmNavBehaviour):
     """Fix the map pose: from two or more landmarks of the last panorama, else from the
     belief once one corridor position dominates it.
@@ -331,13 +384,15 @@ class FollowLead(PmNavBehaviour):
     past. The lead, a search over the map's corridors, is worked out in the worker and
     again every few metres of the drive (the belief may now say another way: stop).
 
-    Reads ``belief``, ``views``; writes nothing (the belief notes a blocked drive).
+    Reads ``belief``, ``views``; writes ``drive_end`` (how the drive ended: covered,
+    rethought, sign ahead, wall ahead, blocked; the belief notes a blocked drive).
     SUCCESS when the distance is covered (shortened when a sign comes into view ahead:
     look round near it), or the way is blocked (then it backs off the wall first;
     exploring is best effort).
     """
 
     READS = ("belief", "views")
+    WRITES = ("drive_end",)
     JOBS = ("_job", "_lead_job", "_rethink_job")
     STOPS_BASE = True
 
@@ -369,6 +424,8 @@ class FollowLead(PmNavBehaviour):
         self._last_ray = self._start
         self._rethink_job = None
         self._thought_at = self._start
+        self._sign_stop = False  # the distance was cut short for a sign seen ahead
+        self.bb.set("drive_end", None)
 
     def _aim(self, lead, pose: Pose2D) -> None:
         """Drive along the belief's ``lead``, or, without one, 2 m towards the most open view."""
@@ -495,6 +552,7 @@ class FollowLead(PmNavBehaviour):
             backed = math.hypot(pose.x - x, pose.y - y) >= BACKUP_LIMIT_M - 0.01
             if refused or backed or now - t > 5.0:
                 base.set_velocity(0.0, 0.0)
+                self.bb.set("drive_end", DRIVE_BLOCKED)
                 return Status.SUCCESS
             base.set_velocity(-0.1, 0.0)
             self._backing = (x, y, t, True)
@@ -516,10 +574,12 @@ class FollowLead(PmNavBehaviour):
         done_m = math.hypot(pose.x - self._start[0], pose.y - self._start[1])
         if done_m >= self._distance:
             base.set_velocity(0.0, 0.0)
+            self.bb.set("drive_end", DRIVE_SIGN if self._sign_stop else DRIVE_COVERED)
             return Status.SUCCESS
         if self._rethink(pose):
             # The belief now says another way: look again from here.
             base.set_velocity(0.0, 0.0)
+            self.bb.set("drive_end", DRIVE_RETHOUGHT)
             self.feedback_message = f"after {done_m:.1f} m the belief says another way: look again"
             return Status.SUCCESS
         ahead = [a for a in self._signs_ahead if a > SIGN_STOP_M]  # nearer: read already
@@ -528,7 +588,7 @@ class FollowLead(PmNavBehaviour):
             # seen along its wall from beside it), then look round.
             stop = done_m + min(SIGN_APPROACH_M, min(ahead) - SIGN_STOP_M)
             if stop < self._distance:
-                self._distance = stop
+                self._distance, self._sign_stop = stop, True
                 self.feedback_message = f"a sign in view after {done_m:.1f} m: look round soon"
             self._signs_ahead = []
         if done_m > self._best + 0.1:
@@ -546,6 +606,7 @@ class FollowLead(PmNavBehaviour):
             if belief is not None:
                 belief.pending_blocked = self._heading
             self.feedback_message = f"a wall ahead after {done_m:.1f} m: the corridor ends"
+            self.bb.set("drive_end", DRIVE_WALL)
             return Status.SUCCESS
         if base.motion_status() == MotionStatus.BLOCKED or stuck:
             base.stop()

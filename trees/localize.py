@@ -22,6 +22,7 @@ from py_trees.decorators import Retry
 from pmnav_bt.behaviours.active_localize import (
     FixFromBelief,
     FollowLead,
+    LookTellsNothing,
     NoSignInReach,
     UpdateBelief,
 )
@@ -68,17 +69,23 @@ def panorama_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour
 
 
 def active_localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour.Behaviour:
-    """Panorama -> belief -> fix; else drive along the corridor towards signs, and retry."""
+    """Panorama -> belief -> fix; else drive along the corridor towards signs, and retry.
+    After a drive, the panorama is skipped where it cannot tell the belief's likely places
+    apart (``LookTellsNothing``)."""
     cfg = ctx.config.tree
-    once = Sequence(
-        f"{name}Once",
+    look = Selector(
+        f"{name}LookOrNot",
         memory=True,
         children=[
-            panorama_subtree(ctx, name),
-            UpdateBelief(f"{name}Belief", ctx),
-            FixFromBelief(f"{name}Fix", ctx),
+            LookTellsNothing(f"{name}LookTellsNothing", ctx),
+            Sequence(
+                f"{name}Look",
+                memory=True,
+                children=[panorama_subtree(ctx, name), UpdateBelief(f"{name}Belief", ctx)],
+            ),
         ],
     )
+    once = Sequence(f"{name}Once", memory=True, children=[look, FixFromBelief(f"{name}Fix", ctx)])
     explore = Sequence(
         f"{name}Explore",
         memory=True,

@@ -80,6 +80,10 @@ TELLING_COVER = 0.8  # ... holding this much of the belief between them
 TELLING_REACH_M = 60.0  # look for a telling place this far along the corridors
 LEG_OFF_LINE_M = 0.25  # ... and this much more: the robot is beside a path's run
 TELLING_LOOKED_M = 1.5  # a place this close to an earlier glimpse was looked from
+# A look round shows the free floor along every bearing (to MAX_RAY_M): two places whose
+# map floor differs by less than this along each of these bearings look alike.
+LOOK_ALIKE_M = 1.0
+LOOK_BEARINGS = np.radians(np.arange(0.0, 360.0, 15.0))
 
 
 @dataclass(frozen=True)
@@ -151,6 +155,7 @@ class CorridorBelief:
             [self.pm.segments[p.segment - 1].width / 2.0 for p in self.vis.lattice_points]
         )
         shapely.prepare(self._floor)
+        self._walls = self.vis.corridors.boundary  # where a ray along the floor ends
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs
@@ -353,6 +358,15 @@ class CorridorBelief:
         for yaw, free in r.free:
             self._weigh_free(tfs, here, r.odom, yaw, free, P_DRIVE_RAY)
 
+    def _blocked_log(self, tfs: np.ndarray, xy, blocked: float) -> np.ndarray:
+        """Log-weights for a drive blocked from ``xy`` heading ``blocked`` (straightened
+        odometry): a hypothesis under which the corridor goes on ``BLOCK_PROBE_M`` ahead
+        is unlikely."""
+        d = BLOCK_PROBE_M
+        probe = _apply_many(tfs, (xy[0] + d * math.cos(blocked), xy[1] + d * math.sin(blocked)))
+        pn, poff = self.vis.nearest_many(probe)
+        return np.where(poff <= self._half_width[pn], math.log(P_THROUGH_WALL), 0.0)
+
     def _weigh_depth(self, g: Glimpse, tfs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Reweigh by what a glimpse saw in depth (and where it was): the robot inside a
         wall, a blocked drive, walls close ahead, free floor along each ray. Returns where
@@ -363,12 +377,7 @@ class CorridorBelief:
         # A hypothesis that puts the robot inside a wall is unlikely.
         self.logw += np.where(off > half + OFF_CORRIDOR_M, math.log(P_THROUGH_WALL), 0.0)
         if g.blocked is not None:  # the corridor must end (or turn) just ahead
-            d = BLOCK_PROBE_M
-            probe = _apply_many(
-                tfs, (g.odom.x + d * math.cos(g.blocked), g.odom.y + d * math.sin(g.blocked))
-            )
-            pn, poff = self.vis.nearest_many(probe)
-            self.logw += np.where(poff <= self._half_width[pn], math.log(P_THROUGH_WALL), 0.0)
+            self.logw += self._blocked_log(tfs, (g.odom.x, g.odom.y), g.blocked)
         # Depth: a wall close ahead of a view must be a wall on the map; the free floor seen
         # along each view (the whole ray, e.g. into a side corridor) must be floor on it.
         for yaw, free in g.free:
@@ -494,14 +503,69 @@ class CorridorBelief:
     def sign_in_reach(self, odom: Pose2D) -> float:
         """The share of the belief under which the map puts a sign within reliable reading
         range of ``odom`` (1 with no glimpse yet): near 0 in a bare stretch, where looking
-        harder round the same spot reads nothing."""
+        harder round the same spot reads nothing. A drive just blocked here counts (a
+        dead end is no junction with signs round it)."""
         if self.ref is None:
             return 1.0
         w = self.weights()
         p = self._straighten((odom.x, odom.y))
-        near, _ = self.goal.nearest_many(_apply_many(self._map_T_odom(), (p[0], p[1])))
+        tfs = self._map_T_odom()
+        if self.pending_blocked is not None:  # the drive here just met a wall: count it
+            w = w * np.exp(self._blocked_log(tfs, p, self.pending_blocked - self._drift))
+            w = w / w.sum()
+        near, _ = self.goal.nearest_many(_apply_many(tfs, (p[0], p[1])))
         pts = self.goal.lattice_points
         return float(w[np.array([bool(pts[j].readable) for j in near])].sum())
+
+    def look_tells(self, odom: Pose2D) -> bool:
+        """Whether a look round from ``odom`` can tell the belief's likely places apart.
+
+        False when no place holds ``FIX_MASS`` of the belief, no sign is within sight
+        under any likely hypothesis (those a telling place tells apart), and every
+        cluster of them has one whose map shows the same free floor round about as the
+        likeliest (``LOOK_ALIKE_M`` along every bearing, to ``MAX_RAY_M``): the mirror
+        images of a symmetric junction, or places along a bare corridor. There a look
+        costs a full turn and cannot move the belief from one cluster to another. True
+        before the first glimpse, and after a blocked drive (its wall is told at the
+        look)."""
+        if self.ref is None or self.pending_blocked is not None:
+            return True
+        _, mass = self.best_cluster()
+        if mass >= FIX_MASS:  # one place: a look may read the sign that fixes it
+            return True
+        w = self.weights()
+        idx = np.argsort(-w)
+        idx = idx[w[idx] >= TELLING_MIN_WEIGHT * w[idx[0]]]
+        modes = self._modes(idx)
+        tfs = self._map_T_odom()
+        p = self._straighten((odom.x, odom.y))
+        here = _apply_many(tfs[idx], (p[0], p[1]))
+        near, _ = self.vis.nearest_many(here)
+        if any(self.vis.lattice_points[j].readable for j in near):
+            return True
+        if len(modes) < 2:
+            return False
+        yaw = odom.yaw - self._drift
+        at = {int(i): k for k, i in enumerate(idx)}
+
+        def floor(i: int) -> np.ndarray:
+            return self._floor_round(here[at[i]], tfs[i][2] + yaw)
+
+        # Told apart when some cluster has no member (a step along its corridor, maybe)
+        # that would see what the likeliest place sees.
+        ref = floor(modes[0][0])
+        alike = (any((np.abs(floor(i) - ref) <= LOOK_ALIKE_M).all() for i in m) for m in modes[1:])
+        return not all(alike)
+
+    def _floor_round(self, xy: np.ndarray, heading: float) -> np.ndarray:
+        """The free floor (m, to ``MAX_RAY_M``) the map has round ``xy`` (map) along
+        ``LOOK_BEARINGS`` from ``heading``: what a look round from there shows in depth."""
+        a = heading + LOOK_BEARINGS
+        ends = np.asarray(xy) + MAX_RAY_M * np.stack([np.cos(a), np.sin(a)], 1)
+        rays = shapely.linestrings(np.stack([np.broadcast_to(xy, ends.shape), ends], 1))
+        hits = shapely.intersection(rays, self._walls)
+        d = shapely.distance(shapely.Point(xy), hits)
+        return np.where(np.isnan(d), MAX_RAY_M, np.minimum(d, MAX_RAY_M))
 
     def lead(self, odom: Pose2D, max_distance: float = 8.0) -> Lead | None:
         """Where to drive from ``odom``: one of the ways out along the corridor axis (or

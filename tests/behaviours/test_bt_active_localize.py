@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from pmnav_bt.map.generate import generate_sign_sparse
@@ -64,3 +65,56 @@ def test_before_the_first_glimpse_the_map_says_if_the_views_between_are_worth_a_
     near = next(p for p in vis.lattice_points if len(p.readable) >= 2)
     rig.set(map_T_odom=(near.xy[0] - start.x, near.xy[1] - start.y, 0.0))  # "we are there"
     rig.expect(rig.run(NoSignInReach("NoSignInReach", rig.ctx)), Status.FAILURE)
+
+
+def _bare_far_from_ends(pm, b) -> list[int]:
+    """Hypotheses (facing along their corridor) that put the robot on a bare stretch: no
+    sign in sight and 9 m or more from any junction or end."""
+    vis = Visibility.of(pm)
+    ends = np.array([pm.node_xy(n) for n in pm.nodes])
+    pts = vis.lattice_points
+    return [
+        i
+        for i in range(len(b.lattice))
+        if not pts[b.lattice[i]].readable
+        and np.linalg.norm(ends - b.xy[i], axis=1).min() >= 9.0
+        and abs(
+            math.remainder(b.yaw[i] - pm.segments[pts[b.lattice[i]].segment - 1].heading, math.pi)
+        )
+        < 0.1
+    ]
+
+
+@pytest.mark.parametrize("drive_end", ["covered", "rethought", "wall ahead", "sign ahead", None])
+def test_a_look_round_is_skipped_only_where_it_cannot_tell_and_after_a_plain_drive(
+    make_rig, pm, drive_end
+):
+    """``LookTellsNothing``: with the belief split between two bare stretches (what a look
+    shows there is the same), after a drive that covered its lead or turned for another
+    way the look is skipped; after one that met a wall or saw a sign ahead, it is taken.
+    Either way ``drive_end`` is cleared (one skip per drive). With a third place at a
+    junction (its floor looks different), it is taken."""
+    from py_trees.common import Status
+
+    from pmnav_bt.behaviours.active_localize import LookTellsNothing
+    from pmnav_bt.pose.belief import CorridorBelief, Glimpse
+
+    start = Pose2D(60.0, 45.0, math.radians(90.0))
+    rig = make_rig(start)
+    b = CorridorBelief(pm)
+    b.observe(Glimpse(start, {}), axis_odom=start.yaw)
+    bare = _bare_far_from_ends(pm, b)
+    assert len(bare) >= 2
+    far = max(bare, key=lambda i: np.linalg.norm(b.xy[i] - b.xy[bare[0]]))
+    b.logw[:] = -50.0
+    b.logw[[bare[0], far]] = 0.0  # two far-apart bare stretches, equally likely
+    rig.set(belief=b, drive_end=drive_end)
+    skip = drive_end in ("covered", "rethought")
+    look = LookTellsNothing("LookTellsNothing", rig.ctx)
+    rig.expect(rig.run(look), Status.SUCCESS if skip else Status.FAILURE)
+    assert rig.get("drive_end") is None
+    if skip:  # a third place, at a junction: the look can tell it from the others
+        junction = next(i for i in range(len(b.lattice)) if len(b.vis.exits[b.lattice[i]]) >= 3)
+        b.logw[junction] = 0.0
+        rig.set(drive_end=drive_end)
+        rig.expect(rig.run(LookTellsNothing("LookTellsNothing", rig.ctx)), Status.FAILURE)

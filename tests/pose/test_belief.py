@@ -824,3 +824,59 @@ def test_a_look_round_from_beside_a_wall_is_weighed_from_the_centre_line(moved_t
     here = _apply(b._map_T_odom()[idx], (odom.x, odom.y)).mean(axis=0)
     at_branch3 = math.hypot(here[0] - truth[0], here[1] - truth[1]) < 1.5
     assert at_branch3 == moved_to_centre, here
+
+
+def _look(pm, true, odom_xy, blocked=None) -> Glimpse:
+    """A panorama at ``true`` (map pose) with the robot at ``odom_xy`` in odometry: no
+    sign read, the free floor along each view's thin rays (as ``read_panorama`` gives)."""
+    yaw = true[2] + ODOM_T_MAP[2]
+    rays = [math.radians(60.0 * v) + b for v in range(6) for b in FREE_BEARINGS]
+    free = tuple((yaw + a, _free(pm, true, true[2] + a, 0.05, RAY_HALF_WIDTH_M)) for a in rays)
+    return Glimpse(Pose2D(odom_xy[0], odom_xy[1], yaw), {}, blocked, free)
+
+
+def _drive_rays(pm, b: CorridorBelief, true, odom_xy, distance: float) -> tuple[float, float]:
+    """Drive ``distance`` straight on from ``true`` (map pose; odometry ``odom_xy``), a
+    depth ray and the walls' axis a metre to the belief; the odometry position at the end."""
+    (x, y, h), step = true, 0.25
+    yaw = h + ODOM_T_MAP[2]
+    for i in range(1, int(distance / step) + 1):
+        odom = Pose2D(
+            odom_xy[0] + i * step * math.cos(yaw), odom_xy[1] + i * step * math.sin(yaw), yaw
+        )
+        if i % 4 == 0:
+            here = (x + i * step * math.cos(h), y + i * step * math.sin(h), h)
+            b.observe_ray(odom, _free(pm, here, h), yaw)
+    return odom.x, odom.y
+
+
+def test_a_look_round_that_cannot_tell_the_places_apart_is_not_worth_taking():
+    """sign_sparse_2 hard #15: a start 4 m south of the cross, a look at the cross (any of
+    its four arms), the south arm's dead end (north or south arm: mirror images), and
+    back at the cross the two hypotheses stand at the same cross facing opposite ways,
+    with no sign in sight: a look there shows the same under both (it did, and left them
+    50/50), so it is not worth its full turn. At the dead end, before its look, it was
+    (an arm's end is a dead end under two of the four hypotheses, a junction under the
+    others); before any look, and after a blocked drive, a look is always taken."""
+    pm = parse_building(generate_sign_sparse(2))
+    south, north = -math.pi / 2, math.pi / 2
+    b = CorridorBelief(pm)
+    assert b.look_tells(Pose2D(0.0, 0.0, 0.0))  # no glimpse yet
+    start = se2_apply(ODOM_T_MAP, (30.0, 26.0))
+    b.observe(g := _look(pm, (30.0, 26.0, north), start), axis_odom=g.odom.yaw)
+    cross = _drive_rays(pm, b, (30.0, 26.0, north), start, 4.0)
+    b.observe(g := _look(pm, (30.0, 30.0, south), cross), axis_odom=g.odom.yaw)
+    end = _drive_rays(pm, b, (30.0, 30.0, south), cross, 28.25)
+    facing_end = Pose2D(*end, south + ODOM_T_MAP[2])
+    assert b.look_tells(facing_end)  # a dead end under two hypotheses, a junction under two
+    b.pending_blocked = facing_end.yaw
+    assert b.look_tells(facing_end)  # a blocked drive is told at a look
+    b.observe(g := _look(pm, (30.0, 1.75, north), end), axis_odom=g.odom.yaw)
+    back = _drive_rays(pm, b, (30.0, 1.75, north), end, 28.25)
+    _, mass = b.best_cluster()
+    assert mass == pytest.approx(0.5, abs=0.05)  # the cross, from the north or the south
+    assert not b.look_tells(Pose2D(*back, north + ODOM_T_MAP[2]))
+    # The look it skips would indeed have left the belief as it was.
+    b.observe(g := _look(pm, (30.0, 30.0, north), back), axis_odom=g.odom.yaw)
+    _, after = b.best_cluster()
+    assert after == pytest.approx(mass, abs=0.05)
