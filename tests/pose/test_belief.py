@@ -880,3 +880,32 @@ def test_a_look_round_that_cannot_tell_the_places_apart_is_not_worth_taking():
     b.observe(g := _look(pm, (30.0, 30.0, north), back), axis_odom=g.odom.yaw)
     _, after = b.best_cluster()
     assert after == pytest.approx(mass, abs=0.05)
+
+
+def test_a_drive_blocked_here_counts_in_the_share_of_the_belief_with_signs_in_reach():
+    """At the end of sign_sparse_2's south arm, facing its end wall, the belief split
+    between that dead end (no sign) and a metre short of branch3 in the east arm
+    (room13's plate in reach): half of it puts a sign in reach. A drive just blocked here
+    says the corridor ends ahead, as it does not short of branch3: the share falls near 0,
+    and the views between a panorama's (a plate cut on a seam) are not worth their turn.
+    (Under a hypothesis that puts the robot at a junction's far wall the block tells
+    nothing: there the panorama's depth does.)"""
+    pm = parse_building(generate_sign_sparse(2))
+    b = CorridorBelief(pm, lead_range=3.5)
+    here = (30.0, 0.0, -math.pi / 2)
+    g = glimpse(pm, here, ())
+    b.observe(g, axis_odom=g.odom.yaw)
+    odom = Pose2D(*se2_compose(ODOM_T_MAP, here))
+    put = b._map_T_odom()
+    where = _apply(put, (b.ref.x, b.ref.y))
+    turn = put[:, 2] + b.ref.yaw
+
+    def hypothesis(xy, yaw):
+        off = np.linalg.norm(where - xy, axis=1) + np.abs(np.angle(np.exp(1j * (turn - yaw))))
+        return int(np.argmin(off))
+
+    b.logw[:] = -50.0
+    b.logw[[hypothesis((30.0, 0.0), -math.pi / 2), hypothesis((59.0, 30.0), 0.0)]] = 0.0
+    assert b.sign_in_reach(odom) == pytest.approx(0.5, abs=0.01)
+    b.pending_blocked = odom.yaw
+    assert b.sign_in_reach(odom) < 0.05
