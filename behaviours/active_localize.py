@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from enum import StrEnum
 
 import numpy as np
 from py_trees.common import Status
@@ -234,16 +235,19 @@ class NoSignInReach(PmNavBehaviour):
         return Status.SUCCESS if share < NO_SIGN_SHARE else Status.FAILURE
 
 
-# How a FollowLead drive ended (``drive_end``): after these, a look round that cannot
-# tell the belief's places apart is skipped; after a wall met or a sign seen ahead, never.
-DRIVE_COVERED, DRIVE_RETHOUGHT, DRIVE_SIGN, DRIVE_WALL, DRIVE_BLOCKED = (
-    "covered",
-    "rethought",
-    "sign ahead",
-    "wall ahead",
-    "blocked",
-)
-SKIPPABLE_ENDS = (DRIVE_COVERED, DRIVE_RETHOUGHT)
+class DriveEnd(StrEnum):
+    """How a FollowLead drive ended (``drive_end``)."""
+
+    COVERED = "covered"
+    RETHOUGHT = "rethought"  # the belief chose another way on the drive
+    SIGN = "sign ahead"
+    WALL = "wall ahead"
+    BLOCKED = "blocked"
+
+
+# After these a look round that cannot tell the belief's places apart is skipped; after a
+# wall met or a sign seen ahead, never.
+SKIPPABLE_ENDS = (DriveEnd.COVERED, DriveEnd.RETHOUGHT)
 
 
 class LookTellsNothing(PmNavBehaviour):
@@ -552,7 +556,7 @@ class FollowLead(PmNavBehaviour):
             backed = math.hypot(pose.x - x, pose.y - y) >= BACKUP_LIMIT_M - 0.01
             if refused or backed or now - t > 5.0:
                 base.set_velocity(0.0, 0.0)
-                self.bb.set("drive_end", DRIVE_BLOCKED)
+                self.bb.set("drive_end", DriveEnd.BLOCKED)
                 return Status.SUCCESS
             base.set_velocity(-0.1, 0.0)
             self._backing = (x, y, t, True)
@@ -574,12 +578,12 @@ class FollowLead(PmNavBehaviour):
         done_m = math.hypot(pose.x - self._start[0], pose.y - self._start[1])
         if done_m >= self._distance:
             base.set_velocity(0.0, 0.0)
-            self.bb.set("drive_end", DRIVE_SIGN if self._sign_stop else DRIVE_COVERED)
+            self.bb.set("drive_end", DriveEnd.SIGN if self._sign_stop else DriveEnd.COVERED)
             return Status.SUCCESS
         if self._rethink(pose):
             # The belief now says another way: look again from here.
             base.set_velocity(0.0, 0.0)
-            self.bb.set("drive_end", DRIVE_RETHOUGHT)
+            self.bb.set("drive_end", DriveEnd.RETHOUGHT)
             self.feedback_message = f"after {done_m:.1f} m the belief says another way: look again"
             return Status.SUCCESS
         ahead = [a for a in self._signs_ahead if a > SIGN_STOP_M]  # nearer: read already
@@ -606,7 +610,7 @@ class FollowLead(PmNavBehaviour):
             if belief is not None:
                 belief.pending_blocked = self._heading
             self.feedback_message = f"a wall ahead after {done_m:.1f} m: the corridor ends"
-            self.bb.set("drive_end", DRIVE_WALL)
+            self.bb.set("drive_end", DriveEnd.WALL)
             return Status.SUCCESS
         if base.motion_status() == MotionStatus.BLOCKED or stuck:
             base.stop()

@@ -155,7 +155,6 @@ class CorridorBelief:
             [self.pm.segments[p.segment - 1].width / 2.0 for p in self.vis.lattice_points]
         )
         shapely.prepare(self._floor)
-        self._walls = self.vis.corridors.boundary  # where a ray along the floor ends
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs
@@ -533,10 +532,7 @@ class CorridorBelief:
         _, mass = self.best_cluster()
         if mass >= FIX_MASS:  # one place: a look may read the sign that fixes it
             return True
-        w = self.weights()
-        idx = np.argsort(-w)
-        idx = idx[w[idx] >= TELLING_MIN_WEIGHT * w[idx[0]]]
-        modes = self._modes(idx)
+        _, idx, modes = self._likely_modes()
         tfs = self._map_T_odom()
         p = self._straighten((odom.x, odom.y))
         here = _apply_many(tfs[idx], (p[0], p[1]))
@@ -563,7 +559,7 @@ class CorridorBelief:
         a = heading + LOOK_BEARINGS
         ends = np.asarray(xy) + MAX_RAY_M * np.stack([np.cos(a), np.sin(a)], 1)
         rays = shapely.linestrings(np.stack([np.broadcast_to(xy, ends.shape), ends], 1))
-        hits = shapely.intersection(rays, self._walls)
+        hits = shapely.intersection(rays, self.vis.walls)
         d = shapely.distance(shapely.Point(xy), hits)
         return np.where(np.isnan(d), MAX_RAY_M, np.minimum(d, MAX_RAY_M))
 
@@ -718,6 +714,14 @@ class CorridorBelief:
             and math.hypot(g.odom.x - p[0], g.odom.y - p[1]) < BLOCKED_NEAR_M
         }
 
+    def _likely_modes(self) -> tuple[np.ndarray, np.ndarray, list[list[int]]]:
+        """The weights, the hypotheses at least ``TELLING_MIN_WEIGHT`` as likely as the best
+        (best first), and their clusters: the places a look must tell apart."""
+        w = self.weights()
+        idx = np.argsort(-w)
+        idx = idx[w[idx] >= TELLING_MIN_WEIGHT * w[idx[0]]]
+        return w, idx, self._modes(idx)
+
     def _modes(self, idx: np.ndarray) -> list[list[int]]:
         """Hypotheses ``idx`` (best first) grouped greedily into clusters."""
         modes: list[list[int]] = []
@@ -744,10 +748,7 @@ class CorridorBelief:
         across the axis; None when no such place is in reach or the belief is not split."""
         if self.ref is None:
             return None
-        w = self.weights()
-        idx = np.argsort(-w)
-        idx = idx[w[idx] >= TELLING_MIN_WEIGHT * w[idx[0]]]
-        modes = self._modes(idx)
+        w, idx, modes = self._likely_modes()
         mass = np.array([w[m].sum() for m in modes])
         if (
             len(modes) < 2

@@ -113,6 +113,11 @@ class Visibility:
         shapely.prepare(poly)
         return poly
 
+    @cached_property
+    def walls(self):
+        """The corridor floor's outline: where a ray along the floor ends."""
+        return self.corridors.boundary
+
     def _inset(self, p: np.ndarray) -> np.ndarray:
         loc = self.pm.locate(float(p[0]), float(p[1]))
         c = loc.point(self.pm)
