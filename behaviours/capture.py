@@ -2,8 +2,9 @@
 
 Used for localization (30, 90, ..., 330 deg) and for search (0, +-30, +-60, +-90 deg
 minus the view the last action rules out, centred on the target when the map puts it
-off to a side: ``search_centre``). Frames are taken and grounded in the
-worker; the tick only steers and polls.
+off to a side: ``search_centre``; taken nearest the target's bearing first:
+``nearest_first``). Frames are taken and grounded in the worker; the tick only steers
+and polls.
 """
 
 from __future__ import annotations
@@ -52,6 +53,22 @@ def sweep_order(yaws: list[float]) -> list[float]:
     if not ys:
         return ys
     return ys if abs(ys[0]) <= abs(ys[-1]) else ys[::-1]
+
+
+def nearest_first(yaws: list[float], bearing: float) -> list[float]:
+    """The search views in the order to take them: first the one nearest ``bearing`` (the
+    target's, by the map; a search that stops once the target is seen mostly ends there),
+    then on outwards to the side the bearing leans from it, then the other side (on a
+    tie, the side with fewer views first: fewer turns back). Turning to the nearer
+    extreme first and sweeping across passes the likeliest view only halfway through."""
+    ys = sorted(yaws)
+    if not ys:
+        return ys
+    i = min(range(len(ys)), key=lambda k: abs(wrap_angle(ys[k] - bearing)))
+    up, down = ys[i + 1 :], ys[:i][::-1]
+    lean = wrap_angle(bearing - ys[i])
+    up_first = lean > 0 if lean != 0 else len(up) <= len(down)
+    return [ys[i], *(up + down if up_first else down + up)]
 
 
 class CaptureViews(PmNavBehaviour):

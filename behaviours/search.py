@@ -36,12 +36,14 @@ def target_entity(b: PmNavBehaviour) -> Entity | None:
 
 def target_bearing(b: PmNavBehaviour) -> float:
     """The current target's bearing by the map from the estimated pose, relative to the
-    heading (rad; 0 without a target or a pose estimate)."""
+    heading (rad; 0 without a target or a pose estimate): towards its door or landmark
+    (where the sign is), else its node on the centre line (from level with the node, the
+    node's own bearing says nothing)."""
     t, tf = b.get("target"), b.get("map_T_odom")
     if t is None or tf is None:
         return 0.0
     est = map_pose(tf, b.ctx.base.pose())
-    x, y = float(t.position[0]), float(t.position[1])
+    x, y = (float(v) for v in (t.target if t.target is not None else t.position))
     return wrap_angle(math.atan2(y - est.y, x - est.x) - est.yaw)
 
 

@@ -14,7 +14,7 @@ from py_trees.behaviours import Failure as AlwaysFail
 from py_trees.composites import Parallel, Selector, Sequence
 from py_trees.decorators import FailureIsSuccess, Repeat, Retry
 
-from pmnav_bt.behaviours.capture import CaptureViews, search_centre, search_yaws
+from pmnav_bt.behaviours.capture import CaptureViews, nearest_first, search_centre, search_yaws
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.decorators import ClockTimeout
@@ -59,6 +59,13 @@ def localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour
     return active_localize_subtree(ctx, name)
 
 
+def search_views(b: py_trees.behaviour.Behaviour) -> list[float]:
+    """The search views (rad from the heading): the paper's, centred on the target when the
+    map puts it aside, taken nearest its bearing first."""
+    bearing = target_bearing(b)
+    return nearest_first(search_yaws(b.get("last_action"), search_centre(bearing)), bearing)
+
+
 def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
     """One plan step: target determination, then search-verify-approach for a visible
     target or drive-turn-check for an unseen turn or fork, then target update."""
@@ -83,10 +90,10 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
             CaptureViews(
                 "SearchViews",
                 ctx,
-                # the paper's views, centred on the target when the map puts it aside
-                lambda b: search_yaws(b.get("last_action"), search_centre(target_bearing(b))),
+                search_views,
                 target_entity,
                 enough=lambda views: any(d.score >= 0.5 for d in views[-1].detections or ()),
+                sweep=False,
             ),
             CoarseDirection("CoarseDirection", ctx),
             # coarse-only (Table 4): no grounding and no refinement of the view direction

@@ -13,6 +13,7 @@ from pmnav_bt.behaviours.capture import (
     LOCALIZATION_YAWS_DEG,
     SEARCH_YAWS_DEG,
     CaptureViews,
+    nearest_first,
     search_centre,
     search_yaws,
     sweep_order,
@@ -70,6 +71,25 @@ def test_sweep_order_starts_at_the_nearer_extreme():
     assert sweep_order([r(0), r(-30), r(60)]) == [r(-30), r(0), r(60)]
     left = sweep_order(search_yaws(Action.TURN_LEFT))  # -90 left out: start at -60
     assert [round(math.degrees(y)) for y in left] == [-60, -30, 0, 30, 60, 90]
+
+
+def test_search_views_are_taken_nearest_the_targets_bearing_first():
+    """The view nearest the bearing, then outwards on the side it leans to, then the other
+    side; a bearing on a view: the side with fewer views first (fewer turns back)."""
+    r = math.radians
+
+    def order(yaws, bearing_deg):
+        return [round(math.degrees(y)) for y in nearest_first(yaws, r(bearing_deg))]
+
+    paper = search_yaws(None)
+    assert order(paper, 0) == [0, 30, 60, 90, -30, -60, -90]
+    assert order(paper, 20) == [30, 0, -30, -60, -90, 60, 90]  # 20 leans back towards 0
+    assert order(paper, -50) == [-60, -30, 0, 30, 60, 90, -90]
+    assert order(search_yaws(Action.TURN_LEFT), 0) == [0, -30, -60, 30, 60, 90]
+    assert order([], 0) == []
+    # Centred on a target behind the robot: views past +-180 deg, nearest by the angle.
+    behind = search_yaws(None, search_centre(r(-170)))
+    assert order(behind, 175) == [-180, -210, -240, -270, -150, -120, -90]
 
 
 def test_capture_turns_through_the_yaws_taking_one_view_at_each(make_rig):

@@ -21,6 +21,7 @@ from pmnav_bt.behaviours.search import (
     FineDirection,
     Ground,
     Verify,
+    target_bearing,
     target_entity,
 )
 from pmnav_bt.failures import FailureCode
@@ -29,10 +30,12 @@ from pmnav_bt.localization import Sighting
 from pmnav_bt.perception.coarse import DetectorCoarseDirection
 from pmnav_bt.planning.resolve import sign_text
 from pmnav_bt.seams import CoarseChoice, Entity, Pose2D
+from pmnav_bt.trees.pmnav import step_subtree
 
 # On the start-turn1 corridor facing south, 4.5 m short of room4's door.
 NORTH_OF_ROOM4 = Pose2D(0.0, 26.5, math.radians(-90))
 ROOM4_DOOR = (1.2, 22.0)
+NEARER_ROOM4 = Pose2D(0.0, 25.0, math.radians(-90))  # 3 m short: read at 160 px
 
 
 def targets(rig) -> dict:
@@ -154,6 +157,34 @@ def test_ground_terminate_while_turning_stops_the_base(make_rig):
     assert rig.body.velocity_command != (0.0, 0.0)
     ground.stop(Status.INVALID)
     assert rig.stopped()
+
+
+def test_the_tree_searches_first_where_the_map_puts_the_target(make_rig):
+    """The tree's search views start at the one nearest the target's bearing by the map and
+    stop once it is seen: room4's door, 3 m ahead and 1.2 m to the left (22 deg), is read in
+    the first view, at +30 deg, one turn (the paper's sweep turns to -90 first and reaches
+    +30 at the fifth view)."""
+    rig = make_rig(NEARER_ROOM4)
+    rig.set(target=targets(rig)["room4"], map_T_odom=(0.0, 0.0, 0.0))
+    cap = next(n for n in step_subtree(rig.ctx).iterate() if n.name == "SearchViews")
+    rig.expect(rig.run(cap, max_ticks=300), Status.SUCCESS)
+    views = rig.get("views")
+    assert [rel_deg(v) for v in views] == [30]
+    assert any(d.label == "104 Laboratory" for d in views[0].detections)
+    turned = rig.true_pose().yaw - NEARER_ROOM4.yaw
+    assert rig.yaw_error(turned, math.radians(30)) < math.radians(2)
+
+
+def test_the_target_bearing_points_at_its_door_not_its_node(make_rig):
+    """Just past room4's node, facing on south: the door (where the sign is) is on the left,
+    a little behind, while the node on the centre line lies straight behind."""
+    rig = make_rig(Pose2D(0.0, 21.7, math.radians(-90)))
+    step = targets(rig)["room4"]
+    assert step.position[1] == pytest.approx(22.0) and step.target == ROOM4_DOOR
+    rig.set(target=step, map_T_odom=(0.0, 0.0, 0.0))
+    cap = CaptureViews("SearchViews", rig.ctx, lambda b: [], target_entity)
+    want = math.atan2(0.3, 1.2) + math.radians(90)  # the door, from the heading
+    assert target_bearing(cap) == pytest.approx(want, abs=0.02)
 
 
 def fine_and_verify(rig, map_T_odom):
