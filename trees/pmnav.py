@@ -9,6 +9,8 @@ the coarse view direction and uses no refiner at all.
 
 from __future__ import annotations
 
+import math
+
 import py_trees
 from py_trees.behaviours import Failure as AlwaysFail
 from py_trees.composites import Parallel, Selector, Sequence
@@ -75,7 +77,9 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
     ranges = SearchRanges(ctx.config, ctx.pm.building)
 
     def search_range(b) -> float:
-        return ranges.of(target_entity(b)).search_range
+        t = b.get("target")
+        across = None if t.target is None else math.dist(t.target, t.position)
+        return ranges.search_range_to(target_entity(b), across)
 
     def research_distance(b) -> float:
         return ranges.of(target_entity(b)).research_distance

@@ -26,6 +26,8 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from pmnav_bt.seams import EntityKind
+
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.config import Config
     from pmnav_bt.map.building import Building
@@ -68,6 +70,12 @@ MAX_RESEARCH_DISTANCE_M = 2.0
 # A door's sign hangs beside it and the robot drives the corridor's centre: search from
 # this much nearer than the read range.
 SEARCH_MARGIN_M = 0.5
+# ... and on either side of it (``grounder.sign_to_door`` from it): search from where a
+# sign on the far side is seen within this angle of its plate's normal (ANGLE_RECALL keeps
+# the full recall to 70 deg; the margin is for a robot off the centre line), no nearer
+# than MIN_ABREAST_M before level with the door.
+MAX_SEARCH_ANGLE_DEG = 65.0
+MIN_ABREAST_M = 0.5
 
 
 def plate_kind(text: str) -> str:
@@ -245,16 +253,40 @@ def landmark_ranges(config: Config) -> dict[str, float] | None:
     return {k: sign_read_range(config, kind=k) for k in PLATE_KINDS}
 
 
+def abreast_range(across: float, beside: float) -> float:
+    """How far before level with a door (m, along the corridor's centre line) its sign is
+    seen within ``MAX_SEARCH_ANGLE_DEG`` of the plate's normal on whichever side of the
+    door it hangs: the wall ``across`` m off the centre line, the sign ``beside`` m along it
+    from the door (at least ``MIN_ABREAST_M``). From farther, a sign on the far side is
+    seen along its wall, where the reader names none (``ANGLE_RECALL``)."""
+    reach = across * math.tan(math.radians(MAX_SEARCH_ANGLE_DEG)) - beside
+    return max(MIN_ABREAST_M, reach)
+
+
 class SearchRanges:
     """The tree's search distances per plate kind (``search_settings``), looked up by the
-    entity a step looks for: how close to go to read that entity's sign."""
+    entity a step looks for: how close to go to read that entity's sign. For a reader
+    (not the oracle) and a search range not set in the config, a room's search range is
+    also at most its ``abreast_range`` (``search_range_to``)."""
 
     def __init__(self, config: Config, building: Building, width: int | None = None):
         self.building = building
         self.by_kind = {k: search_settings(config, width, k) for k in PLATE_KINDS}
         self.default = search_settings(config, width)
+        angled = not _oracle(config) and config.tree.search_range is None
+        self.beside = config.grounder.sign_to_door if angled else None
 
     def of(self, entity: Entity | None) -> SearchSettings:
         if entity is None:
             return self.default
         return self.by_kind[entity_plate_kind(self.building, entity)]
+
+    def search_range_to(self, entity: Entity | None, across: float | None) -> float:
+        """How close (m, to its node) to go before searching for ``entity``'s sign: its
+        plate kind's search range, and for a room whose door is ``across`` m off the
+        centre line at most its ``abreast_range``."""
+        search = self.of(entity).search_range
+        room = entity is not None and entity.kind == EntityKind.ROOM
+        if self.beside is None or across is None or not room:
+            return search
+        return min(search, abreast_range(across, self.beside))

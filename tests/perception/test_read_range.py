@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from pmnav_bt.config import load_config
 from pmnav_bt.perception.read_range import (
+    MAX_SEARCH_ANGLE_DEG,
+    MIN_ABREAST_M,
+    abreast_range,
     ocr_read_range,
     plate_kind,
     reading_width,
@@ -94,10 +99,13 @@ def test_the_built_tree_uses_them(fig2_map):
 
     from pmnav_bt.trees.pmnav import step_subtree
 
-    def keeps(cfg, look_for: str) -> dict[str, tuple[float, float]]:
+    def keeps(cfg, look_for: str, across: float | None = None) -> dict[str, tuple[float, float]]:
+        """The search distances the tree's behaviours take for a step looking for
+        ``look_for``, its door ``across`` m off the centre line (None: no door)."""
         ctx = SimpleNamespace(config=cfg, now=lambda: 0.0, refiner=None, pm=fig2_map)
         root = step_subtree(ctx)
-        target = SimpleNamespace(look_for=look_for)
+        door = None if across is None else (across, 0.0)
+        target = SimpleNamespace(look_for=look_for, position=(0.0, 0.0), target=door)
         out = {}
         for b in root.iterate():
             if b.name in ("IntoSearchRange", "MoveOn"):
@@ -112,3 +120,26 @@ def test_the_built_tree_uses_them(fig2_map):
     assert got["IntoSearchRange"][0] == 2.0 and got["MoveOn"] == (0.0, 1.0)
     got = keeps(load_config(None, ["grounder.backend=ocr", "sim.reading_width=0"]), "room5")
     assert got["IntoSearchRange"][0] == 2.0 and got["MoveOn"] == (0.0, 1.0)
+    # A door 1.2 m off the centre line: nearer still, where a sign hanging on its far side
+    # is seen within 65 deg of its plate (1.2 tan 65 - 1.14 m before level with the door).
+    abreast = abreast_range(1.2, 1.14)
+    assert abreast == pytest.approx(1.43, abs=0.01)
+    assert keeps(ocr, "room5", across=1.2)["IntoSearchRange"][0] == pytest.approx(abreast)
+    assert keeps(ocr, "room17", across=1.2)["IntoSearchRange"][0] == pytest.approx(abreast)
+    assert keeps(ocr, "room5", across=3.0)["IntoSearchRange"][0] == 3.0  # a wide hall
+    # The oracle, and a search range set in the config, keep theirs.
+    oracle = load_config(None, ["grounder.backend=sim_gt"])
+    assert keeps(oracle, "room5", across=1.2)["IntoSearchRange"][0] == 4.5
+    own = load_config(None, ["grounder.backend=ocr", "tree.search_range=2.5"])
+    assert keeps(own, "room5", across=1.2)["IntoSearchRange"][0] == 2.5
+
+
+def test_a_search_reads_a_sign_on_either_side_of_its_door_from_the_abreast_range():
+    """From ``abreast_range`` before level with a door, on the centre line, a sign on its
+    far side is seen at ``MAX_SEARCH_ANGLE_DEG`` off its plate's normal (a narrow corridor:
+    no nearer than ``MIN_ABREAST_M``)."""
+    across, beside = 1.5, 1.14
+    d = abreast_range(across, beside)
+    far = math.degrees(math.atan2(d + beside, across))
+    assert far == pytest.approx(MAX_SEARCH_ANGLE_DEG)
+    assert abreast_range(0.6, beside) == MIN_ABREAST_M
