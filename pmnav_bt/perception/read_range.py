@@ -26,6 +26,7 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from pmnav_bt.geometry import side_of
 from pmnav_bt.seams import EntityKind
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -70,8 +71,8 @@ MAX_RESEARCH_DISTANCE_M = 2.0
 # A door's sign hangs beside it and the robot drives the corridor's centre: search from
 # this much nearer than the read range.
 SEARCH_MARGIN_M = 0.5
-# ... and on either side of it (``grounder.sign_to_door`` from it): search from where a
-# sign on the far side is seen within this angle of its plate's normal (ANGLE_RECALL keeps
+# ... ``grounder.sign_to_door`` from it, on the side ``grounder.door_side`` says: search
+# from where that sign is seen within this angle of its plate's normal (ANGLE_RECALL keeps
 # the full recall to 70 deg; the margin is for a robot off the centre line), no nearer
 # than MIN_ABREAST_M before level with the door.
 MAX_SEARCH_ANGLE_DEG = 65.0
@@ -255,19 +256,30 @@ def landmark_ranges(config: Config) -> dict[str, float] | None:
 
 def abreast_range(across: float, beside: float) -> float:
     """How far before level with a door (m, along the corridor's centre line) its sign is
-    seen within ``MAX_SEARCH_ANGLE_DEG`` of the plate's normal on whichever side of the
-    door it hangs: the wall ``across`` m off the centre line, the sign ``beside`` m along it
-    from the door (at least ``MIN_ABREAST_M``). From farther, a sign on the far side is
-    seen along its wall, where the reader names none (``ANGLE_RECALL``)."""
+    seen within ``MAX_SEARCH_ANGLE_DEG`` of the plate's normal, the wall ``across`` m off
+    the centre line and the sign ``beside`` m further along it than the door (negative:
+    nearer; at least ``MIN_ABREAST_M``). From farther, a sign on the far side of its door
+    is seen along its wall, where the reader names none (``ANGLE_RECALL``)."""
     reach = across * math.tan(math.radians(MAX_SEARCH_ANGLE_DEG)) - beside
     return max(MIN_ABREAST_M, reach)
+
+
+def sign_ahead(config: Config, heading: float, node, door) -> int:
+    """+1 where the building's convention (``grounder.door_side``: the side of its sign a
+    door is on, seen facing the wall) hangs the sign of ``door`` further along the way
+    than the door for a robot passing it at ``node`` heading ``heading`` (rad), -1 where
+    nearer: a door on the left of the way with its sign on the viewer's right is passed
+    after its door."""
+    left = side_of(heading, node, door) == "left"
+    sign_right = config.grounder.door_side == "left"
+    return 1 if left == sign_right else -1
 
 
 class SearchRanges:
     """The tree's search distances per plate kind (``search_settings``), looked up by the
     entity a step looks for: how close to go to read that entity's sign. For a reader
     (not the oracle) and a search range not set in the config, a room's search range is
-    also at most its ``abreast_range`` (``search_range_to``)."""
+    also at most its sign's ``abreast_range`` (``search_range_to``)."""
 
     def __init__(self, config: Config, building: Building, width: int | None = None):
         self.building = building
@@ -281,12 +293,16 @@ class SearchRanges:
             return self.default
         return self.by_kind[entity_plate_kind(self.building, entity)]
 
-    def search_range_to(self, entity: Entity | None, across: float | None) -> float:
+    def search_range_to(
+        self, entity: Entity | None, across: float | None, ahead: int | None = None
+    ) -> float:
         """How close (m, to its node) to go before searching for ``entity``'s sign: its
         plate kind's search range, and for a room whose door is ``across`` m off the
-        centre line at most its ``abreast_range``."""
+        centre line at most the ``abreast_range`` of its sign, hung ``ahead`` (+1: further
+        along the way than the door, -1: nearer; ``sign_ahead``) or, unknown (None), on
+        either side (the far side decides)."""
         search = self.of(entity).search_range
         room = entity is not None and entity.kind == EntityKind.ROOM
         if self.beside is None or across is None or not room:
             return search
-        return min(search, abreast_range(across, self.beside))
+        return min(search, abreast_range(across, self.beside * (1 if ahead is None else ahead)))

@@ -15,6 +15,7 @@ from pmnav_bt.perception.read_range import (
     plate_kind,
     reading_width,
     search_settings,
+    sign_ahead,
     sign_read_range,
     sign_visible_range,
 )
@@ -99,13 +100,18 @@ def test_the_built_tree_uses_them(fig2_map):
 
     from pmnav_bt.trees.pmnav import step_subtree
 
-    def keeps(cfg, look_for: str, across: float | None = None) -> dict[str, tuple[float, float]]:
+    def keeps(
+        cfg, look_for: str, across: float | None = None, heading: float = -math.pi / 2
+    ) -> dict[str, tuple[float, float]]:
         """The search distances the tree's behaviours take for a step looking for
-        ``look_for``, its door ``across`` m off the centre line (None: no door)."""
+        ``look_for``, its door ``across`` m east of the centre line (None: no door), the
+        robot arriving ``heading`` (default south: the door on its left)."""
         ctx = SimpleNamespace(config=cfg, now=lambda: 0.0, refiner=None, pm=fig2_map)
         root = step_subtree(ctx)
         door = None if across is None else (across, 0.0)
-        target = SimpleNamespace(look_for=look_for, position=(0.0, 0.0), target=door)
+        target = SimpleNamespace(
+            look_for=look_for, position=(0.0, 0.0), target=door, heading=heading
+        )
         out = {}
         for b in root.iterate():
             if b.name in ("IntoSearchRange", "MoveOn"):
@@ -120,13 +126,21 @@ def test_the_built_tree_uses_them(fig2_map):
     assert got["IntoSearchRange"][0] == 2.0 and got["MoveOn"] == (0.0, 1.0)
     got = keeps(load_config(None, ["grounder.backend=ocr", "sim.reading_width=0"]), "room5")
     assert got["IntoSearchRange"][0] == 2.0 and got["MoveOn"] == (0.0, 1.0)
-    # A door 1.2 m off the centre line: nearer still, where a sign hanging on its far side
-    # is seen within 65 deg of its plate (1.2 tan 65 - 1.14 m before level with the door).
+    # A door 1.2 m off the centre line on the left of the way, its sign (by the building's
+    # convention, on the viewer's right of it) further along: nearer still, where that
+    # sign is seen within 65 deg of its plate (1.2 tan 65 - 1.14 m before the door).
     abreast = abreast_range(1.2, 1.14)
     assert abreast == pytest.approx(1.43, abs=0.01)
     assert keeps(ocr, "room5", across=1.2)["IntoSearchRange"][0] == pytest.approx(abreast)
     assert keeps(ocr, "room17", across=1.2)["IntoSearchRange"][0] == pytest.approx(abreast)
     assert keeps(ocr, "room5", across=3.0)["IntoSearchRange"][0] == 3.0  # a wide hall
+    # On the right of the way its sign hangs before it: read from the plate's range.
+    assert keeps(ocr, "room5", across=1.2, heading=math.pi / 2)["IntoSearchRange"][0] == 3.0
+    # A building whose doors hang on the other side of their signs: the other way round.
+    other = load_config(None, ["grounder.backend=ocr", "grounder.door_side=right"])
+    assert keeps(other, "room5", across=1.2)["IntoSearchRange"][0] == 3.0
+    north = keeps(other, "room5", across=1.2, heading=math.pi / 2)
+    assert north["IntoSearchRange"][0] == pytest.approx(abreast)
     # The oracle, and a search range set in the config, keep theirs.
     oracle = load_config(None, ["grounder.backend=sim_gt"])
     assert keeps(oracle, "room5", across=1.2)["IntoSearchRange"][0] == 4.5
@@ -134,12 +148,25 @@ def test_the_built_tree_uses_them(fig2_map):
     assert keeps(own, "room5", across=1.2)["IntoSearchRange"][0] == 2.5
 
 
-def test_a_search_reads_a_sign_on_either_side_of_its_door_from_the_abreast_range():
-    """From ``abreast_range`` before level with a door, on the centre line, a sign on its
-    far side is seen at ``MAX_SEARCH_ANGLE_DEG`` off its plate's normal (a narrow corridor:
-    no nearer than ``MIN_ABREAST_M``)."""
+def test_a_search_reads_a_sign_beyond_its_door_from_the_abreast_range():
+    """From ``abreast_range`` before level with a door, on the centre line, a sign hung
+    beyond it is seen at ``MAX_SEARCH_ANGLE_DEG`` off its plate's normal (a narrow
+    corridor: no nearer than ``MIN_ABREAST_M``); one hung before it, from farther."""
     across, beside = 1.5, 1.14
     d = abreast_range(across, beside)
     far = math.degrees(math.atan2(d + beside, across))
     assert far == pytest.approx(MAX_SEARCH_ANGLE_DEG)
     assert abreast_range(0.6, beside) == MIN_ABREAST_M
+    assert abreast_range(across, -beside) == pytest.approx(d + 2 * beside)
+
+
+def test_the_buildings_convention_says_which_side_of_its_door_a_sign_hangs():
+    """``grounder.door_side`` "left" (the simulator's): facing a door, its sign is on the
+    right. Passing a door on the left, its sign comes after it; on the right, before."""
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    south = -math.pi / 2
+    assert sign_ahead(cfg, south, (60.0, 5.5), (61.2, 5.5)) == 1  # east wall: on the left
+    assert sign_ahead(cfg, south, (60.0, 8.5), (58.8, 8.5)) == -1  # west wall: on the right
+    assert sign_ahead(cfg, math.pi / 2, (60.0, 5.5), (61.2, 5.5)) == -1  # heading north
+    other = load_config(None, ["grounder.backend=ocr", "grounder.door_side=right"])
+    assert sign_ahead(other, south, (60.0, 5.5), (61.2, 5.5)) == -1
