@@ -9,8 +9,6 @@ the coarse view direction and uses no refiner at all.
 
 from __future__ import annotations
 
-import math
-
 import py_trees
 from py_trees.behaviours import Failure as AlwaysFail
 from py_trees.composites import Parallel, Selector, Sequence
@@ -48,7 +46,7 @@ from pmnav_bt.behaviours.search import (
     target_bearing,
     target_entity,
 )
-from pmnav_bt.perception.read_range import SearchRanges, sign_ahead
+from pmnav_bt.perception.read_range import SearchRanges
 from pmnav_bt.seams import PixelGoalPolicy
 from pmnav_bt.trees.localize import active_localize_subtree, recovery_subtree
 
@@ -78,11 +76,7 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
 
     def search_range(b) -> float:
         t = b.get("target")
-        if t.target is None:
-            return ranges.search_range_to(target_entity(b), None)
-        across = math.dist(t.target, t.position)
-        ahead = sign_ahead(ctx.config, t.heading, t.position, t.target)
-        return ranges.search_range_to(target_entity(b), across, ahead)
+        return ranges.search_range_to(target_entity(b), t.position, t.target, t.heading)
 
     def research_distance(b) -> float:
         return ranges.of(target_entity(b)).research_distance

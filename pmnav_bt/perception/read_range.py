@@ -287,22 +287,21 @@ class SearchRanges:
         self.default = search_settings(config, width)
         angled = not _oracle(config) and config.tree.search_range is None
         self.beside = config.grounder.sign_to_door if angled else None
+        self.config = config
 
     def of(self, entity: Entity | None) -> SearchSettings:
         if entity is None:
             return self.default
         return self.by_kind[entity_plate_kind(self.building, entity)]
 
-    def search_range_to(
-        self, entity: Entity | None, across: float | None, ahead: int | None = None
-    ) -> float:
-        """How close (m, to its node) to go before searching for ``entity``'s sign: its
-        plate kind's search range, and for a room whose door is ``across`` m off the
-        centre line at most the ``abreast_range`` of its sign, hung ``ahead`` (+1: further
-        along the way than the door, -1: nearer; ``sign_ahead``) or, unknown (None), on
-        either side (the far side decides)."""
+    def search_range_to(self, entity: Entity | None, node, door, heading: float) -> float:
+        """How close (m, to its ``node`` on the centre line) to go before searching for
+        ``entity``'s sign, arriving ``heading`` (rad): its plate kind's search range, and for
+        a room with a ``door`` (None: none on the map) at most the ``abreast_range`` of its
+        sign, on the side of the door the building's convention hangs it (``sign_ahead``)."""
         search = self.of(entity).search_range
         room = entity is not None and entity.kind == EntityKind.ROOM
-        if self.beside is None or across is None or not room:
+        if self.beside is None or door is None or not room:
             return search
-        return min(search, abreast_range(across, self.beside * (1 if ahead is None else ahead)))
+        ahead = sign_ahead(self.config, heading, node, door)
+        return min(search, abreast_range(math.dist(door, node), self.beside * ahead))
