@@ -274,6 +274,7 @@ class LookTellsNothing(PmNavBehaviour):
         if belief is not None and end in SKIPPABLE_ENDS:
             pose = self.ctx.base.pose()
             self._job = self.ctx.worker.submit(lambda c: belief.look_tells(pose))
+            self.feedback_message = "weighing a look round"  # not the last decision's reason
         self._end = end
 
     def update(self) -> Status:
