@@ -909,3 +909,69 @@ def test_a_drive_blocked_here_counts_in_the_share_of_the_belief_with_signs_in_re
     assert b.sign_in_reach(odom) == pytest.approx(0.5, abs=0.01)
     b.pending_blocked = odom.yaw
     assert b.sign_in_reach(odom) < 0.05
+
+
+def test_a_miss_is_judged_at_the_plate_beside_the_door_not_at_the_door():
+    """sign_sparse_0, seed-1 hard #11 with the OCR stack: at the turn (30.3, 0) a look read
+    nothing. room10's door is 2.9 m off there, but its plate hangs 1.14 m beyond it (3.9 m,
+    67 deg), which OCR reads one time in three: with the door's place the miss cost the
+    true corner 1 - 0.84 and two such looks fixed the mirror-image corner."""
+    from pmnav_bt.config import load_config
+    from pmnav_bt.perception.read_range import sign_layout, sign_recall
+
+    pm = parse_building(generate_sign_sparse(0))
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    recall = sign_recall(cfg, pm.building)
+    at_door = CorridorBelief(pm, read_range=6.0, recall=recall)
+    hung = CorridorBelief(
+        pm,
+        read_range=6.0,
+        recall=recall,
+        layout=sign_layout(cfg),
+        lead_layout=sign_layout(cfg, reliable=True),
+    )
+    room10, turn = Entity.room("room10"), np.array([30.3, 0.0])
+    assert at_door._miss_log(room10, turn) == pytest.approx(math.log(0.25))
+    assert hung._miss_log(room10, turn) == pytest.approx(math.log(1.0 - 0.30))
+    # Nor is the turn a place to drive to for reading it (the telling places, the leads).
+    k = hung.goal.nearest_lattice((30.0, 0.0))
+    assert room10 in at_door.goal.lattice_points[k].readable
+    assert room10 not in hung.goal.lattice_points[k].readable
+
+
+def test_a_wall_met_early_after_a_long_drive_keeps_the_place_a_junction_fixed(monkeypatch):
+    """sign_sparse_1, seed-1 hard #6: looks at and beside the junction put the belief on
+    the true place; 28 m east the odometry had run 5 % long, so the end wall came 1.4 m
+    early. Each hypothesis is one rigid transform from the first look, so without room
+    for that drift the depth ruled out the true place and a blind fix at the far end of
+    the building followed."""
+    pm = parse_building(generate_sign_sparse(1))
+    start = (30.0, 57.0, -math.pi / 2)
+
+    def look(true):  # depth from the true pose; odometry 5 % long from the start
+        odo = (*(np.add(start[:2], 1.05 * np.subtract(true[:2], start[:2]))), true[2])
+        free = tuple(
+            (true[2] + k * math.pi / 2 + ODOM_T_MAP[2], _free(pm, true, true[2] + k * math.pi / 2))
+            for k in range(4)
+        )
+        return Glimpse(Pose2D(*se2_compose(ODOM_T_MAP, odo)), {}, None, free)
+
+    def truth_mass(b):
+        near = np.linalg.norm(b.xy - np.array(start[:2]), axis=1) < 1.6
+        facing = np.abs(np.angle(np.exp(1j * (b.yaw - start[2])))) < 0.3
+        return float(b.weights()[near & facing].sum())
+
+    def drive(b):
+        masses = []
+        for true in (start, (30.0, 60.0, 0.0), (45.0, 60.0, 0.0), (58.3, 60.0, 0.0)):
+            g = look(true)
+            b.observe(g, axis_odom=g.odom.yaw)
+            masses.append(truth_mass(b))
+        return masses
+
+    masses = drive(CorridorBelief(pm))
+    assert masses[2] > 0.9  # the junction and the corridor east told the place
+    assert masses[3] > 0.8  # and the early wall did not undo it
+    monkeypatch.setattr(CorridorBelief, "_slack", lambda self, odom: 0.0)
+    rigid = drive(CorridorBelief(pm))
+    assert rigid[2] > 0.9 and rigid[3] < 0.6

@@ -95,3 +95,54 @@ def test_the_trip_to_a_target_by_way_of_signs_is_never_shorter_than_the_route():
     near = dict(vis.exits[mid])
     assert near[3.14] < near[0.0]
     assert east < west - 10.0
+
+
+def test_a_layout_hangs_each_room_sign_where_the_simulator_does():
+    """``grounder.door_side`` "left" (the simulator's): facing a door, its sign hangs on
+    the right, ``grounder.sign_to_door`` from it; "right" hangs it on the left. The oracle
+    has no layout: its signs are checked at the map's places."""
+    from pmnav_bt.config import load_config
+    from pmnav_bt.perception.read_range import sign_layout
+    from pmnav_bt.seams import EntityKind
+    from pmnav_bt.sim.world import SimWorld
+
+    b = load_building("straight_office")
+    pm = parse_building(b)
+    left = Visibility(pm, 3.5, layout=sign_layout(load_config(None, ["grounder.backend=ocr"])))
+    right = Visibility(
+        pm,
+        3.5,
+        layout=sign_layout(load_config(None, ["grounder.backend=ocr", "grounder.door_side=right"])),
+    )
+    with SimWorld(b, ceiling=False) as world:
+        hung = {r.id: np.array(world.signs[r.id].centre) for r in b.rooms}
+    rooms = [k for k, e in enumerate(left.entities) if e.kind is EntityKind.ROOM]
+    assert len(rooms) == len(hung) > 10
+    for k in rooms:
+        where = hung[left.entities[k].id]
+        assert np.linalg.norm(left.plate_xy[k] - where) < 0.05
+        assert np.linalg.norm(right.plate_xy[k] - where) == pytest.approx(2 * 1.14, abs=0.05)
+    assert sign_layout(load_config(None, ["grounder.backend=sim_gt"])) is None
+    np.testing.assert_array_equal(Visibility.of(pm).plate_xy, Visibility.of(pm).sign_xy)
+
+
+def test_a_plate_beyond_the_readers_angle_is_not_readable(sparse):
+    """sign_sparse_0, seed-1 hard #11: room10's door is 2.9 m from the turn at (30.3, 0),
+    59 deg off its normal, but its plate hangs 1.14 m beyond the door: 3.9 m and 67 deg,
+    past the 65 deg within which OCR reads reliably. From 2 m up the corridor it is."""
+    from pmnav_bt.config import load_config
+    from pmnav_bt.perception.read_range import sign_layout
+
+    cfg = load_config(None, ["grounder.backend=ocr"])
+    at_door = Visibility(sparse, 3.5)
+    reliably = Visibility(sparse, 3.5, layout=sign_layout(cfg, reliable=True))
+    in_sight = Visibility(sparse, 6.0, layout=sign_layout(cfg))
+    room10 = Entity.room("room10")
+    k = reliably.entities.index(room10)
+    np.testing.assert_allclose(reliably.plate_xy[k], [28.8, 3.64], atol=0.01)
+    assert room10 in at_door.readable_from((30.3, 0.0))
+    assert room10 not in reliably.readable_from((30.3, 0.0))
+    assert room10 in in_sight.readable_from((30.3, 0.0))  # 67 deg: named now and then
+    assert room10 in reliably.readable_from((30.0, 2.0))
+    assert room10 not in in_sight.readable_from((29.5, 7.0))  # 78 deg: along its wall
+    assert room10 in Visibility(sparse, 6.0).readable_from((29.5, 7.0))  # no layout: any angle
