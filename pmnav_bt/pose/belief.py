@@ -348,21 +348,12 @@ class CorridorBelief:
             1,
         )
 
-    def _slack(self, odom: Pose2D) -> float:
-        """How far (m) the odometry may have drifted between the reference and ``odom``
-        (``DRIFT_PER_M``, as a sighting's spread grows): each hypothesis is one rigid
-        transform from there, so a depth check far from it gives this much more room. A
-        wall met 1.4 m early after 28 m of 5 % drift says the odometry ran long, not that
-        the place the junction fixed was wrong."""
-        return DRIFT_PER_M * math.hypot(odom.x - self.ref.x, odom.y - self.ref.y)
-
     def _weigh_free(
         self, tfs: np.ndarray, here: np.ndarray, odom: Pose2D, yaw: float, free: float, p: float
     ) -> None:
         """The free floor seen along ``yaw`` from ``odom`` (``here`` under each hypothesis)
-        must be floor on the map: a hypothesis with a wall within that reach (less the
-        odometry's ``_slack``) gets ``p``."""
-        reach = min(free, MAX_RAY_M) - RAY_SLACK_M - self._slack(odom)
+        must be floor on the map: a hypothesis with a wall within that reach gets ``p``."""
+        reach = min(free, MAX_RAY_M) - RAY_SLACK_M
         if reach > 1.0:
             end = _apply_many(tfs, (odom.x + reach * math.cos(yaw), odom.y + reach * math.sin(yaw)))
             floor = shapely.covers(self._floor, shapely.linestrings(np.stack([here, end], 1)))
@@ -374,12 +365,12 @@ class CorridorBelief:
         for yaw, free in r.free:
             self._weigh_free(tfs, here, r.odom, yaw, free, P_DRIVE_RAY)
 
-    def _blocked_log(self, tfs: np.ndarray, odom: Pose2D, blocked: float) -> np.ndarray:
-        """Log-weights for a drive blocked at ``odom`` heading ``blocked`` (straightened
-        odometry): a hypothesis under which the corridor goes on ``BLOCK_PROBE_M`` (and the
-        odometry's ``_slack``) ahead is unlikely."""
-        d = BLOCK_PROBE_M + self._slack(odom)
-        probe = _apply_many(tfs, (odom.x + d * math.cos(blocked), odom.y + d * math.sin(blocked)))
+    def _blocked_log(self, tfs: np.ndarray, xy, blocked: float) -> np.ndarray:
+        """Log-weights for a drive blocked from ``xy`` heading ``blocked`` (straightened
+        odometry): a hypothesis under which the corridor goes on ``BLOCK_PROBE_M`` ahead
+        is unlikely."""
+        d = BLOCK_PROBE_M
+        probe = _apply_many(tfs, (xy[0] + d * math.cos(blocked), xy[1] + d * math.sin(blocked)))
         pn, poff = self.vis.nearest_many(probe)
         return np.where(poff <= self._half_width[pn], math.log(P_THROUGH_WALL), 0.0)
 
@@ -393,14 +384,13 @@ class CorridorBelief:
         # A hypothesis that puts the robot inside a wall is unlikely.
         self.logw += np.where(off > half + OFF_CORRIDOR_M, math.log(P_THROUGH_WALL), 0.0)
         if g.blocked is not None:  # the corridor must end (or turn) just ahead
-            self.logw += self._blocked_log(tfs, g.odom, g.blocked)
+            self.logw += self._blocked_log(tfs, (g.odom.x, g.odom.y), g.blocked)
         # Depth: a wall close ahead of a view must be a wall on the map; the free floor seen
         # along each view (the whole ray, e.g. into a side corridor) must be floor on it.
-        slack = self._slack(g.odom)
         for yaw, free in g.free:
             c, s_ = math.cos(yaw), math.sin(yaw)
             if free < NEAR_WALL_M:
-                d = free + 0.5 + slack
+                d = free + 0.5
                 probe = _apply_many(tfs, (g.odom.x + d * c, g.odom.y + d * s_))
                 pn, poff = self.vis.nearest_many(probe)
                 # Clearly inside a corridor: an oblique view puts the probe only a little
@@ -528,8 +518,7 @@ class CorridorBelief:
         p = self._straighten((odom.x, odom.y))
         tfs = self._map_T_odom()
         if self.pending_blocked is not None:  # the drive here just met a wall: count it
-            here = Pose2D(float(p[0]), float(p[1]), 0.0)
-            w = w * np.exp(self._blocked_log(tfs, here, self.pending_blocked - self._drift))
+            w = w * np.exp(self._blocked_log(tfs, p, self.pending_blocked - self._drift))
             w = w / w.sum()
         near, _ = self.goal.nearest_many(_apply_many(tfs, (p[0], p[1])))
         pts = self.goal.lattice_points
