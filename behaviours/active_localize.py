@@ -181,7 +181,6 @@ class UpdateBelief(PmNavBehaviour):
                 recall=sign_recall(cfg, pm.building),
                 lead_range=sign_lead_range(cfg),
                 layout=sign_layout(cfg),
-                lead_layout=sign_layout(cfg, reliable=True),
                 target=_goal_xy(pm, self.get("goal")),
             )
             tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
@@ -235,7 +234,7 @@ class NoSignInReach(PmNavBehaviour):
             share, of = belief.sign_in_reach(pose), "the belief"
         else:  # before the first glimpse: the last estimate, else anywhere on the map
             cfg = self.ctx.config
-            vis = Visibility.of(self.ctx.pm, sign_lead_range(cfg), sign_layout(cfg, reliable=True))
+            vis = Visibility.of(self.ctx.pm, sign_lead_range(cfg))
             tf = self.get("map_T_odom")
             if tf is not None:
                 share = float(bool(vis.readable_from(se2_apply(tf, (pose.x, pose.y)))))

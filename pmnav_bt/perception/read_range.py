@@ -193,15 +193,14 @@ def sign_lead_range(config: Config, width: int | None = None) -> float | None:
     return sign_read_range(config, width)
 
 
-def sign_layout(config: Config, reliable: bool = False) -> SignLayout | None:
+def sign_layout(config: Config) -> SignLayout | None:
     """Where the localization belief expects a room's sign plate (``grounder.sign_to_door``
     beside its door, on the side ``grounder.door_side`` says) and from which angles the
-    reader names it: up to where ``ANGLE_RECALL`` keeps any recall, or ``reliable``, up to
-    ``MAX_SEARCH_ANGLE_DEG`` (where to go to read it). None for the oracle: the belief
-    checks signs at the map's places, as ``READ_RANGE_M`` was checked."""
+    reader names it at all (up to where ``ANGLE_RECALL`` keeps any recall). None for the
+    oracle: the belief checks signs at the map's places, as ``READ_RANGE_M`` was checked."""
     if _oracle(config):
         return None
-    named = MAX_SEARCH_ANGLE_DEG if reliable else max(a for a, s in ANGLE_RECALL if s > 0.0)
+    named = max(a for a, s in ANGLE_RECALL if s > 0.0)
     g = config.grounder
     return SignLayout(g.sign_to_door, g.door_side == "left", math.radians(named))
 

@@ -139,11 +139,12 @@ class CorridorBelief:
     # 5 m off that OCR reads one time in seven is no place to drive to.
     lead_range: float | None = None
     # Where a room's sign plate hangs beside its door and from which angles it is named
-    # (None: at the door, from any angle) for the signs in sight, and for those read
-    # reliably (None: ``layout``). A sign 1.1 m beyond its door, seen 67 deg off its plate
-    # from 3.9 m, is read one time in three, not five in six as the door's place says.
+    # (None: at the door, from any angle), for the signs in sight: a sign 1.1 m beyond
+    # its door, seen 67 deg off its plate from 3.9 m, is read one time in three, not five
+    # in six as the door's place says. The places to drive to (``goal``) are judged from
+    # the doors: they count signs only, and judged from the plates the end of a bare arm,
+    # where a look also shows the junction's shape, no longer counted.
     layout: SignLayout | None = None
-    lead_layout: SignLayout | None = None
     # Where the robot is going (map; None: nowhere yet): of two ways towards signs, the
     # one whose whole trip, finding the place and then going on, is shorter.
     target: tuple[float, float] | None = None
@@ -154,9 +155,7 @@ class CorridorBelief:
         self.vis = Visibility.of(self.pm, self.read_range, self.layout)
         # The same lattice, with the signs read reliably from each point (where to go).
         self.goal = Visibility.of(
-            self.pm,
-            self.read_range if self.lead_range is None else self.lead_range,
-            self.layout if self.lead_layout is None else self.lead_layout,
+            self.pm, self.read_range if self.lead_range is None else self.lead_range
         )
         self._plate = {  # each sign's plate: where it hangs and its wall's normal
             e: (xy, n)
