@@ -192,16 +192,12 @@ class UpdateBelief(PmNavBehaviour):
         for s in read.sightings:
             seen.setdefault(s.entity, s.odom_xy)
         glimpse = Glimpse(odom, seen, free=read.free, named=read.named, to_centre=read.to_centre)
-        restarts = belief.restarts
         belief.observe(glimpse, axis_odom=read.axis)
         self.bb.set("belief", belief)
         _, mass = belief.best_cluster()
         self.feedback_message = (
             f"{len(seen)} sign(s) read, {len(belief.glimpses)} glimpse(s); best {mass:.0%}"
         )
-        if belief.restarts > restarts:  # the look contradicted every place held
-            self.feedback_message += "; started again: the look fits no place held"
-            self.ctx.log("belief_restart", self.feedback_message)
         return Status.SUCCESS
 
 

@@ -58,10 +58,6 @@ CROSS_WAY_MASS = 0.7  # turn into a side corridor only when this much belief say
 MAX_DRIFT_STEP = math.radians(20.0)  # a larger change of the wall axis is another corridor
 MIN_BLIND_GLIMPSES = 4  # glimpses before a fix from the corridors' shape alone
 BLIND_SPREAD_M = 0.75  # ... and how tight the belief must be for it
-# A glimpse that drops the likeliest log-weight by more than this, more than three depth
-# readings against every place the belief held (P_DEPTH each), says the odometry slipped
-# from them: the belief starts again from that glimpse.
-SURPRISE_NATS = 3.0 * math.log(10.0)
 LOOK_SPACING_M = 6.0  # look round at least this far beyond an earlier look in the same way
 NEAR_WALL_M = 2.0  # depth: a wall closer than this ahead of a view ...
 MAX_RAY_M = 8.0  # free floor seen in depth is checked along the view up to this far
@@ -150,8 +146,6 @@ class CorridorBelief:
     target: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        self.surprise = 0.0  # how far the last glimpse dropped the likeliest log-weight
-        self.restarts = 0  # times the glimpses contradicted every place held (_restart)
         self.vis = Visibility.of(self.pm, self.read_range, self.layout)
         # The same lattice, with the signs read reliably from each point (where to go).
         self.goal = Visibility.of(
@@ -259,19 +253,6 @@ class CorridorBelief:
         )
         self.glimpses.append(g)
         self._weigh(g)
-        if self.surprise > SURPRISE_NATS:
-            self._restart(glimpse, axis_odom)
-
-    def _restart(self, glimpse: Glimpse, axis_odom: float | None) -> None:
-        """Start again from ``glimpse`` alone, without the earlier glimpses, drives and
-        prior: it contradicts every place they held (the odometry slipped, or the estimate
-        was wrong). After 28 m of drive that ran 1.4 m long, the end wall met early ruled
-        out the place a junction had fixed, and what was left of the belief, a corner at
-        the far end of the building, became a blind fix."""
-        self.glimpses, self.rays, self.ref, self.prior = [], [], None, None
-        self._last_way = None
-        self.restarts += 1
-        self.observe(glimpse, axis_odom)
 
     def _advance(self, odom: Pose2D, axis_odom: float | None) -> bool:
         """Carry the straightened odometry on to ``odom``: the walls' axis measured there
@@ -419,11 +400,6 @@ class CorridorBelief:
         return here, near
 
     def _weigh(self, g: Glimpse) -> None:
-        before = float(self.logw.max())
-        self._weigh_glimpse(g)
-        self.surprise = before - float(self.logw.max())
-
-    def _weigh_glimpse(self, g: Glimpse) -> None:
         tfs = self._map_T_odom()
         ref = self.ref
         travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
@@ -491,7 +467,6 @@ class CorridorBelief:
         blind = not any(g.seen for g in self.glimpses)
         if blind and self.prior is None and len(self.glimpses) < MIN_BLIND_GLIMPSES:
             return None
-
         idx, mass = self.best_cluster()
         if mass < FIX_MASS:
             return None
