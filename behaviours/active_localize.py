@@ -20,12 +20,7 @@ from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose, sighting
 from pmnav_bt.perception.geometry import free_distance, target_point
-from pmnav_bt.perception.read_range import (
-    sign_layout,
-    sign_lead_range,
-    sign_recall,
-    sign_visible_range,
-)
+from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_visible_range
 from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
@@ -180,7 +175,6 @@ class UpdateBelief(PmNavBehaviour):
                 read_range=sign_visible_range(cfg),
                 recall=sign_recall(cfg, pm.building),
                 lead_range=sign_lead_range(cfg),
-                layout=sign_layout(cfg),
                 target=_goal_xy(pm, self.get("goal")),
             )
             tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
@@ -229,8 +223,7 @@ class NoSignInReach(PmNavBehaviour):
         if belief is not None and belief.ref is not None:
             share, of = belief.sign_in_reach(pose), "the belief"
         else:  # before the first glimpse: the last estimate, else anywhere on the map
-            cfg = self.ctx.config
-            vis = Visibility.of(self.ctx.pm, sign_lead_range(cfg))
+            vis = Visibility.of(self.ctx.pm, sign_lead_range(self.ctx.config))
             tf = self.get("map_T_odom")
             if tf is not None:
                 share = float(bool(vis.readable_from(se2_apply(tf, (pose.x, pose.y)))))

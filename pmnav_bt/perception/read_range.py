@@ -15,9 +15,8 @@ From the read range follow (``search_settings``, ``SearchRanges`` per plate kind
 close the tree goes to a target before searching for its sign (``tree.search_range``),
 how far it moves on before searching again (``tree.research_distance``), and the range
 the localization belief expects signs (all kinds) to be read from (``pose.visibility``),
-how likely each sign is read from a given distance (``sign_recall``: a sign not read
-is evidence only where the reader would have read it), and where its plate hangs beside
-its door and from which angles it is named (``sign_layout``).
+and how likely each sign is read from a given distance (``sign_recall``: a sign not read
+is evidence only where the reader would have read it).
 Values set in the config win.
 """
 
@@ -28,7 +27,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from pmnav_bt.geometry import side_of
-from pmnav_bt.pose.visibility import SignLayout
 from pmnav_bt.seams import EntityKind
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -191,18 +189,6 @@ def sign_lead_range(config: Config, width: int | None = None) -> float | None:
     if _oracle(config):
         return None
     return sign_read_range(config, width)
-
-
-def sign_layout(config: Config) -> SignLayout | None:
-    """Where the localization belief expects a room's sign plate (``grounder.sign_to_door``
-    beside its door, on the side ``grounder.door_side`` says) and from which angles the
-    reader names it at all (up to where ``ANGLE_RECALL`` keeps any recall). None for the
-    oracle: the belief checks signs at the map's places, as ``READ_RANGE_M`` was checked."""
-    if _oracle(config):
-        return None
-    named = max(a for a, s in ANGLE_RECALL if s > 0.0)
-    g = config.grounder
-    return SignLayout(g.sign_to_door, g.door_side == "left", math.radians(named))
 
 
 def sign_recall(config: Config, building: Building, width: int | None = None):

@@ -30,7 +30,7 @@ import shapely
 from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose.lookahead import expected_trip, telling
-from pmnav_bt.pose.visibility import SignLayout, Visibility, entity_xy
+from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
 P_MISS = 0.25  # a sign the map says is readable is not read
@@ -134,27 +134,20 @@ class CorridorBelief:
     # m, signs are read reliably to: where to go to read them (None: read_range). A sign
     # 5 m off that OCR reads one time in seven is no place to drive to.
     lead_range: float | None = None
-    # Where a room's sign plate hangs beside its door and from which angles it is named
-    # (None: at the door, from any angle), for the signs in sight: a sign 1.1 m beyond
-    # its door, seen 67 deg off its plate from 3.9 m, is read one time in three, not five
-    # in six as the door's place says. The places to drive to (``goal``) are judged from
-    # the doors: they count signs only, and judged from the plates the end of a bare arm,
-    # where a look also shows the junction's shape, no longer counted.
-    layout: SignLayout | None = None
     # Where the robot is going (map; None: nowhere yet): of two ways towards signs, the
     # one whose whole trip, finding the place and then going on, is shorter.
     target: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        self.vis = Visibility.of(self.pm, self.read_range, self.layout)
+        self.vis = Visibility.of(self.pm, self.read_range)
         # The same lattice, with the signs read reliably from each point (where to go).
         self.goal = Visibility.of(
             self.pm, self.read_range if self.lead_range is None else self.lead_range
         )
-        self._plate = {  # each sign's plate: where it hangs and its wall's normal
+        self._plate = {  # each sign's plate: where the map puts it and its wall's normal
             e: (xy, n)
             for e, xy, n in zip(
-                self.vis.entities, self.vis.plate_xy, self.vis.sign_normal, strict=True
+                self.vis.entities, self.vis.sign_xy, self.vis.sign_normal, strict=True
             )
         }
         self._floor = shapely.buffer(self.vis.corridors, RAY_SLACK_M)  # a little tolerance

@@ -2,9 +2,7 @@
 
 A sign is readable from a point when the straight line to it stays inside the corridors
 (walls block the view) and it is no farther than ``READ_RANGE_M``. Every sign is on a
-corridor wall, so the check uses a point just in front of the wall. The map places a
-room's sign at its door; a ``SignLayout`` (the building's convention and the reader's
-angles) puts the plate beside the door, where a reader has to see it. The counts along the
+corridor wall, so the check uses a point just in front of the wall. The counts along the
 corridor centre lines, on a ``LATTICE_M`` lattice, tell active localization where signs
 are and class start poses by landmark density (paper, Table 3).
 """
@@ -23,23 +21,11 @@ import shapely
 
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.planning.resolve import entity_position
-from pmnav_bt.seams import Entity, EntityKind
+from pmnav_bt.seams import Entity
 
 READ_RANGE_M = 9.5  # a sign is read up to about this far (checked against the sim grounder)
 WALL_INSET_M = 0.3  # the sight line ends this far in front of the wall
 LATTICE_M = 0.5  # spacing of the lattice points along the corridor centre lines
-
-
-@dataclass(frozen=True)
-class SignLayout:
-    """Where a room's sign plate hangs and from where a reader names it: ``beside`` m
-    along the wall from its door's centre, on the viewer's ``right`` of the door (facing
-    the wall) or left, and read within ``max_angle`` rad of the plate's normal (None: from
-    any angle). The default is the map's own place, the door."""
-
-    beside: float = 0.0
-    right: bool = True
-    max_angle: float | None = None
 
 
 def entity_xy(pm: PrioriMap, entity: Entity) -> tuple[float, float]:
@@ -80,59 +66,35 @@ class LatticePoint:
 class Visibility:
     """The map's prediction of what is readable where (built once per priori-map)."""
 
-    def __init__(
-        self,
-        pm: PrioriMap,
-        read_range: float = READ_RANGE_M,
-        lattice: float = LATTICE_M,
-        layout: SignLayout | None = None,
-    ):
+    def __init__(self, pm: PrioriMap, read_range: float = READ_RANGE_M, lattice: float = LATTICE_M):
         self.pm = pm
         self.read_range = read_range
         self.lattice = lattice
-        self.layout = layout or SignLayout()
         self.entities = map_entities(pm)
         self._xy = np.array([entity_xy(pm, e) for e in self.entities], dtype=float).reshape(-1, 2)
-        door_eye = np.array([self._inset(p) for p in self._xy]).reshape(-1, 2)
-        d = door_eye - self._xy
-        n = np.linalg.norm(d, axis=1, keepdims=True)
-        self._normal = np.where(n > 1e-9, d / np.maximum(n, 1e-9), 0.0)
-        # A room's plate: along its wall to the viewer's right (facing the wall, -normal).
-        along = np.stack([-self._normal[:, 1], self._normal[:, 0]], 1)
-        side = self.layout.beside * (1.0 if self.layout.right else -1.0)
-        rooms = np.array([e.kind == EntityKind.ROOM for e in self.entities], dtype=bool)
-        shift = np.where(rooms[:, None], side * along, 0.0)
-        self._plate = self._xy + shift
-        self._eye = door_eye + shift  # the sight line ends just in front of the plate
+        self._eye = np.array([self._inset(p) for p in self._xy]).reshape(-1, 2)
 
     @property
     def sign_xy(self) -> np.ndarray:
-        """(N, 2) where the map puts each of ``entities``' signs (a room's: its door)."""
+        """(N, 2) where the map puts each of ``entities``' signs."""
         return self._xy
 
-    @property
-    def plate_xy(self) -> np.ndarray:
-        """(N, 2) where each of ``entities``' sign plates hangs under the ``layout``."""
-        return self._plate
-
-    @property
+    @cached_property
     def sign_normal(self) -> np.ndarray:
         """(N, 2) unit normals of ``entities``' plates: from the wall into the corridor."""
-        return self._normal
+        d = self._eye - self._xy
+        n = np.linalg.norm(d, axis=1, keepdims=True)
+        return np.where(n > 1e-9, d / np.maximum(n, 1e-9), 0.0)
 
     @classmethod
-    def of(
-        cls, pm: PrioriMap, read_range: float | None = None, layout: SignLayout | None = None
-    ) -> Visibility:
+    def of(cls, pm: PrioriMap, read_range: float | None = None) -> Visibility:
         """The cached Visibility of ``pm`` for signs read to ``read_range`` (None:
-        ``READ_RANGE_M``; the OCR reader's comes from perception/read_range.py) and hung
-        as ``layout`` says (None: at the map's places, from any angle)."""
+        ``READ_RANGE_M``; the OCR reader's comes from perception/read_range.py)."""
         r = READ_RANGE_M if read_range is None else float(read_range)
-        key = (r, layout or SignLayout())
         cache = pm.__dict__.setdefault("_visibility", {})
-        v = cache.get(key)
+        v = cache.get(r)
         if v is None:
-            v = cache[key] = cls(pm, read_range=r, layout=layout)
+            v = cache[r] = cls(pm, read_range=r)
         return v
 
     @cached_property
@@ -168,12 +130,7 @@ class Visibility:
         p = np.asarray(xy, dtype=float)
         if not len(self.entities):
             return frozenset()
-        v = p - self._plate
-        d = np.linalg.norm(v, axis=1)
-        ok = d <= self.read_range
-        if self.layout.max_angle is not None:  # seen along its wall: not named
-            ok &= np.einsum("ij,ij->i", v, self._normal) >= d * math.cos(self.layout.max_angle)
-        near = np.nonzero(ok)[0]
+        near = np.nonzero(np.linalg.norm(self._xy - p, axis=1) <= self.read_range)[0]
         if not len(near):
             return frozenset()
         lines = shapely.linestrings(
