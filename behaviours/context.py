@@ -35,7 +35,8 @@ class TraceEvent:
 @dataclass
 class Context:
     """Injected into every behaviour of one tree. ``base`` is wrapped in a
-    ``CalibratedBase``: its odometry's rotation scale is learnt from the walls."""
+    ``CalibratedBase``: its odometry's rotation and distance scales are learnt from the
+    walls (each distance track is a ``calibrate`` trace event)."""
 
     base: Base
     pm: PrioriMap  # the map-less baseline: a SignsOnly (sign vocabulary, no geometry)
@@ -52,6 +53,9 @@ class Context:
     def __post_init__(self) -> None:
         if not isinstance(self.base, CalibratedBase):
             self.base = CalibratedBase(self.base)
+        self.base.on_distance = lambda scale, gain: self.log(
+            "calibrate", "", distance_scale=scale, distance_gain=gain
+        )
 
     @classmethod
     def wired(

@@ -1,4 +1,4 @@
-"""Odometry whose rotation is calibrated against the corridor walls.
+"""Odometry whose rotation and distance are calibrated against the corridor walls.
 
 Wheel odometry turns by a constant factor too much or too little (wheel base
 miscalibrated, wheel slip when turning in place): a 5 % rotation-scale error puts the
@@ -8,9 +8,16 @@ measure that error: their direction in odometry must stay the same (modulo 90 de
 while the robot turns, so how fast it moves with the odometry's rotation during a
 panorama is the rotation-scale error (``rotation_scale_error``).
 
+Wheels also drive a constant factor too far or too short (tyre wear, wheel radius): at
+5 % a 28 m leg ends 1.4 m off, beyond what the corridor belief and the door checks
+allow. A wall ahead measures that too: driving straight at it, the free floor seen in
+depth shrinks by the true distance driven (``distance_scale``), whatever the odometry
+says.
+
 ``CalibratedBase`` wraps a ``Base`` and reports odometry re-integrated with every yaw
-increment multiplied by ``gain`` (1.0 until ``calibrate`` learns it; until then it passes
-the poses through unchanged).
+increment multiplied by ``gain`` and every distance by ``distance_gain`` (1.0 until
+``calibrate`` and its own straight-drive tracks learn them; until then it passes the
+poses through unchanged).
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ from dataclasses import replace
 import numpy as np
 
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
+from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.seams import Base, Observation, Pose2D
 from pmnav_bt.wrapped_base import WrappedBase
 
@@ -29,6 +37,14 @@ MIN_VIEWS = 4  # wall directions needed in one panorama to measure the rotation 
 MIN_SPAN = math.radians(180.0)  # ... spread over at least this much turning
 MAX_RESIDUAL = math.radians(2.5)  # rms misfit of the wall directions: not one straight axis
 MAX_GAIN_ERROR = 0.2  # a learnt gain stays within 1 +- this
+# Distance: a straight drive at a wall seen in depth.
+MIN_TRACK_M = 2.0  # the readings of one wall must span this much driving
+MIN_TRACK_POINTS = 4
+MAX_TRACK_TURN = math.radians(4.0)  # a drive is straight while the heading stays this close
+TRACK_FREE_M = (0.6, 6.0)  # wall readings used: nearer, the wall leaves the view; farther,
+# a pixel of the wall's foot spans centimetres
+TRACK_STEP_SLACK_M = 0.1  # between two readings of one wall (beyond the gain's range)
+MAX_TRACK_RMS = 0.05  # m, the readings' misfit of one straight-line approach
 
 
 def rotation_scale_error(angles: list[tuple[float, float, int]]) -> float | None:
@@ -55,19 +71,60 @@ def rotation_scale_error(angles: list[tuple[float, float, int]]) -> float | None
     return None if rms > MAX_RESIDUAL else float(slope)
 
 
+def distance_scale(track: list[tuple[float, float]]) -> float | None:
+    """True metres per odometry metre, from one straight drive's frames in the order
+    taken: (odometry distance driven along the drive's heading, free floor seen straight
+    ahead in depth). Readings of one wall (consecutive frames whose free floor shrinks
+    as the odometry says, within ``MAX_GAIN_ERROR``) spanning ``MIN_TRACK_M`` give the
+    slope of free floor against odometry; a reading of something else (a door frame, the
+    far wall once a side corridor opens) starts another run, and the longest run counts.
+    None when no run is long enough or straight enough."""
+    lo, hi = TRACK_FREE_M
+    pts = [(s, f) for s, f in track if lo <= f <= hi]
+    runs: list[list[tuple[float, float]]] = []
+    for s, f in pts:
+        if runs:
+            s0, f0 = runs[-1][-1]
+            ds = s - s0
+            if ds >= 0.0 and abs((f0 - f) - ds) <= MAX_GAIN_ERROR * ds + TRACK_STEP_SLACK_M:
+                runs[-1].append((s, f))
+                continue
+        runs.append([(s, f)])
+    best = max(runs, key=lambda r: r[-1][0] - r[0][0], default=[])
+    if len(best) < MIN_TRACK_POINTS or best[-1][0] - best[0][0] < MIN_TRACK_M:
+        return None
+    s, f = np.array(best).T
+    slope, icpt = np.polyfit(s, f, 1)
+    rms = float(np.sqrt(np.mean((f - (slope * s + icpt)) ** 2)))
+    k = -float(slope)
+    if rms > MAX_TRACK_RMS or abs(k - 1.0) > MAX_GAIN_ERROR:
+        return None
+    return k
+
+
 class CalibratedBase(WrappedBase):
-    """A ``Base`` whose odometry yaw increments are multiplied by ``gain``.
+    """A ``Base`` whose odometry yaw increments are multiplied by ``gain`` and distance
+    increments by ``distance_gain``.
 
     Poses are re-integrated from the wrapped base's increments each time they are read
     (the tree reads them every tick); an observation's pose is mapped with the current
-    correction (it is read right after the frame). Everything else passes through.
+    correction (it is read right after the frame). Every observation with depth also
+    extends the current straight-drive track (raw odometry, free floor ahead); a frame
+    that turned from it ends the track, whose ``distance_scale`` joins the distance
+    gain (the mean of all tracks' scales, weighted by how far each drove).
+    ``on_distance(scale, gain)`` is told each one. Everything else passes through.
     """
 
     def __init__(self, inner: Base) -> None:
         super().__init__(inner)
         self.gain = 1.0
+        self.distance_gain = 1.0
+        self.on_distance = None  # called with (scale, new distance gain) per track
         self._asked: list[float] = []  # the gain each measurement asked for
-        self._lock = threading.Lock()
+        self._scales: list[tuple[float, float]] = []  # (scale, metres) per track
+        self._track: list[tuple[float, float]] = []
+        self._track_from: Pose2D | None = None  # raw odometry where the track began
+        self._lock = threading.RLock()
         self._raw: Pose2D | None = None
         self._corr: Pose2D | None = None
 
@@ -101,14 +158,15 @@ class CalibratedBase(WrappedBase):
     def _update(self, raw: Pose2D) -> Pose2D:
         last, corr = self._raw, self._corr
         self._raw = raw
-        if last is None or self.gain == 1.0 and corr == last:
+        if last is None or self.gain == 1.0 and self.distance_gain == 1.0 and corr == last:
             self._corr = raw  # not calibrated yet: the odometry as it is
             return raw
         dth = wrap_angle(raw.yaw - last.yaw)
         mid = last.yaw + dth / 2.0
         dx, dy = raw.x - last.x, raw.y - last.y
-        fwd = math.cos(mid) * dx + math.sin(mid) * dy
-        side = -math.sin(mid) * dx + math.cos(mid) * dy
+        k = self.distance_gain
+        fwd = k * (math.cos(mid) * dx + math.sin(mid) * dy)
+        side = k * (-math.sin(mid) * dx + math.cos(mid) * dy)
         cth = dth * self.gain
         cm = corr.yaw + cth / 2.0
         self._corr = Pose2D(
@@ -122,10 +180,43 @@ class CalibratedBase(WrappedBase):
         with self._lock:
             return self._update(self.inner.pose())
 
+    def _extend_track(self, obs: Observation) -> None:
+        """Add a frame to the straight-drive track (raw odometry), ending the track and
+        taking in its scale when the frame turned away from it or went back."""
+        raw = obs.pose
+        start = self._track_from
+        if start is not None:
+            c, s = math.cos(start.yaw), math.sin(start.yaw)
+            along = c * (raw.x - start.x) + s * (raw.y - start.y)
+            last = self._track[-1][0] if self._track else 0.0
+            turned = abs(wrap_angle(raw.yaw - start.yaw)) > MAX_TRACK_TURN
+            if not turned and along >= last - 0.05:
+                self._track.append((along, free_distance(obs, 0.0)))
+                return
+            self._end_track()
+        self._track_from = raw
+        self._track = [(0.0, free_distance(obs, 0.0))]
+
+    def _end_track(self) -> None:
+        track, self._track, self._track_from = self._track, [], None
+        scale = distance_scale(track)
+        if scale is None:
+            return
+        span = track[-1][0] - track[0][0]
+        self._scales.append((scale, span))
+        k, w = np.array(self._scales).T
+        self.distance_gain = float(
+            np.clip(np.average(k, weights=w), 1.0 - MAX_GAIN_ERROR, 1.0 + MAX_GAIN_ERROR)
+        )
+        if self.on_distance is not None:
+            self.on_distance(scale, self.distance_gain)
+
     def observe(self) -> Observation:
         obs = self.inner.observe()
         with self._lock:
             self._update(self.inner.pose())
+            if obs.depth is not None:
+                self._extend_track(obs)
             if self._corr == self._raw:
                 return obs
             corr_T_raw = self._corr_T_raw()

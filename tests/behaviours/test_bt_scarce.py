@@ -205,6 +205,30 @@ def test_a_panorama_calibrates_the_odometry_rotation_so_turning_round_is_true(ma
     assert turned == pytest.approx(math.pi, abs=math.radians(3.0))
 
 
+def test_a_straight_drive_at_a_wall_calibrates_the_odometry_distance(make_rig):
+    # Seed 43 at 5 % noise: the odometry counts 7.5 % too much distance. Driving south
+    # to 1 m short of fig2's turn1 (the corridor's end wall beyond it), the free floor
+    # seen in depth at every watch frame shrinks by the true distance driven.
+    rig = make_rig(Pose2D(0.0, 6.5, SOUTH), width=320, height=240, noise=0.05, seed=43)
+    assert rig.base._scale == pytest.approx(1.0749, abs=1e-4)
+    plan = rig.plan("0,5,-90", "room11")
+    rig.set(target=plan.steps[0])  # turn1, at (0, 0)
+    rig.expect(rig.run(MoveToward("IntoSearchRange", rig.ctx, keep=1.0), 600), Status.SUCCESS)
+    assert rig.ctx.base.distance_gain == 1.0  # the drive's track is still open
+    rig.expect(rig.run(Spin("TurnRound", rig.ctx, math.pi), 300), Status.SUCCESS)
+    rig.ctx.base.observe()  # the next frame, turned: the track ends and is measured
+    assert rig.ctx.base.distance_gain == pytest.approx(1.0 / 1.0749, rel=0.01)
+    assert [e for e in rig.ctx.trace if e.data.get("distance_scale")]
+    # Back north: the calibrated odometry now drives true, the raw one 7.5 % long.
+    true0, cal0, raw0 = rig.true_pose(), rig.ctx.base.pose(), rig.base.pose()
+    rig.set(target=rig.plan("0,5,90", "room4").steps[0])
+    rig.expect(rig.run(MoveToward("MoveOn", rig.ctx, keep=0.0, distance=4.0), 600), Status.SUCCESS)
+    true1, cal1, raw1 = rig.true_pose(), rig.ctx.base.pose(), rig.base.pose()
+    true = math.dist((true0.x, true0.y), (true1.x, true1.y))
+    assert math.dist((raw0.x, raw0.y), (raw1.x, raw1.y)) / true == pytest.approx(1.0749, rel=0.01)
+    assert math.dist((cal0.x, cal0.y), (cal1.x, cal1.y)) / true == pytest.approx(1.0, abs=0.01)
+
+
 @pytest.mark.parametrize("off", [0.8, -0.5, 0.0])
 def test_a_panorama_finds_the_way_to_the_corridor_centre_line(make_rig, off):
     """A look round from beside a wall says where the centre line is (the belief's

@@ -1,4 +1,5 @@
-"""The odometry's rotation scale, measured from the walls during a panorama and taken out."""
+"""The odometry's rotation scale, measured from the walls during a panorama, and its
+distance scale, measured from a wall ahead while driving straight, taken out."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import math
 import pytest
 
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
+from pmnav_bt.pose.odometry import CalibratedBase, distance_scale, rotation_scale_error
 from pmnav_bt.seams import Pose2D
 
 AXIS = math.radians(7.0)  # the corridor's axis in the map (walls along and across it)
@@ -94,3 +95,31 @@ def test_calibrated_odometry_turns_round_true_and_drives_where_the_robot_drives(
     after = cal.pose()
     assert math.dist((before.x, before.y), (after.x, after.y)) == pytest.approx(2.0)
     assert math.atan2(after.y - before.y, after.x - before.x) == pytest.approx(after.yaw)
+
+
+def approach(scale: float, start: float = 9.0, odom_step: float = 0.3, n: int = 20) -> list:
+    """A straight drive at a wall ``start`` m ahead on odometry that counts ``scale``
+    times the true distance: (odometry distance, free floor ahead) every ``odom_step``."""
+    return [(i * odom_step, start - i * odom_step / scale) for i in range(n)]
+
+
+@pytest.mark.parametrize("scale", [0.9, 1.0, 1.07])
+def test_a_wall_ahead_measures_how_far_the_odometry_over_or_under_counts(scale):
+    # Readings beyond 6 m (the wall's foot a pixel or two tall) are left out.
+    assert distance_scale(approach(scale)) == pytest.approx(1.0 / scale, abs=1e-9)
+
+
+def test_the_longest_run_of_readings_of_one_wall_counts():
+    track = approach(1.07, start=6.0, n=14)
+    track[4] = (track[4][0], 1.5)  # a door frame stood out for one frame
+    # ... and the wall beyond came into view after a side corridor opened: another run
+    track += [(4.2 + 0.3 * i, 5.5 - 0.3 * i / 1.07) for i in range(5)]
+    assert distance_scale(track) == pytest.approx(1.0 / 1.07, abs=1e-9)
+
+
+def test_too_short_a_drive_or_readings_that_fit_no_approach_measure_nothing():
+    assert distance_scale(approach(1.07, start=5.0, n=6)) is None  # 1.5 m of driving
+    wobbly = [(s, f + (0.12 if i % 2 else -0.12)) for i, (s, f) in enumerate(approach(1.0, 6.0))]
+    assert distance_scale(wobbly) is None
+    assert distance_scale(approach(1.4, start=6.0)) is None  # beyond any wheel's error
+    assert distance_scale([]) is None
