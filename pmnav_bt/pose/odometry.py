@@ -145,7 +145,7 @@ class CalibratedBase(WrappedBase):
 
     def corr_T_raw(self) -> tuple[float, float, float]:
         """The calibrated odometry frame from the wrapped base's, now (it changes as the
-        robot turns once calibrated): ``map_T_odom`` of the tree composed with it is the
+        robot turns or drives once calibrated): ``map_T_odom`` of the tree composed with it is the
         map pose of the base's own odometry frame (for a map -> odom transform)."""
         with self._lock:
             self._update(self.inner.pose())
