@@ -181,6 +181,7 @@ class UpdateBelief(PmNavBehaviour):
             if tf is not None:
                 sigma = tracker.sigma(self.ctx.odometer.distance) if tracker else 3.0
                 belief.prior = (tf, sigma)
+        _rescale(belief, self.ctx.base)
         odom = views[0].observation.pose if views else self.ctx.base.pose()
         seen: dict[Entity, tuple[float, float]] = {}
         for s in read.sightings:
@@ -193,6 +194,13 @@ class UpdateBelief(PmNavBehaviour):
             f"{len(seen)} sign(s) read, {len(belief.glimpses)} glimpse(s); best {mass:.0%}"
         )
         return Status.SUCCESS
+
+
+def _rescale(belief: CorridorBelief, base) -> None:
+    """Keep the belief's positions in the odometry's calibrated distance (it changes when a
+    straight drive at a wall ends: ``CalibratedBase``)."""
+    if isinstance(base, CalibratedBase):
+        belief.rescale(base.distance_gain)
 
 
 def _goal_xy(pm, goal) -> tuple[float, float] | None:
@@ -503,6 +511,7 @@ class FollowLead(PmNavBehaviour):
         if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:
             return
         self._last_ray = (seen_from.x, seen_from.y)
+        _rescale(belief, self.ctx.base)
         belief.observe_ray(seen_from, min(free, 50.0), axis)
 
     def _rethink(self, pose: Pose2D) -> bool:

@@ -84,6 +84,7 @@ TELLING_LOOKED_M = 1.5  # a place this close to an earlier glimpse was looked fr
 # map floor differs by less than this along each of these bearings look alike.
 LOOK_ALIKE_M = 1.0
 LOOK_BEARINGS = np.radians(np.arange(0.0, 360.0, 15.0))
+RESCALE_MIN = 0.002  # a change of the odometry's distance gain smaller than this is kept
 
 
 @dataclass(frozen=True)
@@ -137,6 +138,9 @@ class CorridorBelief:
     # Where the robot is going (map; None: nowhere yet): of two ways towards signs, the
     # one whose whole trip, finding the place and then going on, is shorter.
     target: tuple[float, float] | None = None
+    # The odometry's distance gain (``CalibratedBase``) the positions held were driven
+    # under: when it changes, they are scaled about the reference (``rescale``).
+    gain: float = 1.0
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm, self.read_range)
@@ -284,6 +288,32 @@ class CorridorBelief:
         ray = Glimpse(Pose2D(float(p[0]), float(p[1]), yaw), {}, free=((yaw, free),))
         self._weigh_ray(ray, self._map_T_odom())
         self.rays.append(ray)
+
+    def rescale(self, gain: float) -> None:
+        """The odometry's distance calibration is now ``gain``: every position the belief
+        holds (glimpses, signs seen, drive rays, the straightened odometry) was driven under
+        the old one, so it is moved from the reference by new / old and every hypothesis is
+        weighed again. Each hypothesis is one rigid transform from the reference: without
+        this, a long first leg on odometry 5 % long puts the true place a metre and a half
+        short of the wall it then meets, and the walls rule it out."""
+        k = gain / self.gain
+        self.gain = gain
+        if self.ref is None or abs(k - 1.0) < RESCALE_MIN:
+            return
+        rx, ry = self.ref.x, self.ref.y
+
+        def moved(xy) -> tuple[float, float]:
+            return (rx + k * (xy[0] - rx), ry + k * (xy[1] - ry))
+
+        def glimpse(g: Glimpse) -> Glimpse:
+            x, y = moved((g.odom.x, g.odom.y))
+            seen = {e: moved(xy) for e, xy in g.seen.items()}
+            return replace(g, odom=replace(g.odom, x=x, y=y), seen=seen)
+
+        self.glimpses = [glimpse(g) for g in self.glimpses]
+        self.rays = [glimpse(r) for r in self.rays]
+        self._corr = moved(self._corr)
+        self._build()
 
     def _straighten_tf(self) -> tuple[float, float, float]:
         """straightened_T_odom at the last glimpse."""

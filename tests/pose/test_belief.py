@@ -909,3 +909,47 @@ def test_a_drive_blocked_here_counts_in_the_share_of_the_belief_with_signs_in_re
     assert b.sign_in_reach(odom) == pytest.approx(0.5, abs=0.01)
     b.pending_blocked = odom.yaw
     assert b.sign_in_reach(odom) < 0.05
+
+
+def _truth_after_a_long_leg(pm, scale: float, rescale: bool) -> float:
+    """sign_sparse_2: a look round at the centre of the cross (its four arms pin the
+    place), a 28.5 m drive north on odometry that counts ``scale`` times the true
+    distance (depth ahead every metre), and a look round 2.7 m short of the arm's end
+    wall. The weight left on the true place (the one that puts the first look there)."""
+    b = CorridorBelief(pm)
+    start = (30.0, 30.0, math.pi / 2)
+    g = glimpse(pm, start, (), depth=True)
+    b.observe(g, axis_odom=g.odom.yaw)
+
+    def odom_at(y: float) -> Pose2D:
+        return Pose2D(*se2_compose(ODOM_T_MAP, (30.0, 30.0 + scale * (y - 30.0), math.pi / 2)))
+
+    for y in np.arange(31.0, 58.5, 1.0):
+        b.observe_ray(odom_at(y), _free(pm, (30.0, y, math.pi / 2), math.pi / 2))
+    if rescale:  # the drive at the end wall calibrated the odometry's distance
+        b.rescale(1.0 / scale)
+        assert b.gain == pytest.approx(1.0 / scale)
+    end = replace(glimpse(pm, (30.0, 58.5, math.pi / 2), (), depth=True), odom=odom_at(58.5))
+    b.observe(end, axis_odom=end.odom.yaw)
+    return _weight_near(b, g.odom, start[:2], start[2])
+
+
+def test_a_belief_rescaled_with_the_odometrys_distance_keeps_the_true_place():
+    """Each hypothesis is one rigid transform from the first look: on odometry 6 % long,
+    28.5 m on the true place puts the robot 1.7 m further north than it is, where the map
+    has the end wall before the free floor depth sees; the walls rule it out. Once the
+    drive at that wall has calibrated the odometry's distance (``CalibratedBase``), the
+    belief moves what it holds by the new gain and the true place stays; a change of the
+    gain within ``RESCALE_MIN`` moves nothing."""
+    pm = parse_building(generate_sign_sparse(2))
+    exact = _truth_after_a_long_leg(pm, 1.0, rescale=False)
+    long = _truth_after_a_long_leg(pm, 1.06, rescale=False)
+    rescaled = _truth_after_a_long_leg(pm, 1.06, rescale=True)
+    assert long < 0.05 * exact  # ruled out by the end wall
+    assert rescaled > 0.5 * exact
+    b = CorridorBelief(pm)
+    g = glimpse(pm, (30.0, 30.0, math.pi / 2), (), depth=True)
+    b.observe(g, axis_odom=g.odom.yaw)
+    before = [x.odom for x in b.glimpses]
+    b.rescale(1.001)
+    assert [x.odom for x in b.glimpses] == before and b.gain == 1.001
