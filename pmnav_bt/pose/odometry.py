@@ -180,10 +180,10 @@ class CalibratedBase(WrappedBase):
         with self._lock:
             return self._update(self.inner.pose())
 
-    def _extend_track(self, obs: Observation) -> None:
-        """Add a frame to the straight-drive track (raw odometry), ending the track and
-        taking in its scale when the frame turned away from it or went back."""
-        raw = obs.pose
+    def _extend_track(self, raw: Pose2D, free: float) -> None:
+        """Add a frame (its raw odometry pose and the free floor ahead) to the
+        straight-drive track, ending the track and taking in its scale when the frame
+        turned away from it or went back."""
         start = self._track_from
         if start is not None:
             c, s = math.cos(start.yaw), math.sin(start.yaw)
@@ -191,11 +191,11 @@ class CalibratedBase(WrappedBase):
             last = self._track[-1][0] if self._track else 0.0
             turned = abs(wrap_angle(raw.yaw - start.yaw)) > MAX_TRACK_TURN
             if not turned and along >= last - 0.05:
-                self._track.append((along, free_distance(obs, 0.0)))
+                self._track.append((along, free))
                 return
             self._end_track()
         self._track_from = raw
-        self._track = [(0.0, free_distance(obs, 0.0))]
+        self._track = [(0.0, free)]
 
     def _end_track(self) -> None:
         track, self._track, self._track_from = self._track, [], None
@@ -213,10 +213,13 @@ class CalibratedBase(WrappedBase):
 
     def observe(self) -> Observation:
         obs = self.inner.observe()
+        # The free floor ahead for the distance track: measured once, outside the lock
+        # (the tree's tick reads the pose meanwhile).
+        free = free_distance(obs, 0.0) if obs.depth is not None else None
         with self._lock:
             self._update(self.inner.pose())
-            if obs.depth is not None:
-                self._extend_track(obs)
+            if free is not None:
+                self._extend_track(obs.pose, free)
             if self._corr == self._raw:
                 return obs
             corr_T_raw = self._corr_T_raw()
