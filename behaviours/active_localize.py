@@ -155,8 +155,14 @@ class UpdateBelief(PmNavBehaviour):
     JOBS = ("_job",)
 
     def initialise(self) -> None:
-        ctx, views = self.ctx, self.get("views") or []
-        self._job = ctx.worker.submit(lambda c: read_panorama(ctx, views))
+        ctx, views, belief = self.ctx, self.get("views") or [], self.get("belief")
+
+        def job(cancelled):
+            if belief is not None:  # a rescale weighs every hypothesis again: not in a tick
+                _rescale(belief, ctx.base)
+            return read_panorama(ctx, views)
+
+        self._job = ctx.worker.submit(job)
 
     def update(self) -> Status:
         status, read = self.poll(self._job, "reading the panorama")
@@ -181,7 +187,7 @@ class UpdateBelief(PmNavBehaviour):
             if tf is not None:
                 sigma = tracker.sigma(self.ctx.odometer.distance) if tracker else 3.0
                 belief.prior = (tf, sigma)
-        _rescale(belief, self.ctx.base)
+        _rescale(belief, self.ctx.base)  # a new belief takes the gain (the job did an old one's)
         odom = views[0].observation.pose if views else self.ctx.base.pose()
         seen: dict[Entity, tuple[float, float]] = {}
         for s in read.sightings:
@@ -198,7 +204,8 @@ class UpdateBelief(PmNavBehaviour):
 
 def _rescale(belief: CorridorBelief, base) -> None:
     """Keep the belief's positions in the odometry's calibrated distance (it changes when a
-    straight drive at a wall ends: ``CalibratedBase``)."""
+    straight drive at a wall ends: ``CalibratedBase``). Slow when the belief moves
+    (``CorridorBelief.rescale_due``)."""
     if isinstance(base, CalibratedBase):
         belief.rescale(base.distance_gain)
 

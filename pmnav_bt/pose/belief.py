@@ -297,8 +297,9 @@ class CorridorBelief:
         this, a long first leg on odometry 5 % long puts the true place a metre and a half
         short of the wall it then meets, and the walls rule it out."""
         k = gain / self.gain
+        due = self.rescale_due(gain)
         self.gain = gain
-        if self.ref is None or abs(k - 1.0) < RESCALE_MIN:
+        if not due:
             return
         rx, ry = self.ref.x, self.ref.y
 
@@ -314,6 +315,11 @@ class CorridorBelief:
         self.rays = [glimpse(r) for r in self.rays]
         self._corr = moved(self._corr)
         self._build()
+
+    def rescale_due(self, gain: float) -> bool:
+        """Whether ``rescale(gain)`` would move what the belief holds and weigh every
+        hypothesis again (too slow for a tick: behaviours do it in the worker)."""
+        return self.ref is not None and abs(gain / self.gain - 1.0) >= RESCALE_MIN
 
     def _straighten_tf(self) -> tuple[float, float, float]:
         """straightened_T_odom at the last glimpse."""

@@ -6,6 +6,7 @@ tolerance follows the pose uncertainty."""
 from __future__ import annotations
 
 import math
+import threading
 
 import pytest
 from py_trees.common import Status
@@ -26,6 +27,7 @@ from pmnav_bt.behaviours.search import (
 from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
 from pmnav_bt.localization import Sighting
+from pmnav_bt.pose.belief import CorridorBelief
 from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.seams import Entity, MotionStatus, Pose2D
 from pmnav_bt.trees.localize import recovery_subtree
@@ -227,6 +229,29 @@ def test_a_straight_drive_at_a_wall_calibrates_the_odometry_distance(make_rig):
     true = math.dist((true0.x, true0.y), (true1.x, true1.y))
     assert math.dist((raw0.x, raw0.y), (raw1.x, raw1.y)) / true == pytest.approx(1.0749, rel=0.01)
     assert math.dist((cal0.x, cal0.y), (cal1.x, cal1.y)) / true == pytest.approx(1.0, abs=0.01)
+
+
+def test_a_rescale_of_the_belief_runs_in_the_worker_not_in_a_tick(make_rig, monkeypatch):
+    """A new distance gain moves everything the belief holds and weighs every hypothesis
+    again (1-2 s): UpdateBelief does it in its worker job, before the look is added."""
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH), width=320, height=240)
+    views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
+    rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
+    rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
+    belief = rig.get("belief")
+    moved = []  # the thread each rescale that moved the belief ran in
+    rescale = CorridorBelief.rescale
+
+    def watched(self, gain):
+        if self.rescale_due(gain):
+            moved.append(threading.current_thread().name)
+        rescale(self, gain)
+
+    monkeypatch.setattr(CorridorBelief, "rescale", watched)
+    rig.ctx.base.distance_gain = 1.05  # as if a drive at a wall had measured it
+    rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
+    assert belief.gain == 1.05 and len(belief.glimpses) == 2
+    assert len(moved) == 1 and moved[0].startswith("pmnav-worker")
 
 
 @pytest.mark.parametrize("off", [0.8, -0.5, 0.0])
