@@ -147,6 +147,10 @@ class UpdateBelief(PmNavBehaviour):
 
     The goal room's door is the belief's ``target``: where to look for signs first.
 
+    Reading the panorama and weighing every hypothesis with it (0.1-2 s) run in the
+    worker, on a fork of the belief (``CorridorBelief.fork``) that replaces it when done:
+    a look halted half-way leaves the belief as it was.
+
     Reads ``views``, ``belief``, ``map_T_odom``, ``pose_tracker``, ``goal``; writes ``belief``.
     """
 
@@ -156,50 +160,56 @@ class UpdateBelief(PmNavBehaviour):
 
     def initialise(self) -> None:
         ctx, views, belief = self.ctx, self.get("views") or [], self.get("belief")
+        odom = views[0].observation.pose if views else ctx.base.pose()
+        goal, prior = self.get("goal"), None
+        if belief is None and (tf := self.get("map_T_odom")) is not None:
+            tracker = self.get("pose_tracker")
+            prior = (tf, tracker.sigma(ctx.odometer.distance) if tracker else 3.0)
 
         def job(cancelled):
-            if belief is not None:  # a rescale weighs every hypothesis again: not in a tick
-                _rescale(belief, ctx.base)
-            return read_panorama(ctx, views)
+            read = read_panorama(ctx, views)
+            b = _new_belief(ctx, goal, prior) if belief is None else belief.fork()
+            _rescale(b, ctx.base)  # a new gain weighs every hypothesis again
+            seen: dict[Entity, tuple[float, float]] = {}
+            for s in read.sightings:
+                seen.setdefault(s.entity, s.odom_xy)
+            glimpse = Glimpse(
+                odom, seen, free=read.free, named=read.named, to_centre=read.to_centre
+            )
+            b.observe(glimpse, axis_odom=read.axis)
+            return read, b, len(seen), b.best_cluster()[1]
 
         self._job = ctx.worker.submit(job)
 
     def update(self) -> Status:
-        status, read = self.poll(self._job, "reading the panorama")
+        status, done = self.poll(self._job, "reading the panorama")
         if status is not None:
             return status
+        read, belief, n_seen, mass = done
         error = read.rotation_error
         if error is not None and isinstance(self.ctx.base, CalibratedBase):
             gain = self.ctx.base.calibrate(error)
             self.ctx.log("calibrate", "", rotation_error=error, gain=gain)
-        views = self.get("views") or []
-        belief = self.get("belief")
-        if belief is None:
-            cfg, pm = self.ctx.config, self.ctx.pm
-            belief = CorridorBelief(
-                pm,
-                read_range=sign_visible_range(cfg),
-                recall=sign_recall(cfg, pm.building),
-                lead_range=sign_lead_range(cfg),
-                target=_goal_xy(pm, self.get("goal")),
-            )
-            tf, tracker = self.get("map_T_odom"), self.get("pose_tracker")
-            if tf is not None:
-                sigma = tracker.sigma(self.ctx.odometer.distance) if tracker else 3.0
-                belief.prior = (tf, sigma)
-        _rescale(belief, self.ctx.base)  # a new belief takes the gain (the job did an old one's)
-        odom = views[0].observation.pose if views else self.ctx.base.pose()
-        seen: dict[Entity, tuple[float, float]] = {}
-        for s in read.sightings:
-            seen.setdefault(s.entity, s.odom_xy)
-        glimpse = Glimpse(odom, seen, free=read.free, named=read.named, to_centre=read.to_centre)
-        belief.observe(glimpse, axis_odom=read.axis)
         self.bb.set("belief", belief)
-        _, mass = belief.best_cluster()
         self.feedback_message = (
-            f"{len(seen)} sign(s) read, {len(belief.glimpses)} glimpse(s); best {mass:.0%}"
+            f"{n_seen} sign(s) read, {len(belief.glimpses)} glimpse(s); best {mass:.0%}"
         )
         return Status.SUCCESS
+
+
+def _new_belief(ctx, goal, prior) -> CorridorBelief:
+    """A belief with no glimpse yet, for ``goal`` (its door is where to look first), with
+    ``prior`` ((map_T_odom, sigma m) of the estimate so far; None: none)."""
+    cfg, pm = ctx.config, ctx.pm
+    belief = CorridorBelief(
+        pm,
+        read_range=sign_visible_range(cfg),
+        recall=sign_recall(cfg, pm.building),
+        lead_range=sign_lead_range(cfg),
+        target=_goal_xy(pm, goal),
+    )
+    belief.prior = prior
+    return belief
 
 
 def _rescale(belief: CorridorBelief, base) -> None:

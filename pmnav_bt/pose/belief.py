@@ -19,6 +19,7 @@ different signs.
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -166,6 +167,17 @@ class CorridorBelief:
             return "CorridorBelief(no glimpse)"
         _, mass = self.best_cluster()
         return f"CorridorBelief({len(self.glimpses)} glimpses, best {mass:.0%})"
+
+    def fork(self) -> CorridorBelief:
+        """A copy to add to away from the tree (in the worker): it shares the map and the
+        lattice, and holds its own glimpses, drive rays and weights."""
+        other = copy.copy(self)
+        other.glimpses, other.rays, other.logw = (
+            list(self.glimpses),
+            list(self.rays),
+            self.logw.copy(),
+        )
+        return other
 
     def _build(self) -> None:
         pts = self.vis.lattice_points

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import threading
 
+import numpy as np
 import pytest
 from py_trees.common import Status
 
@@ -231,27 +232,53 @@ def test_a_straight_drive_at_a_wall_calibrates_the_odometry_distance(make_rig):
     assert math.dist((cal0.x, cal0.y), (cal1.x, cal1.y)) / true == pytest.approx(1.0, abs=0.01)
 
 
-def test_a_rescale_of_the_belief_runs_in_the_worker_not_in_a_tick(make_rig, monkeypatch):
-    """A new distance gain moves everything the belief holds and weighs every hypothesis
-    again (1-2 s): UpdateBelief does it in its worker job, before the look is added."""
+def test_a_look_is_weighed_in_the_worker_on_a_fork_of_the_belief(make_rig, monkeypatch):
+    """Weighing every hypothesis with a look (and, after a new distance gain, moving what
+    the belief holds: 1-2 s) runs in UpdateBelief's worker job, on a fork of the belief
+    that replaces it on the blackboard when done (DESIGN.md: a tick never blocks)."""
     rig = make_rig(Pose2D(0.0, 26.5, SOUTH), width=320, height=240)
     views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
     rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
     rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
-    belief = rig.get("belief")
-    moved = []  # the thread each rescale that moved the belief ran in
-    rescale = CorridorBelief.rescale
+    first = rig.get("belief")
+    ran = []  # (what, thread) of each rescale that moved a belief and each look weighed
+    rescale, observe = CorridorBelief.rescale, CorridorBelief.observe
 
-    def watched(self, gain):
+    def watched_rescale(self, gain):
         if self.rescale_due(gain):
-            moved.append(threading.current_thread().name)
+            ran.append(("rescale", threading.current_thread().name))
         rescale(self, gain)
 
-    monkeypatch.setattr(CorridorBelief, "rescale", watched)
+    def watched_observe(self, glimpse, axis_odom=None):
+        ran.append(("observe", threading.current_thread().name))
+        observe(self, glimpse, axis_odom)
+
+    monkeypatch.setattr(CorridorBelief, "rescale", watched_rescale)
+    monkeypatch.setattr(CorridorBelief, "observe", watched_observe)
     rig.ctx.base.distance_gain = 1.05  # as if a drive at a wall had measured it
     rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
-    assert belief.gain == 1.05 and len(belief.glimpses) == 2
-    assert len(moved) == 1 and moved[0].startswith("pmnav-worker")
+    second = rig.get("belief")
+    assert [w for w, _ in ran] == ["rescale", "observe"]
+    assert all(t.startswith("pmnav-worker") for _, t in ran), ran
+    assert second.gain == 1.05 and len(second.glimpses) == 2
+    assert first.gain == 1.0 and len(first.glimpses) == 1  # the fork took it all
+
+
+def test_a_look_halted_half_way_leaves_the_belief_as_it_was(make_rig):
+    """The worker has weighed the look, but the tree halts UpdateBelief before it takes the
+    result (a preemption): the belief on the blackboard is the one before the look."""
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH), width=320, height=240)
+    views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
+    rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
+    rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
+    before = rig.get("belief")
+    logw = before.logw.copy()
+    look = UpdateBelief("LocalizeBelief", rig.ctx)
+    assert rig.tick(look) == Status.RUNNING
+    rig.wait()  # the job runs to its end
+    look.stop(Status.INVALID)
+    assert rig.get("belief") is before and len(before.glimpses) == 1
+    np.testing.assert_array_equal(before.logw, logw)
 
 
 @pytest.mark.parametrize("off", [0.8, -0.5, 0.0])
