@@ -85,7 +85,7 @@ TELLING_LOOKED_M = 1.5  # a place this close to an earlier glimpse was looked fr
 # map floor differs by less than this along each of these bearings look alike.
 LOOK_ALIKE_M = 1.0
 LOOK_BEARINGS = np.radians(np.arange(0.0, 360.0, 15.0))
-RESCALE_MIN = 0.002  # a change of the odometry's distance gain smaller than this is kept
+RESCALE_MIN = 0.002  # a change of the odometry's distance gain smaller than this waits
 
 
 @dataclass(frozen=True)
@@ -307,12 +307,15 @@ class CorridorBelief:
         the old one, so it is moved from the reference by new / old and every hypothesis is
         weighed again. Each hypothesis is one rigid transform from the reference: without
         this, a long first leg on odometry 5 % long puts the true place a metre and a half
-        short of the wall it then meets, and the walls rule it out."""
-        k = gain / self.gain
-        due = self.rescale_due(gain)
-        self.gain = gain
-        if not due:
+        short of the wall it then meets, and the walls rule it out.
+
+        A change within ``RESCALE_MIN`` of the gain the positions are in waits (``gain``
+        stays): several small ones in a row move them once they add up to more."""
+        if self.ref is None:  # nothing held yet
+            self.gain = gain
+        if not self.rescale_due(gain):
             return
+        k, self.gain = gain / self.gain, gain
         rx, ry = self.ref.x, self.ref.y
 
         def moved(xy) -> tuple[float, float]:

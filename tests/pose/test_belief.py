@@ -940,7 +940,7 @@ def test_a_belief_rescaled_with_the_odometrys_distance_keeps_the_true_place():
     has the end wall before the free floor depth sees; the walls rule it out. Once the
     drive at that wall has calibrated the odometry's distance (``CalibratedBase``), the
     belief moves what it holds by the new gain and the true place stays; a change of the
-    gain within ``RESCALE_MIN`` moves nothing."""
+    gain within ``RESCALE_MIN`` waits until more such changes add up to more."""
     pm = parse_building(generate_sign_sparse(2))
     exact = _truth_after_a_long_leg(pm, 1.0, rescale=False)
     long = _truth_after_a_long_leg(pm, 1.06, rescale=False)
@@ -950,6 +950,13 @@ def test_a_belief_rescaled_with_the_odometrys_distance_keeps_the_true_place():
     b = CorridorBelief(pm)
     g = glimpse(pm, (30.0, 30.0, math.pi / 2), (), depth=True)
     b.observe(g, axis_odom=g.odom.yaw)
+    b.observe(g2 := glimpse(pm, (30.0, 40.0, math.pi / 2), (), depth=True), g2.odom.yaw)
     before = [x.odom for x in b.glimpses]
-    b.rescale(1.001)
-    assert [x.odom for x in b.glimpses] == before and b.gain == 1.001
+    b.rescale(1.0015)
+    assert [x.odom for x in b.glimpses] == before and b.gain == 1.0
+    b.rescale(1.003)  # 0.15 % and 0.15 %: together beyond RESCALE_MIN
+    assert b.gain == 1.003
+    ref, moved = b.glimpses[0].odom, b.glimpses[1].odom
+    assert math.dist((ref.x, ref.y), (moved.x, moved.y)) == pytest.approx(
+        1.003 * math.dist((ref.x, ref.y), (before[1].x, before[1].y))
+    )
