@@ -520,15 +520,19 @@ class FollowLead(PmNavBehaviour):
 
     def _note_ray(self, seen_from: Pose2D, free: float | None, axis: float | None) -> None:
         """Add the free floor ahead and the walls' axis (odometry; None: not seen) to the
-        belief every ``RAY_SPACING_M`` of the drive."""
+        belief every ``RAY_SPACING_M`` of the drive. Not after the odometry's distance gain
+        has changed until the next look moves the belief to it (in the worker: too slow for
+        a tick): a ray would mix two gains."""
         belief: CorridorBelief | None = self.get("belief")
         if belief is None or free is None or not self._driving or self._rethink_job is not None:
             return  # (not while the lead is worked out again on the belief, in the worker)
+        base = self.ctx.base
+        if isinstance(base, CalibratedBase) and belief.rescale_due(base.distance_gain):
+            return
         x, y = self._last_ray
         if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:
             return
         self._last_ray = (seen_from.x, seen_from.y)
-        _rescale(belief, self.ctx.base)
         belief.observe_ray(seen_from, min(free, 50.0), axis)
 
     def _rethink(self, pose: Pose2D) -> bool:

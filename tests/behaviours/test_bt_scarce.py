@@ -264,6 +264,37 @@ def test_a_look_is_weighed_in_the_worker_on_a_fork_of_the_belief(make_rig, monke
     assert first.gain == 1.0 and len(first.glimpses) == 1  # the fork took it all
 
 
+@pytest.mark.parametrize("new_gain", [False, True])
+def test_a_drive_adds_no_ray_after_a_new_distance_gain_until_a_look(
+    make_rig, monkeypatch, new_gain
+):
+    """FollowLead adds the depth ahead to the belief along its drive. After the odometry's
+    distance gain changed, the belief's positions are still in the old one and moving them
+    is too slow for a tick: the drive adds no ray until the next look has done it."""
+    from pmnav_bt.behaviours.active_localize import FollowLead
+
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH), width=320, height=240)
+    views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
+    rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
+    rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
+    belief = rig.get("belief")
+    moved = []
+    rescale = CorridorBelief.rescale
+
+    def watched(self, gain):
+        if self.rescale_due(gain):
+            moved.append(threading.current_thread().name)
+        rescale(self, gain)
+
+    monkeypatch.setattr(CorridorBelief, "rescale", watched)
+    if new_gain:
+        rig.ctx.base.distance_gain = 1.05
+    lead = FollowLead("FollowLead", rig.ctx, max_distance=4.0)
+    rig.run(lead, 2000)
+    assert moved == [] and belief.gain == 1.0
+    assert (len(belief.rays) == 0) == new_gain, len(belief.rays)
+
+
 def test_a_look_halted_half_way_leaves_the_belief_as_it_was(make_rig):
     """The worker has weighed the look, but the tree halts UpdateBelief before it takes the
     result (a preemption): the belief on the blackboard is the one before the look."""
