@@ -2,7 +2,9 @@
 
 All drive on the estimated map pose (``map_T_odom`` composed with odometry) with
 velocity commands, and watch for obstacles: the base reporting a collision, no
-progress for a while, or depth showing something on the floor ahead.
+progress for a while, or depth showing something on the floor ahead. Something on
+the floor with open floor beside it (a pillar, a trolley on the centre line) is driven
+round (``detour``); only what fills the corridor blocks the drive.
 """
 
 from __future__ import annotations
@@ -32,6 +34,15 @@ WALL_ARRIVAL_MARGIN_M = 0.4
 WALL_ARRIVAL_NEAR_M = 3.0
 # Depth is checked this far ahead: a 1 m box leaves the 1.6 m camera's view 1.4 m away.
 OBSTACLE_RANGE = 2.0
+# Round an obstacle: the nearest bearing off the way to the goal (either side, in view)
+# along which the floor is free DETOUR_PAST_M beyond the obstacle's near face (and a
+# margin), to a point that far past it, inside the map's corridors; at most MAX_DETOURS
+# a drive (each watched like the drive: another obstacle, another detour).
+DETOUR_BEARINGS = tuple(math.radians(a) for a in (10.0, 15.0, 20.0, 25.0, 30.0))
+DETOUR_PAST_M = 0.6
+DETOUR_MARGIN_M = 0.3
+DETOUR_VIEW_MARGIN = math.radians(5.0)  # a bearing this close to the image border is not seen
+MAX_DETOURS = 2
 
 
 class DriveTo(PmNavBehaviour):
@@ -70,12 +81,18 @@ class DriveTo(PmNavBehaviour):
         self._bumps = 0
         self._watch_job = None
         self._watch_t = -math.inf
+        self._detour: tuple[float, float] | None = None  # a point round an obstacle
+        self._detours = 0
 
     def aim_at(self, goal: tuple[float, float]) -> None:
         """Drive to ``goal`` from here on, progress watched afresh (a route's next leg)."""
         self._goal = goal
         self._best, self._best_t = math.inf, self.ctx.now()
         self._bumps = 0
+
+    def _aim(self) -> tuple[float, float]:
+        """Where the drive heads now: round an obstacle first, then the goal."""
+        return self._goal if self._detour is None else self._detour
 
     def estimate(self):
         return map_pose(self.get("map_T_odom"), self.ctx.base.pose())
@@ -95,18 +112,25 @@ class DriveTo(PmNavBehaviour):
             base.stop()
             return watched
         est = self.estimate()
-        dist = math.hypot(self._goal[0] - est.x, self._goal[1] - est.y)
+        aim = self._aim()
+        dist = math.hypot(aim[0] - est.x, aim[1] - est.y)
         if dist < self._best - 0.1:
             self._best, self._best_t = dist, now
         elif now - self._best_t > NO_PROGRESS_S:
             base.stop()
             return self.fail(FailureCode.BLOCKED, f"no progress for {NO_PROGRESS_S:.0f} s")
-        v, w, done = goto_command(est, *self._goal, self.ctx.limits)
+        v, w, done = goto_command(est, *aim, self.ctx.limits)
+        if done and self._detour is not None:  # past the obstacle: on to the goal
+            self._detour = None
+            self._best, self._best_t = math.inf, now
+            return Status.RUNNING
         if done:
             base.set_velocity(0.0, 0.0)
             return Status.SUCCESS
         base.set_velocity(v, w)
-        self.feedback_message = f"{dist:.1f} m to go"
+        self.feedback_message = f"{dist:.1f} m to go" + (
+            " round an obstacle" if self._detour else ""
+        )
         return Status.RUNNING
 
     def _poll_watch(self, now: float) -> Status | None:
@@ -118,8 +142,8 @@ class DriveTo(PmNavBehaviour):
         if self._watch_job is None:
             if now - self._watch_t >= WATCH_PERIOD_S:
                 self._watch_t = now
-                base, goal, target = self.ctx.base, self._goal, self.get("target")
-                tf = self.get("map_T_odom")
+                base, goal, target = self.ctx.base, self._aim(), self.get("target")
+                tf, pm = self.get("map_T_odom"), self.ctx.pm
 
                 def watch(cancelled):
                     obs = base.observe()
@@ -127,7 +151,10 @@ class DriveTo(PmNavBehaviour):
                     found = self.inspect(obs, est, target)
                     found["walls"] = measure_walls(self.ctx.grounder, obs)
                     found["ahead"] = ahead = _toward_goal(obs, est, goal)
-                    return obs, _closer_than_goal(ahead, est, goal), found
+                    blocked = _closer_than_goal(ahead, est, goal)
+                    if blocked is not None:
+                        found["detour"] = detour(obs, est, goal, blocked, pm)
+                    return obs, blocked, found
 
                 self._watch_job = self.ctx.worker.submit(watch)
             return None
@@ -147,8 +174,41 @@ class DriveTo(PmNavBehaviour):
             return Status.SUCCESS
         if free is not None:
             self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)
+            point = found.get("detour")
+            if point is not None and self._detours < MAX_DETOURS:
+                self._detour, self._detours = point, self._detours + 1
+                self._best, self._best_t = math.inf, self.ctx.now()
+                self.ctx.log("detour", "", x=point[0], y=point[1], obstacle=free)
+                return None
             return self.fail(FailureCode.BLOCKED, f"obstacle {free:.1f} m ahead")
         return None
+
+
+def detour(obs, est, goal, free: float, pm) -> tuple[float, float] | None:
+    """A map point round an obstacle ``free`` m ahead on the way from ``est`` to ``goal``:
+    along the nearest bearing off that way (``DETOUR_BEARINGS``, the more open side first)
+    with the floor free ``DETOUR_PAST_M`` beyond the obstacle's near face, that far past it
+    and inside the map's corridors; None when there is none (the corridor is shut)."""
+    way = wrap_angle(heading((est.x, est.y), goal) - est.yaw)
+    k = obs.intrinsics
+    in_view = math.atan2(k.cx, k.fx) - DETOUR_VIEW_MARGIN
+    past = free + DETOUR_PAST_M
+    for off in DETOUR_BEARINGS:
+        reach = past / math.cos(off)
+        sides = []
+        for b in (way + off, way - off):
+            if abs(b) > in_view:
+                continue
+            open_m = free_distance(obs, b)
+            if open_m >= reach + DETOUR_MARGIN_M:
+                sides.append((open_m, b))
+        for _, b in sorted(sides, reverse=True):
+            a = est.yaw + b
+            p = (est.x + reach * math.cos(a), est.y + reach * math.sin(a))
+            loc = pm.locate(*p)
+            if loc.offset <= loc.segment.width / 2.0 - DETOUR_MARGIN_M:
+                return float(p[0]), float(p[1])
+    return None
 
 
 def _toward_goal(obs, est, goal) -> float | None:

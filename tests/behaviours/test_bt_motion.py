@@ -104,6 +104,28 @@ def test_approach_with_an_obstacle_in_the_way_fails_blocked(make_rig):
     assert rig.true_pose() == p  # and it stays there
 
 
+@pytest.mark.parametrize("size", [0.4, 1.6])
+def test_approach_drives_round_a_pillar_but_not_round_a_shut_corridor(make_rig, size):
+    """A pillar on the centre line, open floor beside it (the hospital's real map has
+    one): the drive goes round it and arrives. A box across the corridor (fig2's is 2 m
+    wide) leaves no way round: BLOCKED, stopped before it."""
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+    rig.add_obstacle(0.0, 24.0, size=size, height=1.9)
+    rig.set(target=room4_step(rig))
+    seen = rig.run(Approach("Approach", rig.ctx), max_ticks=600)
+    kinds = [e.kind for e in rig.ctx.trace]
+    assert rig.body.stats.collisions == 0
+    if size < 1.0:
+        rig.expect(seen, Status.SUCCESS)
+        assert "detour" in kinds
+        assert rig.true_pose().y < 24.0 - size / 2  # past it
+    else:
+        rig.expect(seen, Status.FAILURE)
+        assert rig.failure.code == FailureCode.BLOCKED
+        assert "detour" not in kinds
+        assert rig.true_pose().y > 24.0 + size / 2
+
+
 def test_approach_stops_before_a_tall_obstacle_seen_in_depth(make_rig):
     rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
     rig.add_obstacle(0.1, 24.0, size=0.8, height=1.9)  # a cabinet: in view up close
