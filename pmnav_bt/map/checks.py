@@ -184,17 +184,24 @@ def grid_warnings(b: Building, plan: FloorPlanImage) -> list[Problem]:
             if (hi - lo) * step >= OFF_FREE_M:
                 mid = xy[(lo + hi) // 2]
                 c = cell[(lo + hi) // 2]
-                what = (
-                    "runs into an obstacle in the corridor"
+                what, then = (
+                    (
+                        "runs into an obstacle in the corridor",
+                        "the robot must leave the centre line to go round it (it does when "
+                        "depth shows open floor beside it)",
+                    )
                     if free[c[1], c[0]]
-                    else "leaves the grid's free space"
+                    else (
+                        "leaves the grid's free space",
+                        "the robot follows the centre line and stops there",
+                    )
                 )
                 out.append(
                     Problem(
                         f"edges[{i}]",
                         f"{e.a}-{e.b} {what} for {(hi - lo) * step:.2f} m near "
-                        f"({mid[0]:.2f}, {mid[1]:.2f}): the robot follows the centre line and "
-                        "stops there; move the waypoints",
+                        f"({mid[0]:.2f}, {mid[1]:.2f}): {then}; move the waypoints if they "
+                        "can avoid it",
                     )
                 )
         measured = centre_line_width(
