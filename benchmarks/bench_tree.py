@@ -8,7 +8,11 @@ busy. Two worker modes are measured:
   worker renders pybullet frames, which hold Python's interpreter lock, so this is
   a pessimistic figure for the robot, whose worker decodes images and runs models.
 
-    python benchmarks/bench_tree.py [--episodes 3] [--set grounder.backend=sim_gt]
+The sign_sparse_2 case starts with no sign in reach: the corridor belief is built,
+weighed with each look (``UpdateBelief``, in the worker) and with the depth along each
+drive (``FollowLead``), which is where the slowest ticks were.
+
+    python benchmarks/bench_tree.py [--episodes 4] [--case sign_sparse_2] [--set k=v]
 """
 
 from __future__ import annotations
@@ -57,7 +61,8 @@ def pct(xs: list[float], q: float) -> float:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--episodes", type=int, default=3)
+    ap.add_argument("--episodes", type=int, default=4)
+    ap.add_argument("--case", default=None, help="only the cases in this building")
     ap.add_argument("--set", action="append", default=[], help="config override key=value")
     args = ap.parse_args()
     from pmnav_bt.registry import grounder_label
@@ -67,7 +72,10 @@ def main() -> None:
         ("fig2_hospital", "room17", "22,0,0"),
         ("fig2_hospital", "room17", None),
         ("loop_school", "room10", None),
+        ("sign_sparse_2", "room7", "30,35.5,-90"),
     ][: args.episodes]
+    if args.case:
+        cases = [c for c in cases if c[0] == args.case]
     print(
         f"{'episode':<34} {'mode':<9} {'ticks':>6} {'median ms':>9} {'p99 ms':>7} "
         f"{'max ms':>7} {'wall s':>7} {'sim s/wall s':>12} ok"
