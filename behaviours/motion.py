@@ -76,8 +76,7 @@ class DriveTo(PmNavBehaviour):
 
     def initialise(self) -> None:
         self._goal = self.goal()
-        self._best = math.inf
-        self._best_t = self.ctx.now()
+        self._progress_afresh()
         self._bumps = 0
         self._watch_job = None
         self._watch_t = -math.inf
@@ -87,8 +86,12 @@ class DriveTo(PmNavBehaviour):
     def aim_at(self, goal: tuple[float, float]) -> None:
         """Drive to ``goal`` from here on, progress watched afresh (a route's next leg)."""
         self._goal = goal
-        self._best, self._best_t = math.inf, self.ctx.now()
+        self._progress_afresh()
         self._bumps = 0
+
+    def _progress_afresh(self) -> None:
+        """Watch the progress towards a new aim from now on (``NO_PROGRESS_S``)."""
+        self._best, self._best_t = math.inf, self.ctx.now()
 
     def _aim(self) -> tuple[float, float]:
         """Where the drive heads now: round an obstacle first, then the goal."""
@@ -122,7 +125,7 @@ class DriveTo(PmNavBehaviour):
         v, w, done = goto_command(est, *aim, self.ctx.limits)
         if done and self._detour is not None:  # past the obstacle: on to the goal
             self._detour = None
-            self._best, self._best_t = math.inf, now
+            self._progress_afresh()
             return Status.RUNNING
         if done:
             base.set_velocity(0.0, 0.0)
@@ -177,7 +180,7 @@ class DriveTo(PmNavBehaviour):
             point = found.get("detour")
             if point is not None and self._detours < MAX_DETOURS:
                 self._detour, self._detours = point, self._detours + 1
-                self._best, self._best_t = math.inf, self.ctx.now()
+                self._progress_afresh()
                 self.ctx.log("detour", "", x=point[0], y=point[1], obstacle=free)
                 return None
             return self.fail(FailureCode.BLOCKED, f"obstacle {free:.1f} m ahead")
@@ -190,8 +193,7 @@ def detour(obs, est, goal, free: float, pm) -> tuple[float, float] | None:
     with the floor free ``DETOUR_PAST_M`` beyond the obstacle's near face, that far past it
     and inside the map's corridors; None when there is none (the corridor is shut)."""
     way = wrap_angle(heading((est.x, est.y), goal) - est.yaw)
-    k = obs.intrinsics
-    in_view = math.atan2(k.cx, k.fx) - DETOUR_VIEW_MARGIN
+    in_view = abs(obs.intrinsics.pixel_bearing(0.0)) - DETOUR_VIEW_MARGIN
     past = free + DETOUR_PAST_M
     for off in DETOUR_BEARINGS:
         reach = past / math.cos(off)
