@@ -264,6 +264,24 @@ def test_a_look_is_weighed_in_the_worker_on_a_fork_of_the_belief(make_rig, monke
     assert first.gain == 1.0 and len(first.glimpses) == 1  # the fork took it all
 
 
+def test_a_distance_measured_at_a_wall_replaces_the_beliefs_own_reading(make_rig):
+    """Until a straight drive at a wall measures the odometry's distance, the belief reads
+    it from its looks (``CorridorBelief.likeliest_scale``). Once measured, the next look
+    moves the belief to the measured gain and drops its own reading: the two would count
+    the same error twice."""
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH), width=320, height=240)
+    views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
+    rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
+    rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
+    rig.get("belief").rescale(1.0, 0.94)  # as if the looks had read the distance short
+    base = rig.ctx.base
+    base._scales.append((1.03, 12.0))  # a straight drive at a wall measured it
+    base.distance_gain = 1.03
+    rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
+    belief = rig.get("belief")
+    assert (belief.gain, belief.scale) == (1.03, 1.0) and len(belief.glimpses) == 2
+
+
 @pytest.mark.parametrize("new_gain", [False, True])
 def test_a_drive_adds_no_ray_after_a_new_distance_gain_until_a_look(
     make_rig, monkeypatch, new_gain
