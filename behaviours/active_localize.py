@@ -63,10 +63,6 @@ SLIDE_ACROSS_M = 0.5
 # so a six-view panorama looks every 5 deg. From a bare corridor a side opening a few
 # metres off is seen only through a narrow window of bearings (4 m off: 11-19 deg from
 # the axis), and only a thin ray that passes it ends beyond the corridor's side walls.
-# The odometry's distance, as the belief may read it before a drive at a wall measures it:
-# these factors on the calibrated distance, a priori within DISTANCE_SIGMA of 1.
-DISTANCE_SCALES = tuple(np.round(np.arange(0.92, 1.081, 0.02), 2))
-DISTANCE_SIGMA = 0.05
 FREE_BEARINGS = tuple(math.radians(b) for b in np.arange(-27.5, 28.0, 5.0))
 RAY_HALF_WIDTH_M = 0.05  # a thin ray: the floor along a line, not the body's swept strip
 
@@ -181,7 +177,6 @@ class UpdateBelief(PmNavBehaviour):
                 odom, seen, free=read.free, named=read.named, to_centre=read.to_centre
             )
             b.observe(glimpse, axis_odom=read.axis)
-            b = _likeliest_scale(b, ctx.base)
             return read, b, len(seen), b.best_cluster()[1]
 
         self._job = ctx.worker.submit(job)
@@ -219,28 +214,10 @@ def _new_belief(ctx, goal, prior) -> CorridorBelief:
 
 def _rescale(belief: CorridorBelief, base) -> None:
     """Keep the belief's positions in the odometry's calibrated distance (it changes when a
-    straight drive at a wall ends: ``CalibratedBase``), which replaces the belief's own
-    reading of it once measured. Slow when the belief moves
+    straight drive at a wall ends: ``CalibratedBase``). Slow when the belief moves
     (``CorridorBelief.rescale_due``)."""
     if isinstance(base, CalibratedBase):
-        belief.rescale(base.distance_gain, 1.0 if base.distance_measured else None)
-
-
-def _rescale_due(belief: CorridorBelief, base) -> bool:
-    """Whether ``_rescale`` would move the belief (too slow for a tick)."""
-    if not isinstance(base, CalibratedBase):
-        return False
-    return belief.rescale_due(base.distance_gain, 1.0 if base.distance_measured else None)
-
-
-def _likeliest_scale(belief: CorridorBelief, base) -> CorridorBelief:
-    """Until a straight drive at a wall has measured the odometry's distance, the belief
-    moved to the distance under which what it holds is likeliest
-    (``CorridorBelief.likeliest_scale``, ``DISTANCE_SCALES``)."""
-    measured = isinstance(base, CalibratedBase) and base.distance_measured
-    if measured or len(belief.glimpses) < 2:
-        return belief
-    return belief.likeliest_scale(DISTANCE_SCALES, DISTANCE_SIGMA)
+        belief.rescale(base.distance_gain)
 
 
 def _goal_xy(pm, goal) -> tuple[float, float] | None:
@@ -549,7 +526,8 @@ class FollowLead(PmNavBehaviour):
         belief: CorridorBelief | None = self.get("belief")
         if belief is None or free is None or not self._driving or self._rethink_job is not None:
             return  # (not while the lead is worked out again on the belief, in the worker)
-        if _rescale_due(belief, self.ctx.base):
+        base = self.ctx.base
+        if isinstance(base, CalibratedBase) and belief.rescale_due(base.distance_gain):
             return
         x, y = self._last_ray
         if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:

@@ -142,10 +142,6 @@ class CorridorBelief:
     # The odometry's distance gain (``CalibratedBase``) the positions held were driven
     # under: when it changes, they are scaled about the reference (``rescale``).
     gain: float = 1.0
-    # The belief's own reading of the odometry's distance on top of ``gain``, until a
-    # straight drive at a wall has measured it (``likeliest_scale``): positions held are
-    # driven distances times gain times scale.
-    scale: float = 1.0
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm, self.read_range)
@@ -280,7 +276,7 @@ class CorridorBelief:
                 drift, took = drift + step, True
         mean = (self._drift + drift) / 2.0
         c, s = math.cos(-mean), math.sin(-mean)
-        dx, dy = self.scale * (odom.x - self._raw.x), self.scale * (odom.y - self._raw.y)
+        dx, dy = odom.x - self._raw.x, odom.y - self._raw.y
         self._corr = (self._corr[0] + c * dx - s * dy, self._corr[1] + s * dx + c * dy)
         self._drift, self._raw = drift, odom
         return took
@@ -305,25 +301,21 @@ class CorridorBelief:
         self._weigh_ray(ray, self._map_T_odom())
         self.rays.append(ray)
 
-    def rescale(self, gain: float, scale: float | None = None) -> None:
-        """The odometry's distance calibration is now ``gain`` (and the belief's own
-        reading on top of it ``scale``; None: as it is): every position the belief holds
-        (glimpses, signs seen, drive rays, the straightened odometry) was driven under the
-        old ones, so it is moved from the reference by new / old and every hypothesis is
+    def rescale(self, gain: float) -> None:
+        """The odometry's distance calibration is now ``gain``: every position the belief
+        holds (glimpses, signs seen, drive rays, the straightened odometry) was driven under
+        the old one, so it is moved from the reference by new / old and every hypothesis is
         weighed again. Each hypothesis is one rigid transform from the reference: without
         this, a long first leg on odometry 5 % long puts the true place a metre and a half
         short of the wall it then meets, and the walls rule it out.
 
-        A change within ``RESCALE_MIN`` of the distance the positions are in waits
-        (``gain`` and ``scale`` stay): several small ones in a row move them once they add
-        up to more."""
-        scale = self.scale if scale is None else scale
+        A change within ``RESCALE_MIN`` of the gain the positions are in waits (``gain``
+        stays): several small ones in a row move them once they add up to more."""
         if self.ref is None:  # nothing held yet
-            self.gain, self.scale = gain, scale
-        if not self.rescale_due(gain, scale):
+            self.gain = gain
+        if not self.rescale_due(gain):
             return
-        k = gain * scale / (self.gain * self.scale)
-        self.gain, self.scale = gain, scale
+        k, self.gain = gain / self.gain, gain
         rx, ry = self.ref.x, self.ref.y
 
         def moved(xy) -> tuple[float, float]:
@@ -331,8 +323,7 @@ class CorridorBelief:
 
         def glimpse(g: Glimpse) -> Glimpse:
             x, y = moved((g.odom.x, g.odom.y))
-            # A sign's place is measured from the robot by the camera, not driven to.
-            seen = {e: (xy[0] + x - g.odom.x, xy[1] + y - g.odom.y) for e, xy in g.seen.items()}
+            seen = {e: moved(xy) for e, xy in g.seen.items()}
             return replace(g, odom=replace(g.odom, x=x, y=y), seen=seen)
 
         self.glimpses = [glimpse(g) for g in self.glimpses]
@@ -340,39 +331,10 @@ class CorridorBelief:
         self._corr = moved(self._corr)
         self._build()
 
-    def rescale_due(self, gain: float, scale: float | None = None) -> bool:
-        """Whether ``rescale(gain, scale)`` would move what the belief holds and weigh
-        every hypothesis again (too slow for a tick: behaviours do it in the worker)."""
-        scale = self.scale if scale is None else scale
-        return (
-            self.ref is not None
-            and abs(gain * scale / (self.gain * self.scale) - 1.0) >= RESCALE_MIN
-        )
-
-    def likeliest_scale(self, scales, sigma: float) -> CorridorBelief:
-        """This belief, or a fork of it moved to the one of ``scales`` (the belief's own
-        reading of the odometry's distance, on top of ``gain``) under which what it holds
-        is likeliest: summed over every hypothesis, with a prior of spread ``sigma``
-        about 1. Until a straight drive at a wall has measured the odometry's distance,
-        5 % of it too much puts every hypothesis 1.5 m behind the robot 30 m on: a look
-        round 3 m short of the true junction then scores the true place below a dead end
-        elsewhere (the depth and the corridors' shape disagree by metres). Slow: every
-        scale weighs every hypothesis again (the worker's job)."""
-
-        def score(b: CorridorBelief) -> float:
-            top = float(b.logw.max())
-            prior = -0.5 * ((b.scale - 1.0) / sigma) ** 2
-            return top + math.log(float(np.exp(b.logw - top).sum())) + prior
-
-        best, best_score = self, score(self)
-        for s in scales:
-            if not self.rescale_due(self.gain, s):
-                continue
-            other = self.fork()
-            other.rescale(self.gain, s)
-            if (sc := score(other)) > best_score:
-                best, best_score = other, sc
-        return best
+    def rescale_due(self, gain: float) -> bool:
+        """Whether ``rescale(gain)`` would move what the belief holds and weigh every
+        hypothesis again (too slow for a tick: behaviours do it in the worker)."""
+        return self.ref is not None and abs(gain / self.gain - 1.0) >= RESCALE_MIN
 
     def _straighten_tf(self) -> tuple[float, float, float]:
         """straightened_T_odom at the last glimpse."""

@@ -131,12 +131,6 @@ class CalibratedBase(WrappedBase):
     def __getattr__(self, name):  # helpers of the wrapped base (tests, runners)
         return getattr(self.inner, name)
 
-    @property
-    def distance_measured(self) -> bool:
-        """Whether a straight drive at a wall has measured the distance gain yet."""
-        with self._lock:
-            return bool(self._scales)
-
     def calibrate(self, error: float) -> float:
         """Take in a measured ``rotation_scale_error`` (of the calibrated odometry); the
         new gain: the mean of the gains every measurement so far asked for."""

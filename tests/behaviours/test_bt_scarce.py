@@ -244,10 +244,10 @@ def test_a_look_is_weighed_in_the_worker_on_a_fork_of_the_belief(make_rig, monke
     ran = []  # (what, thread) of each rescale that moved a belief and each look weighed
     rescale, observe = CorridorBelief.rescale, CorridorBelief.observe
 
-    def watched_rescale(self, gain, scale=None):
-        if self.rescale_due(gain, scale):
+    def watched_rescale(self, gain):
+        if self.rescale_due(gain):
             ran.append(("rescale", threading.current_thread().name))
-        rescale(self, gain, scale)
+        rescale(self, gain)
 
     def watched_observe(self, glimpse, axis_odom=None):
         ran.append(("observe", threading.current_thread().name))
@@ -258,28 +258,10 @@ def test_a_look_is_weighed_in_the_worker_on_a_fork_of_the_belief(make_rig, monke
     rig.ctx.base.distance_gain = 1.05  # as if a drive at a wall had measured it
     rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
     second = rig.get("belief")
-    assert [w for w, _ in ran][:2] == ["rescale", "observe"]  # then the distance fit
+    assert [w for w, _ in ran] == ["rescale", "observe"]
     assert all(t.startswith("pmnav-worker") for _, t in ran), ran
     assert second.gain == 1.05 and len(second.glimpses) == 2
     assert first.gain == 1.0 and len(first.glimpses) == 1  # the fork took it all
-
-
-def test_a_distance_measured_at_a_wall_replaces_the_beliefs_own_reading(make_rig):
-    """Until a straight drive at a wall measures the odometry's distance, the belief reads
-    it from its looks (``CorridorBelief.likeliest_scale``). Once measured, the next look
-    moves the belief to the measured gain and drops its own reading: the two would count
-    the same error twice."""
-    rig = make_rig(Pose2D(0.0, 26.5, SOUTH), width=320, height=240)
-    views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
-    rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
-    rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
-    rig.get("belief").rescale(1.0, 0.94)  # as if the looks had read the distance short
-    base = rig.ctx.base
-    base._scales.append((1.03, 12.0))  # a straight drive at a wall measured it
-    base.distance_gain = 1.03
-    rig.expect(rig.run(UpdateBelief("LocalizeBelief", rig.ctx), 100), Status.SUCCESS)
-    belief = rig.get("belief")
-    assert (belief.gain, belief.scale) == (1.03, 1.0) and len(belief.glimpses) == 2
 
 
 @pytest.mark.parametrize("new_gain", [False, True])
