@@ -24,7 +24,7 @@ from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_vi
 from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
-from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
+from pmnav_bt.pose.odometry import TRACK_FREE_M, CalibratedBase, rotation_scale_error
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.pose.walls import (
     axis_in_odom,
@@ -47,6 +47,7 @@ CENTRE_LOOKAHEAD_M = 3.0  # steer back onto the corridor's centre line over this
 MAX_CENTRE_TURN = math.radians(15.0)  # ... turning at most this far off the axis for it
 WALL_CHECK_S = 1.0  # clock seconds between wall checks while driving along the corridor
 STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
+MEASURE_NEAR_M = 3.5  # drive on to this far from a wall ahead while the distance is unmeasured
 RAY_SPACING_M = 1.0  # while driving, add the free floor ahead to the belief this often ...
 RETHINK_EVERY_M = 3.0  # ... and work the lead out again every so far (a junction passed)
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
@@ -455,6 +456,7 @@ class FollowLead(PmNavBehaviour):
         self._rethink_job = None
         self._thought_at = self._start
         self._sign_stop = False  # the distance was cut short for a sign seen ahead
+        self._measure_extended = False  # driven on to measure the distance at a wall
         self.bb.set("drive_end", None)
 
     def _aim(self, lead, pose: Pose2D) -> None:
@@ -556,6 +558,29 @@ class FollowLead(PmNavBehaviour):
             )
         return False
 
+    def _approach_to_measure(self, base, done_m: float) -> bool:
+        """At the end of the drive with a wall ahead within the distance calibration's
+        reach and the odometry's distance not measured yet: drive on (once) to
+        ``MEASURE_NEAR_M`` from it, so that the approach spans the ``MIN_TRACK_M`` a
+        measurement needs. Until then each hypothesis is a rigid transform of distances
+        counted up to 10 % long, and a look a few metres short of a T junction takes
+        the dead end that many metres long for it."""
+        if (
+            self._measure_extended
+            or self._sign_stop
+            or not isinstance(base, CalibratedBase)
+            or base.distance_measured
+            or not MEASURE_NEAR_M < self._free_ahead <= TRACK_FREE_M[1]
+        ):
+            return False
+        self._measure_extended = True
+        self._distance = done_m + (self._free_ahead - MEASURE_NEAR_M)
+        self.feedback_message = (
+            f"a wall {self._free_ahead:.1f} m ahead: on to {MEASURE_NEAR_M:.1f} m from it, "
+            "where its approach measures the odometry's distance"
+        )
+        return True
+
     def _sliding(self, pose: Pose2D) -> bool:
         """Slide past a corner (along the open bearing beside it, ``SLIDE_ACROSS_M`` across
         the drive's heading); True once done (then the drive faces its heading and looks at
@@ -607,7 +632,9 @@ class FollowLead(PmNavBehaviour):
             self._driving = True
             self._best_t = now
         done_m = math.hypot(pose.x - self._start[0], pose.y - self._start[1])
-        if done_m >= self._distance:
+        if done_m >= self._distance and self._approach_to_measure(base, done_m):
+            pass  # on a little, towards the wall ahead: its approach measures the distance
+        elif done_m >= self._distance:
             base.set_velocity(0.0, 0.0)
             self.bb.set("drive_end", DriveEnd.SIGN if self._sign_stop else DriveEnd.COVERED)
             return Status.SUCCESS

@@ -180,6 +180,12 @@ class CalibratedBase(WrappedBase):
         with self._lock:
             return self._update(self.inner.pose())
 
+    @property
+    def distance_measured(self) -> bool:
+        """Whether a straight drive at a wall has measured the distance gain yet."""
+        with self._lock:
+            return bool(self._scales)
+
     def _extend_track(self, raw: Pose2D, free: float) -> None:
         """Add a frame (its raw odometry pose and the free floor ahead) to the
         straight-drive track, ending the track and taking in its scale when the frame
