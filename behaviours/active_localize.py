@@ -48,6 +48,8 @@ MAX_CENTRE_TURN = math.radians(15.0)  # ... turning at most this far off the axi
 WALL_CHECK_S = 1.0  # clock seconds between wall checks while driving along the corridor
 STOP_BEFORE_M = 0.9  # stop when depth shows a wall this close ahead
 MEASURE_NEAR_M = 3.5  # drive on to this far from a wall ahead while the distance is unmeasured
+MEASURE_STALE_M = 1.0  # ... seen up to this much beyond the calibration's reach (the last
+# depth reading is up to a wall check old)
 RAY_SPACING_M = 1.0  # while driving, add the free floor ahead to the belief this often ...
 RETHINK_EVERY_M = 3.0  # ... and work the lead out again every so far (a junction passed)
 ALONG_WALL_MAX = math.radians(35.0)  # a wall more oblique than this is not the corridor's
@@ -559,8 +561,8 @@ class FollowLead(PmNavBehaviour):
         return False
 
     def _approach_to_measure(self, base, done_m: float) -> bool:
-        """At the end of the drive with a wall ahead within the distance calibration's
-        reach and the odometry's distance not measured yet: drive on (once) to
+        """At the end of the drive with a wall ahead within (about) the distance
+        calibration's reach and the odometry's distance not measured yet: drive on (once) to
         ``MEASURE_NEAR_M`` from it, so that the approach spans the ``MIN_TRACK_M`` a
         measurement needs. Until then each hypothesis is a rigid transform of distances
         counted up to 10 % long, and a look a few metres short of a T junction takes
@@ -570,7 +572,7 @@ class FollowLead(PmNavBehaviour):
             or self._sign_stop
             or not isinstance(base, CalibratedBase)
             or base.distance_measured
-            or not MEASURE_NEAR_M < self._free_ahead <= TRACK_FREE_M[1]
+            or not MEASURE_NEAR_M < self._free_ahead <= TRACK_FREE_M[1] + MEASURE_STALE_M
         ):
             return False
         self._measure_extended = True

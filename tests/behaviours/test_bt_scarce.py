@@ -232,6 +232,35 @@ def test_a_straight_drive_at_a_wall_calibrates_the_odometry_distance(make_rig):
     assert math.dist((cal0.x, cal0.y), (cal1.x, cal1.y)) / true == pytest.approx(1.0, abs=0.01)
 
 
+@pytest.mark.parametrize("measured", [False, True])
+def test_a_drive_ending_short_of_a_wall_goes_on_until_its_approach_measures_the_distance(
+    make_rig, measured
+):
+    """sign_sparse_2 seed 3 #3 at 5 %: a localization drive stopped 4.8 m from the wall
+    ahead, 1.2 m of approach, short of the 2 m a distance calibration needs; with the
+    odometry 9.7 % long the looks then took a dead end for the T junction it was at.
+    Here fig2 (seed 43, 7.5 % long): a 2 m drive south from 6.5 m north of turn1 ends with
+    its end wall 5.7 m ahead; while the distance is unmeasured the drive goes on to 3.5 m
+    from the wall and turning round after it measures the gain; once measured, the drive
+    stops where its lead ends."""
+    from pmnav_bt.behaviours.active_localize import MEASURE_NEAR_M, FollowLead
+
+    rig = make_rig(Pose2D(0.0, 6.5, SOUTH), width=320, height=240, noise=0.05, seed=43)
+    if measured:
+        rig.ctx.base._scales.append((1.0, 3.0))  # as if a drive at a wall had measured it
+    lead = FollowLead("FollowLead", rig.ctx, max_distance=2.0)  # no belief: 2 m on
+    rig.expect(rig.run(lead, 2000), Status.SUCCESS)
+    wall = -1.2  # turn1's end wall, south of its centre
+    if measured:
+        assert rig.true_pose().y == pytest.approx(6.5 - 2.0 / 1.0749, abs=0.2)
+        return
+    assert rig.true_pose().y - wall == pytest.approx(MEASURE_NEAR_M, abs=0.4), lead.feedback_message
+    rig.expect(rig.run(Spin("TurnRound", rig.ctx, math.pi), 300), Status.SUCCESS)
+    rig.ctx.base.observe()  # a turned frame ends the track
+    assert rig.ctx.base.distance_measured
+    assert rig.ctx.base.distance_gain == pytest.approx(1.0 / 1.0749, rel=0.01)
+
+
 def test_a_look_is_weighed_in_the_worker_on_a_fork_of_the_belief(make_rig, monkeypatch):
     """Weighing every hypothesis with a look (and, after a new distance gain, moving what
     the belief holds: 1-2 s) runs in UpdateBelief's worker job, on a fork of the belief
