@@ -634,9 +634,8 @@ class FollowLead(PmNavBehaviour):
             self._driving = True
             self._best_t = now
         done_m = math.hypot(pose.x - self._start[0], pose.y - self._start[1])
-        if done_m >= self._distance and self._approach_to_measure(base, done_m):
-            pass  # on a little, towards the wall ahead: its approach measures the distance
-        elif done_m >= self._distance:
+        # At the lead's end: stop, unless driving on to a wall ahead measures the distance.
+        if done_m >= self._distance and not self._approach_to_measure(base, done_m):
             base.set_velocity(0.0, 0.0)
             self.bb.set("drive_end", DriveEnd.SIGN if self._sign_stop else DriveEnd.COVERED)
             return Status.SUCCESS
