@@ -19,6 +19,7 @@ from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose, sighting
+from pmnav_bt.perception.door_sightings import find_doors
 from pmnav_bt.perception.geometry import free_distance, target_point
 from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_visible_range
 from pmnav_bt.planning.resolve import resolve_room
@@ -75,15 +76,27 @@ def wall_mask(grounder: Grounder, obs: Observation):
     return grounder.surfaces(obs).wall
 
 
+def doors_in_odom(obs: Observation, mask) -> tuple[tuple[float, float], ...]:
+    """The doors seen along the walls of a frame (``door_sightings``), odometry xy."""
+    if mask is None:
+        return ()
+    p = obs.pose
+    return tuple(
+        tuple(se2_apply((p.x, p.y, p.yaw), d.centre))  # type: ignore[misc]
+        for d in find_doors(obs, mask)
+    )
+
+
 def read_panorama(ctx: Context, views: list) -> Panorama:
     """What a panorama tells the belief (``Panorama``). Worker only.
 
     A rotation-scale error turns each view's odometry yaw by a share of the turning since:
     the views are put back into the odometry frame of the last one (where the robot is
     now) before signs, free floor and the axis are read from them."""
-    fits, walls = [], []
+    fits, walls, masks = [], [], []
     for i, v in enumerate(views):
         mask = wall_mask(ctx.grounder, v.observation)
+        masks.append(mask)
         points = None if mask is None else wall_points(v.observation, mask)
         lines = [] if points is None else wall_lines(points, 2)
         if lines:
@@ -117,7 +130,17 @@ def read_panorama(ctx: Context, views: list) -> Panorama:
         for v in views
         for b in FREE_BEARINGS
     )
-    return Panorama(sightings, axis, free, error, frozenset(named), way_to_centre(seen, axis))
+    doors, door_views = (), ()
+    if ctx.config.tree.localization_doors:
+        doors = tuple(
+            d for v, m in zip(views, masks, strict=True) for d in doors_in_odom(v.observation, m)
+        )
+        door_views = tuple(
+            v.observation.pose.yaw for v, m in zip(views, masks, strict=True) if m is not None
+        )
+    return Panorama(
+        sightings, axis, free, error, frozenset(named), way_to_centre(seen, axis), doors, door_views
+    )
 
 
 @dataclass(frozen=True)
@@ -125,8 +148,9 @@ class Panorama:
     """What a panorama tells: the signs read with a place, the corridor axis (odometry,
     mod pi; None: no walls seen), the free floor along each view's ``FREE_BEARINGS``
     ((odometry yaw, m) each), the odometry's rotation-scale error (None: not measured),
-    the signs read without a place, and the way across to the corridor's centre line
-    (``walls.way_to_centre``).
+    the signs read without a place, the way across to the corridor's centre line
+    (``walls.way_to_centre``), and the doors seen along the walls (odometry xy) with the
+    odometry yaws of the views that looked for them.
     """
 
     sightings: list[Sighting]
@@ -135,6 +159,8 @@ class Panorama:
     rotation_error: float | None
     named: frozenset[Entity]
     to_centre: tuple[float, float] | None
+    doors: tuple[tuple[float, float], ...] = ()
+    door_views: tuple[float, ...] = ()
 
 
 def _turned(obs: Observation, dyaw: float) -> Observation:
@@ -177,7 +203,13 @@ class UpdateBelief(PmNavBehaviour):
             for s in read.sightings:
                 seen.setdefault(s.entity, s.odom_xy)
             glimpse = Glimpse(
-                odom, seen, free=read.free, named=read.named, to_centre=read.to_centre
+                odom,
+                seen,
+                free=read.free,
+                named=read.named,
+                to_centre=read.to_centre,
+                doors=read.doors,
+                door_views=read.door_views,
             )
             b.observe(glimpse, axis_odom=read.axis)
             return read, b, len(seen), b.best_cluster()[1]
@@ -480,10 +512,12 @@ class FollowLead(PmNavBehaviour):
     def _check_walls(self) -> None:
         """Measure the wall direction in view (worker); re-aim along it when it comes."""
         base, grounder = self.ctx.base, self.ctx.grounder
+        look_for_doors = self.ctx.config.tree.localization_doors
 
         def measure(cancelled):
             obs = base.observe()
             mask = wall_mask(grounder, obs)
+            doors = doors_in_odom(obs, mask) if look_for_doors and mask is not None else None
             points = None if mask is None else wall_points(obs, mask)
             lines = [] if points is None else wall_lines(points, 2)  # fitted once, for both
             ahead = [_ahead(obs, d) for d in grounder.read_signs(obs)]
@@ -495,6 +529,7 @@ class FollowLead(PmNavBehaviour):
                 free,
                 centre_between(lines),
                 _open_beside(obs) if free is not None and free < STOP_BEFORE_M else None,
+                doors,
             )
 
         self._job = self.ctx.worker.submit(measure)
@@ -504,7 +539,7 @@ class FollowLead(PmNavBehaviour):
             return
         job, self._job = self._job, None
         try:
-            seen_from, angle, ahead, free, centre, self._open_beside = job.result()
+            seen_from, angle, ahead, free, centre, self._open_beside, doors = job.result()
         except Exception:  # noqa: BLE001 - a lost wall check: drive on, check again
             return
         if self._slide is not None:  # seen while turning to slide: not along the way
@@ -518,13 +553,20 @@ class FollowLead(PmNavBehaviour):
             self._heading = axis + max(-MAX_CENTRE_TURN, min(MAX_CENTRE_TURN, steer))
         elif angle is not None and abs(angle) < ALONG_WALL_MAX:
             axis = self._heading = yaw + angle  # parallel to the wall in view
-        self._note_ray(seen_from, free, axis)
+        self._note_ray(seen_from, free, axis, doors)
         self._signs_ahead = ahead
         self._free_ahead = math.inf if free is None else free
 
-    def _note_ray(self, seen_from: Pose2D, free: float | None, axis: float | None) -> None:
-        """Add the free floor ahead and the walls' axis (odometry; None: not seen) to the
-        belief every ``RAY_SPACING_M`` of the drive. Not after the odometry's distance gain
+    def _note_ray(
+        self,
+        seen_from: Pose2D,
+        free: float | None,
+        axis: float | None,
+        doors: tuple[tuple[float, float], ...] | None = None,
+    ) -> None:
+        """Add the free floor ahead, the walls' axis (odometry; None: not seen) and the
+        doors seen along the walls (None: not looked for) to the belief every
+        ``RAY_SPACING_M`` of the drive. Not after the odometry's distance gain
         has changed until the next look moves the belief to it (in the worker: too slow for
         a tick): a ray would mix two gains."""
         belief: CorridorBelief | None = self.get("belief")
@@ -537,7 +579,7 @@ class FollowLead(PmNavBehaviour):
         if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:
             return
         self._last_ray = (seen_from.x, seen_from.y)
-        belief.observe_ray(seen_from, min(free, 50.0), axis)
+        belief.observe_ray(seen_from, min(free, 50.0), axis, doors)
 
     def _rethink(self, pose: Pose2D) -> bool:
         """Whether the lead, worked out again (worker) every ``RETHINK_EVERY_M`` of the drive

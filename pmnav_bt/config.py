@@ -173,6 +173,11 @@ class TreeConfig(_Section):
         le=100.0,
         description="budget = max(budget_actions, factor * corridor route in forward steps)",
     )
+    localization_doors: bool = Field(
+        True,
+        description="localization: doors seen along the walls (door_sightings) weigh the "
+        "corridor belief, from 12 m, where signs are read from 3.5 m",
+    )
     localization_attempts: int = Field(
         10, ge=1, le=100, description="localization tries (panoramas) before giving up"
     )

@@ -86,6 +86,17 @@ TELLING_LOOKED_M = 1.5  # a place this close to an earlier glimpse was looked fr
 LOOK_ALIKE_M = 1.0
 LOOK_BEARINGS = np.radians(np.arange(0.0, 360.0, 15.0))
 RESCALE_MIN = 0.002  # a change of the odometry's distance gain smaller than this waits
+# Doors seen along the walls (``perception.door_sightings``): found 95 % of the time 4-13 m
+# off in the simulator's views, never where none is (``benchmarks/bench_door_sightings.py``).
+DOOR_SEEN_M = (2.0, 12.0)  # a map door this far off, on the robot's corridor, is in view ...
+DOOR_FOV_MARGIN = math.radians(4.0)  # ... well inside a view that looked for doors
+HALF_FOV = math.radians(30.0)  # the camera's 60 deg (a wider one only sees more)
+DOOR_WALL_NEAR_M = 2.5  # ... from its wall line (not round a corner) ...
+DOOR_MATCH_M = 1.0  # a door seen this close to a map door (or landmark) is that one
+P_DOOR_MISS = 0.2  # a map door in view is not seen (a look round)
+P_DOOR_SPURIOUS = 0.1  # a door is seen where the map has none
+# ... while driving, one view ahead every metre: the same door again and again
+P_DRIVE_DOOR_MISS, P_DRIVE_DOOR_SPURIOUS = 0.6, 0.4
 
 
 @dataclass(frozen=True)
@@ -101,6 +112,10 @@ class Glimpse:
     named: frozenset[Entity] = frozenset()
     # The way (odometry, m) from the robot to the corridor's centre line, seen in depth.
     to_centre: tuple[float, float] | None = None
+    # Doors seen along the walls (odometry xy of each), and the odometry yaws of the views
+    # that looked for them (none: no door evidence).
+    doors: tuple[tuple[float, float], ...] = ()
+    door_views: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -160,6 +175,7 @@ class CorridorBelief:
             [self.pm.segments[p.segment - 1].width / 2.0 for p in self.vis.lattice_points]
         )
         shapely.prepare(self._floor)
+        self._doors = _MapDoors.of(self.pm, self.vis)
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs
@@ -259,6 +275,8 @@ class CorridorBelief:
             None if glimpse.blocked is None else wrap_angle(glimpse.blocked - drift),
             tuple((wrap_angle(y - drift), f) for y, f in glimpse.free),
             glimpse.named,
+            doors=tuple(tuple(self._straighten(xy)) for xy in glimpse.doors),
+            door_views=tuple(wrap_angle(y - drift) for y in glimpse.door_views),
         )
         self.glimpses.append(g)
         self._weigh(g)
@@ -281,7 +299,13 @@ class CorridorBelief:
         self._drift, self._raw = drift, odom
         return took
 
-    def observe_ray(self, odom: Pose2D, free: float, axis_odom: float | None = None) -> None:
+    def observe_ray(
+        self,
+        odom: Pose2D,
+        free: float,
+        axis_odom: float | None = None,
+        doors: tuple[tuple[float, float], ...] | None = None,
+    ) -> None:
         """Add the free floor (m) seen in depth straight ahead from ``odom`` while driving:
         a hypothesis under which the map has a wall within that reach is a little less
         likely (``P_DRIVE_RAY``), so readings along a drive tell apart places where the
@@ -291,13 +315,18 @@ class CorridorBelief:
         ``axis_odom``: the walls' axis in view there (odometry). Taken in along the drive,
         it keeps the heading drift current: on a long drive the odometry's heading can
         drift further between two looks round than a jump the belief would believe
-        (``MAX_DRIFT_STEP``), and the straightened leg bends with the drift as it grows."""
+        (``MAX_DRIFT_STEP``), and the straightened leg bends with the drift as it grows.
+
+        ``doors``: the doors seen in that view (odometry xy; None: not looked for)."""
         if self.ref is None:
             return
         self._advance(odom, axis_odom)
         p = self._straighten((odom.x, odom.y))
         yaw = wrap_angle(odom.yaw - self._drift)
         ray = Glimpse(Pose2D(float(p[0]), float(p[1]), yaw), {}, free=((yaw, free),))
+        if doors is not None:
+            seen = tuple(tuple(self._straighten(xy)) for xy in doors)
+            ray = replace(ray, doors=seen, door_views=(yaw,))
         self._weigh_ray(ray, self._map_T_odom())
         self.rays.append(ray)
 
@@ -324,7 +353,8 @@ class CorridorBelief:
         def glimpse(g: Glimpse) -> Glimpse:
             x, y = moved((g.odom.x, g.odom.y))
             seen = {e: moved(xy) for e, xy in g.seen.items()}
-            return replace(g, odom=replace(g.odom, x=x, y=y), seen=seen)
+            doors = tuple(moved(xy) for xy in g.doors)
+            return replace(g, odom=replace(g.odom, x=x, y=y), seen=seen, doors=doors)
 
         self.glimpses = [glimpse(g) for g in self.glimpses]
         self.rays = [glimpse(r) for r in self.rays]
@@ -407,6 +437,7 @@ class CorridorBelief:
         here = _apply_many(tfs, (r.odom.x, r.odom.y))
         for yaw, free in r.free:
             self._weigh_free(tfs, here, r.odom, yaw, free, P_DRIVE_RAY)
+        self._weigh_doors(r, tfs, here, P_DRIVE_DOOR_MISS, P_DRIVE_DOOR_SPURIOUS)
 
     def _blocked_log(self, tfs: np.ndarray, xy, blocked: float) -> np.ndarray:
         """Log-weights for a drive blocked from ``xy`` heading ``blocked`` (straightened
@@ -443,12 +474,58 @@ class CorridorBelief:
             self._weigh_free(tfs, here, g.odom, yaw, free, P_DEPTH)
         return here, near
 
+    def _weigh_doors(
+        self,
+        g: Glimpse,
+        tfs: np.ndarray,
+        here: np.ndarray,
+        p_miss: float,
+        p_spurious: float,
+        sigma: float = SIGHT_SIGMA_M,
+    ) -> None:
+        """Reweigh by the doors seen along the walls: a map door on the robot's corridor,
+        in a view that looked for doors and within ``DOOR_SEEN_M``, not seen costs
+        ``p_miss``; a door seen where the map has no door or landmark costs
+        ``p_spurious``. Which door it is is not known, only that one is there."""
+        if not g.door_views or self._doors.xy.shape[0] == 0:
+            return
+        md = self._doors
+        tol = max(DOOR_MATCH_M, 1.5 * sigma)
+        seen = np.array(g.doors, dtype=float).reshape(-1, 2)
+        seen_map = np.stack([_apply_many(tfs, xy) for xy in seen], 1) if len(seen) else None
+        if seen_map is not None:  # (N, K, 2): each door seen, where each hypothesis puts it
+            to_any = np.linalg.norm(seen_map[:, :, None] - md.any_xy[None, None], axis=3)
+            self.logw += (to_any.min(axis=2) > tol).sum(axis=1) * math.log(p_spurious)
+        v = md.xy[None] - here[:, None]  # (N, M, 2)
+        dist = np.linalg.norm(v, axis=2)
+        bearing = np.arctan2(v[..., 1], v[..., 0])
+        half = HALF_FOV - DOOR_FOV_MARGIN
+        in_view = np.zeros(dist.shape, bool)
+        for yaw in g.door_views:
+            off = np.angle(np.exp(1j * (bearing - (yaw + tfs[:, 2])[:, None])))
+            in_view |= np.abs(off) <= half
+        in_view &= (dist >= DOOR_SEEN_M[0]) & (dist <= DOOR_SEEN_M[1])
+        # On the robot's corridor: the robot is within a corridor's width of its wall line
+        # (a door round a corner, on a crossing corridor's wall, is seen edge-on or not).
+        across = md.along[None, :, 0] * v[..., 1] - md.along[None, :, 1] * v[..., 0]
+        in_view &= np.abs(across) <= DOOR_WALL_NEAR_M
+        if seen_map is not None:
+            to_seen = np.linalg.norm(md.xy[None, :, None] - seen_map[:, None], axis=3)
+            in_view &= to_seen.min(axis=2) > tol
+        if not in_view.any():
+            return
+        hi, di = np.nonzero(in_view)
+        lines = shapely.linestrings(np.stack([here[hi], md.front[di]], 1))
+        clear = shapely.covers(self._floor, lines)
+        np.add.at(self.logw, hi[clear], math.log(p_miss))
+
     def _weigh(self, g: Glimpse) -> None:
         tfs = self._map_T_odom()
         ref = self.ref
         travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
         sigma = math.hypot(SIGHT_SIGMA_M, DRIFT_PER_M * travelled)
         here_xy, near = self._weigh_depth(g, tfs)
+        self._weigh_doors(g, tfs, here_xy, P_DOOR_MISS, P_DOOR_SPURIOUS, sigma)
         # What the map says is readable at each hypothesis's position for this glimpse.
         readable = [self.vis.lattice_points[j].readable for j in near]
         seen = g.seen.keys()
@@ -925,6 +1002,30 @@ def _sign_shift(tf, src, dst, placed) -> tuple[np.ndarray, float, float]:
     shift = (kept * wk[:, None]).sum(axis=0) / wk.sum()
     res = float(np.sqrt(np.mean(np.sum((kept - shift) ** 2, axis=1))))
     return shift, res, float(1.0 / math.sqrt(wk.sum()))
+
+
+@dataclass(frozen=True)
+class _MapDoors:
+    """The map's room doors as the door sightings see them: on the wall (``xy``), a point
+    in front of each in the corridor (``front``, for the line of sight), the wall's
+    direction (``along``), and every door and landmark a sighting may be (``any_xy``)."""
+
+    xy: np.ndarray
+    front: np.ndarray
+    along: np.ndarray
+    any_xy: np.ndarray
+
+    @classmethod
+    def of(cls, pm: PrioriMap, vis: Visibility) -> _MapDoors:
+        rooms = [Entity.room(r.id) for r in pm.building.rooms]
+        xy = np.array([entity_xy(pm, e) for e in rooms], float).reshape(-1, 2)
+        front = np.array([vis._inset(p) for p in xy], float).reshape(-1, 2)
+        n = front - xy
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-9)
+        along = np.stack([-n[:, 1], n[:, 0]], 1)
+        marks = [Entity.landmark(lm.id) for lm in pm.building.landmarks]
+        any_xy = np.array([entity_xy(pm, e) for e in rooms + marks], float).reshape(-1, 2)
+        return cls(xy, front, along, any_xy)
 
 
 def _weighted_median(w: np.ndarray, x: np.ndarray) -> float:

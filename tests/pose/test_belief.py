@@ -960,3 +960,39 @@ def test_a_belief_rescaled_with_the_odometrys_distance_keeps_the_true_place():
     assert math.dist((ref.x, ref.y), (moved.x, moved.y)) == pytest.approx(
         1.003 * math.dist((ref.x, ref.y), (before[1].x, before[1].y))
     )
+
+
+def test_doors_seen_far_along_the_walls_tell_an_arm_with_doors_from_a_bare_one():
+    """sign_sparse_2: 17 m east of branch1 looking west, room9's and room8's doors are 8.6
+    and 11.6 m ahead, their signs far out of reading range. The east arm, 17 m from
+    branch3 looking east, has the same free floor and no door. Doors seen where the map
+    has them favour the west arm; doors looked for and not seen favour the east; the one
+    view ahead while driving counts too, if less."""
+    pm = parse_building(generate_sign_sparse(2))
+    west, east = (17.0, 30.0, math.pi), (43.0, 30.0, 0.0)
+    g = _look(pm, west, se2_apply(ODOM_T_MAP, west[:2]))
+    views = tuple(g.odom.yaw + math.radians(60.0 * v) for v in range(6))
+    doors = tuple(
+        tuple(se2_apply(ODOM_T_MAP, entity_xy(pm, Entity.room(r)))) for r in ("room8", "room9")
+    )
+
+    def odds(glimpse, ray_doors=None) -> float:
+        """Weight of the west hypothesis over the east one."""
+        b = CorridorBelief(pm, read_range=3.5)  # the OCR reader's: no sign in reach
+        b.observe(glimpse, axis_odom=glimpse.odom.yaw)
+        if ray_doors is not None:
+            b.observe_ray(glimpse.odom, 50.0, glimpse.odom.yaw, ray_doors)
+        w = b.weights()
+
+        def at(pose):
+            d = np.linalg.norm(b.xy - pose[:2], axis=1)
+            turn = np.abs(np.angle(np.exp(1j * (b.yaw - pose[2]))))
+            return w[np.argmin(d + 10.0 * turn)]
+
+        return float(at(west) / at(east))
+
+    assert odds(g) == pytest.approx(1.0, rel=0.2)  # depth alone: mirror images
+    assert odds(replace(g, doors=doors, door_views=views)) > 20.0
+    assert odds(replace(g, door_views=views)) < 1.0 / 20.0  # two doors in view, not seen
+    assert 1.0 / 20.0 < odds(g, ray_doors=()) < 0.5  # the view ahead: weaker
+    assert odds(g, ray_doors=doors) > 2.0
