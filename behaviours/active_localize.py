@@ -19,6 +19,7 @@ from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
 from pmnav_bt.localization import Sighting, fix_pose, sighting
+from pmnav_bt.perception.depth import surfaces
 from pmnav_bt.perception.door_sightings import find_doors
 from pmnav_bt.perception.geometry import free_distance, target_point
 from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_visible_range
@@ -76,14 +77,16 @@ def wall_mask(grounder: Grounder, obs: Observation):
     return grounder.surfaces(obs).wall
 
 
-def doors_in_odom(obs: Observation, mask) -> tuple[tuple[float, float], ...]:
-    """The doors seen along the walls of a frame (``door_sightings``), odometry xy."""
-    if mask is None:
-        return ()
+def doors_in_odom(obs: Observation) -> tuple[tuple[float, float], ...] | None:
+    """The doors seen along the walls of a frame (``door_sightings``), odometry xy; None
+    without depth (not looked for). The walls are depth's (``depth.surfaces``), whatever
+    the grounder's masks: a segmentation's wall mask leaves the doors out."""
+    if obs.depth is None:
+        return None
     p = obs.pose
     return tuple(
         tuple(se2_apply((p.x, p.y, p.yaw), d.centre))  # type: ignore[misc]
-        for d in find_doors(obs, mask)
+        for d in find_doors(obs, surfaces(obs).wall)
     )
 
 
@@ -93,10 +96,9 @@ def read_panorama(ctx: Context, views: list) -> Panorama:
     A rotation-scale error turns each view's odometry yaw by a share of the turning since:
     the views are put back into the odometry frame of the last one (where the robot is
     now) before signs, free floor and the axis are read from them."""
-    fits, walls, masks = [], [], []
+    fits, walls = [], []
     for i, v in enumerate(views):
         mask = wall_mask(ctx.grounder, v.observation)
-        masks.append(mask)
         points = None if mask is None else wall_points(v.observation, mask)
         lines = [] if points is None else wall_lines(points, 2)
         if lines:
@@ -130,16 +132,21 @@ def read_panorama(ctx: Context, views: list) -> Panorama:
         for v in views
         for b in FREE_BEARINGS
     )
-    doors, door_views = (), ()
+    doors, door_views = [], []
     if ctx.config.tree.localization_doors:
-        doors = tuple(
-            d for v, m in zip(views, masks, strict=True) for d in doors_in_odom(v.observation, m)
-        )
-        door_views = tuple(
-            v.observation.pose.yaw for v, m in zip(views, masks, strict=True) if m is not None
-        )
+        for v in views:
+            if (found := doors_in_odom(v.observation)) is not None:
+                doors += found
+                door_views.append(v.observation.pose.yaw)
     return Panorama(
-        sightings, axis, free, error, frozenset(named), way_to_centre(seen, axis), doors, door_views
+        sightings,
+        axis,
+        free,
+        error,
+        frozenset(named),
+        way_to_centre(seen, axis),
+        tuple(doors),
+        tuple(door_views),
     )
 
 
@@ -517,7 +524,7 @@ class FollowLead(PmNavBehaviour):
         def measure(cancelled):
             obs = base.observe()
             mask = wall_mask(grounder, obs)
-            doors = doors_in_odom(obs, mask) if look_for_doors and mask is not None else None
+            doors = doors_in_odom(obs) if look_for_doors else None
             points = None if mask is None else wall_points(obs, mask)
             lines = [] if points is None else wall_lines(points, 2)  # fitted once, for both
             ahead = [_ahead(obs, d) for d in grounder.read_signs(obs)]

@@ -372,3 +372,25 @@ def test_a_drive_that_meets_a_corner_at_its_start_slides_past_it(make_rig):
     assert true.x > 2.0, (true, lead.feedback_message)  # on, past the corner at x 1.2
     assert abs(true.y) < 1.0
     assert rig.body.stats.collisions == 0
+
+
+@pytest.mark.parametrize("doors_on", [True, False])
+def test_a_panorama_tells_the_belief_where_it_saw_doors(make_rig, doors_on):
+    """The doors seen along the walls (``door_sightings``) in the panorama's views go to
+    the belief in odometry, where the map has them, with the views that looked for them;
+    with ``tree.localization_doors`` off, none are looked for."""
+    overrides = () if doors_on else ("tree.localization_doors=false",)
+    rig = make_rig(NORTH_OF_ROOM4, width=320, height=240, overrides=overrides)
+    views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
+    rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
+    read = read_panorama(rig.ctx, rig.get("views"))
+    if not doors_on:
+        assert read.doors == () and read.door_views == ()
+        return
+    assert len(read.door_views) == len(rig.get("views"))
+    doors = np.array([rig.world.doors[r].centre for r in rig.world.doors])
+    assert len(read.doors) >= 2  # room4's 4.5 m ahead, and more down the corridor
+    for xy in read.doors:  # odometry is the map here (no noise)
+        assert np.min(np.linalg.norm(doors - np.asarray(xy), axis=1)) < 0.5, xy
+    room4 = np.asarray(rig.world.doors["room4"].centre)
+    assert min(np.linalg.norm(np.asarray(read.doors) - room4, axis=1)) < 0.3
