@@ -10,6 +10,7 @@ score the detector: it sees RGB and depth.
 
 Run: python benchmarks/bench_door_sightings.py [--views 200] [--seed 0]
      [--buildings all,sign_sparse_0,sign_sparse_1,sign_sparse_2] [--range 14]
+     [--image docs/img/door_sightings.png]  (two example views, the doors found boxed)
 Views are 320x240 as in the tree (``sim.width``); ``--width 640 --height 480`` for more.
 Prints recall per distance band, spurious detections per view and ms per frame.
 """
@@ -43,8 +44,11 @@ def main() -> None:
     ap.add_argument("--min-px", type=int, default=30, help="label pixels for 'in view'")
     ap.add_argument("--width", type=int, default=320, help="camera pixels (the tree's views)")
     ap.add_argument("--height", type=int, default=240)
+    ap.add_argument("--image", default="", help="write two example views here, doors boxed")
     ap.add_argument("--show-spurious", action="store_true", help="print each spurious one")
     args = ap.parse_args()
+    if args.image:
+        write_examples(args.image, args.width, args.height, args.range)
     names = []
     for n in args.buildings.split(","):
         names += list(builtin_buildings()) if n == "all" else [n]
@@ -123,6 +127,64 @@ def main() -> None:
         f"find_doors: p50 {np.median(ms):.0f} ms, "
         f"p95 {np.percentile(ms, 95):.0f} ms per {args.width}x{args.height} frame"
     )
+
+
+EXAMPLES = (("sign_sparse_2", (15.0, 30.0, 180.0)), ("straight_office", (23.0, 0.0, 180.0)))
+
+
+def write_examples(path: str, width: int, height: int, max_range: float) -> None:
+    """Two views with each door found boxed (door height, its width along the wall) and its
+    distance, scaled up 2x side by side."""
+    import cv2
+
+    from pmnav_bt.perception.depth import project
+    from pmnav_bt.perception.door_sightings import DoorSeen
+
+    panels = []
+    for name, (x, y, yaw_deg) in EXAMPLES:
+        with SimWorld(name) as world:
+            base = SimBase(
+                world, pose=Pose2D(x, y, math.radians(yaw_deg)), width=width, height=height
+            )
+            obs = base.observe()
+            base.close()
+        doors: list[DoorSeen] = find_doors(obs, surfaces(obs).wall, max_range)
+        img = cv2.resize(obs.rgb, (2 * width, 2 * height), interpolation=cv2.INTER_NEAREST)
+        img = np.ascontiguousarray(img[..., ::-1])
+        for d in doors:
+            along = np.array([math.cos(d.wall_angle), math.sin(d.wall_angle), 0.0])
+            c = np.array([*d.centre, 0.0])
+            z0, z1 = -obs.camera_height, 2.1 - obs.camera_height
+            pts = np.array([c - along * d.width / 2, c + along * d.width / 2])
+            corners = np.array([[*p[:2], z] for p in pts for z in (z0, z1)])
+            uv = project(obs, corners) * 2.0
+            if np.isnan(uv).any():
+                continue
+            (u0, v0), (u1, v1) = uv.min(axis=0), uv.max(axis=0)
+            cv2.rectangle(img, (int(u0) - 2, int(v0)), (int(u1) + 2, int(v1)), (0, 200, 0), 2)
+            cv2.putText(
+                img,
+                f"{math.hypot(*d.centre):.1f} m",
+                (int(u0) - 10, int(v0) - 6),
+                cv2.FONT_HERSHEY_SIMPLEX,
+                0.45,
+                (0, 140, 0),
+                1,
+                cv2.LINE_AA,
+            )
+        cv2.putText(
+            img,
+            f"{name} ({x:g}, {y:g}, {yaw_deg:g} deg): {len(doors)} doors found",
+            (8, 20),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.55,
+            (0, 0, 0),
+            1,
+            cv2.LINE_AA,
+        )
+        panels.append(img)
+    cv2.imwrite(path, np.hstack(panels))
+    print(f"wrote {path}")
 
 
 def building_heading(vis: Visibility, p) -> float:
