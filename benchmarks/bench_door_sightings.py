@@ -10,7 +10,7 @@ score the detector: it sees RGB and depth.
 
 Run: python benchmarks/bench_door_sightings.py [--views 200] [--seed 0]
      [--buildings all,sign_sparse_0,sign_sparse_1,sign_sparse_2] [--range 14]
-     [--image docs/img/door_sightings.png]  (two example views, the doors found boxed)
+     [--walls grid] [--image docs/img/door_sightings.png]  (example views, doors boxed)
 Views are 320x240 as in the tree (``sim.width``); ``--width 640 --height 480`` for more.
 Prints recall per distance band, spurious detections per view and ms per frame.
 """
@@ -44,6 +44,7 @@ def main() -> None:
     ap.add_argument("--min-px", type=int, default=30, help="label pixels for 'in view'")
     ap.add_argument("--width", type=int, default=320, help="camera pixels (the tree's views)")
     ap.add_argument("--height", type=int, default=240)
+    ap.add_argument("--walls", default="corridors", help="corridors or grid (sim.walls)")
     ap.add_argument("--image", default="", help="write two example views here, doors boxed")
     ap.add_argument("--show-spurious", action="store_true", help="print each spurious one")
     args = ap.parse_args()
@@ -57,10 +58,11 @@ def main() -> None:
     found = np.zeros(len(BANDS) - 1)
     spurious, views, ms = 0, 0, []
     for name in names:
-        building = load_building(resolve_building_path(name))
+        path = resolve_building_path(name)
+        building = load_building(path)
         vis = Visibility.of(parse_building(building))
         pts = vis.lattice_points
-        with SimWorld(building) as world:
+        with SimWorld(building, walls=args.walls, base_dir=path.parent) as world:
             items = list(world.doors.values()) + list(world.landmarks.values())
             centres = np.array([it.centre for it in items])
             base = SimBase(world, width=args.width, height=args.height)

@@ -6,7 +6,9 @@ panel unlike the wall it stands in. Along each wall line fitted in depth
 sign plates, above the skirting) are placed along the line; the wall's own colour is
 the median (CIELAB) of the same wall above the doors (``REF_BAND_M``: where doors are
 many, a door-height median is a door's colour), and runs of pixels far from it
-(``MIN_CONTRAST``), a door's width long, are doors. Which door each is cannot be told
+(``MIN_CONTRAST``, lightness at half weight: a face of the wall shaded otherwise, such
+as the end of a grid map's staggered wall box, is not a door), a door's width long,
+are doors. Which door each is cannot be told
 (that is the sign's job): the corridor belief weighs where doors are seen, and where
 the map has doors that are not.
 
@@ -25,7 +27,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from pmnav_bt.perception.depth import back_project
+from pmnav_bt.perception.depth import back_project, normals
 from pmnav_bt.pose.walls import wall_lines, wall_points
 from pmnav_bt.seams import Observation
 
@@ -33,7 +35,10 @@ DOOR_RANGE_M = 14.0  # doors are looked for this far along the walls
 BAND_M = (0.3, 1.1)  # height above the floor of the pixels looked at
 REF_BAND_M = (2.25, 2.6)  # ... and of the wall's own colour: above door frames (2.2 m)
 ON_LINE_M = 0.12  # a pixel this close to a wall line is on that wall (frames stand 4 cm out)
-MIN_CONTRAST = 25.0  # CIELAB distance from the wall's colour of a door pixel
+FACING = 0.9  # ... and faces the way the wall does (|cos| of the normals' angle): the
+# ends of a grid map's staggered wall boxes face along the corridor, shaded darker
+MIN_CONTRAST = 20.0  # CIELAB distance from the wall's colour of a door pixel, lightness
+LIGHTNESS_WEIGHT = 0.5  # ... counted at half: a face shaded otherwise differs in lightness
 BIN_M = 0.1  # pixels are binned this finely along the wall
 BIN_DOOR_SHARE = 0.5  # a bin whose pixels are this much door colour is door
 MIN_BIN_PX = 2  # ... with at least this many of them
@@ -72,18 +77,20 @@ def find_doors(
         return []
     lab_image = cv2.cvtColor(obs.rgb, cv2.COLOR_RGB2LAB)
     xy, lab = pts[band][:, :2].astype(float), lab_image[band].astype(np.float32)
+    facing = np.nan_to_num(normals(pts)[band][:, :2])
     xy_ref, lab_ref = pts[above][:, :2].astype(float), lab_image[above].astype(np.float32)
     found: list[DoorSeen] = []
     for line in lines:
         d = np.array([math.cos(line.angle), math.sin(line.angle)])
         n = np.array([-d[1], d[0]])
-        on = np.abs(xy @ n - line.offset) <= ON_LINE_M
+        on = (np.abs(xy @ n - line.offset) <= ON_LINE_M) & (np.abs(facing @ n) >= FACING)
         on_ref = np.abs(xy_ref @ n - line.offset) <= ON_LINE_M
         if on.sum() < MIN_WALL_PX or on_ref.sum() < MIN_REF_PX:
             continue
         colour = lab[on]
         ref = np.median(lab_ref[on_ref], axis=0)
-        door = np.linalg.norm(colour - ref, axis=1) > MIN_CONTRAST
+        diff = (colour - ref) * np.array([LIGHTNESS_WEIGHT, 1.0, 1.0], np.float32)
+        door = np.linalg.norm(diff, axis=1) > MIN_CONTRAST
         s = xy[on] @ d
         found += [
             DoorSeen(tuple(float(v) for v in mid * d + line.offset * n), width, line.angle)  # type: ignore[arg-type]
