@@ -86,3 +86,21 @@ def test_no_depth_or_no_wall_finds_nothing(sparse):
     from dataclasses import replace
 
     assert find_doors(replace(obs, depth=None), surfaces(obs).wall) == []
+
+
+def test_the_ends_of_staggered_wall_boxes_are_not_doors():
+    """The real-map hospital with walls from its occupancy grid: the left wall north of
+    (-6, -7.6) is a row of staggered boxes whose ends, facing along the corridor, are
+    shaded darker; they were found as two doors 6-8 m ahead where there is none."""
+    from pathlib import Path
+
+    from pmnav_bt.map.building import load_building
+    from pmnav_bt.sim.world import SimWorld
+
+    here = Path(__file__).resolve().parents[2] / "examples" / "hospital"
+    building = load_building(here / "building.yaml")
+    with SimWorld(building, walls="grid", base_dir=here) as world:
+        got = doors_seen(world, -6.0, -7.6, 90.0)
+        doors = np.array([d.centre for d in world.doors.values()])
+    for g in got:
+        assert np.min(np.linalg.norm(doors - g, axis=1)) < 0.6, g
