@@ -88,10 +88,10 @@ LOOK_BEARINGS = np.radians(np.arange(0.0, 360.0, 15.0))
 RESCALE_MIN = 0.002  # a change of the odometry's distance gain smaller than this waits
 # Doors seen along the walls (``perception.door_sightings``): found 95 % of the time 4-13 m
 # off in the simulator's views, never where none is (``benchmarks/bench_door_sightings.py``).
-DOOR_SEEN_M = (2.0, 12.0)  # a map door this far off, on the robot's corridor, is in view ...
+DOOR_SEEN_M = (2.0, 12.0)  # a map door this far off, on the robot's corridor (the robot
+DOOR_WALL_NEAR_M = 2.5  # this near its wall line: not round a corner), is in view ...
 DOOR_FOV_MARGIN = math.radians(4.0)  # ... well inside a view that looked for doors
 HALF_FOV = math.radians(30.0)  # the camera's 60 deg (a wider one only sees more)
-DOOR_WALL_NEAR_M = 2.5  # ... from its wall line (not round a corner) ...
 DOOR_MATCH_M = 1.0  # a door seen this close to a map door (or landmark) is that one
 P_DOOR_MISS = 0.2  # a map door in view is not seen (a look round)
 P_DOOR_SPURIOUS = 0.1  # a door is seen where the map has none
