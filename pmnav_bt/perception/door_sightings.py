@@ -14,7 +14,7 @@ the map has doors that are not.
 
 The same cue as ``doors.door_from_sign`` (a door looks unlike its wall), taken along
 the whole wall. In the simulator's 320x240 views (``benchmarks/bench_door_sightings.py``,
-660 views of ten buildings) doors 4-13 m off are found 95 % of the time, 13-16 m off
+660 views of eleven buildings) doors 4-13 m off are found 95 % of the time, 13-16 m off
 81 %, and nothing is found where no door or landmark is; far along the wall one image
 column spans 0.3 m of it, so bins no pixel falls in do not break a door's run.
 """
