@@ -175,7 +175,7 @@ class CorridorBelief:
             [self.pm.segments[p.segment - 1].width / 2.0 for p in self.vis.lattice_points]
         )
         shapely.prepare(self._floor)
-        self._doors = _MapDoors.of(self.pm, self.vis)
+        self._doors = _MapDoors.of(self.vis)
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs
@@ -1020,15 +1020,12 @@ class _MapDoors:
     any_xy: np.ndarray
 
     @classmethod
-    def of(cls, pm: PrioriMap, vis: Visibility) -> _MapDoors:
-        rooms = [Entity.room(r.id) for r in pm.building.rooms]
-        xy = np.array([entity_xy(pm, e) for e in rooms], float).reshape(-1, 2)
-        front = np.array([vis._inset(p) for p in xy], float).reshape(-1, 2)
-        n = front - xy
-        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-9)
-        along = np.stack([-n[:, 1], n[:, 0]], 1)
-        marks = [Entity.landmark(lm.id) for lm in pm.building.landmarks]
-        any_xy = np.array([entity_xy(pm, e) for e in rooms + marks], float).reshape(-1, 2)
+    def of(cls, vis: Visibility) -> _MapDoors:
+        """From the map's signs (``Visibility``): the map places a room's at its door."""
+        rooms = [i for i, e in enumerate(vis.entities) if e.kind is EntityKind.ROOM]
+        xy, front, n = vis.sign_xy[rooms], vis.sign_front[rooms], vis.sign_normal[rooms]
+        along = np.stack([-n[:, 1], n[:, 0]], 1).reshape(-1, 2)
+        any_xy = vis.sign_xy
         return cls(xy, front, along, any_xy)
 
 

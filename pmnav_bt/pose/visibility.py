@@ -79,6 +79,12 @@ class Visibility:
         """(N, 2) where the map puts each of ``entities``' signs."""
         return self._xy
 
+    @property
+    def sign_front(self) -> np.ndarray:
+        """(N, 2) where a sight line to each of ``entities``' signs ends: ``WALL_INSET_M``
+        in front of its wall, towards the corridor's centre line."""
+        return self._eye
+
     @cached_property
     def sign_normal(self) -> np.ndarray:
         """(N, 2) unit normals of ``entities``' plates: from the wall into the corridor."""
