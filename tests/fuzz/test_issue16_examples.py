@@ -493,3 +493,14 @@ def test_run_files_stay_in_out_whatever_the_episode_id(tmp_path):
     assert r.tree_log.parent == out and r.plot.parent == out
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a"]
     assert sorted(p.name for p in (tmp_path / "a").iterdir()) == ["out"]
+
+
+@pytest.mark.parametrize("value", ["maybe", "2"])
+def test_the_door_switch_takes_only_a_boolean(capsys, value):
+    cli_fails(
+        capsys,
+        ["sim", "run", "--goal", "room1", "--set", f"tree.localization_doors={value}"],
+        "--set",
+        "tree.localization_doors",
+        "valid boolean",
+    )
