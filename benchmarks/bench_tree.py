@@ -1,6 +1,6 @@
 """Tick latency and episode wall time of the PM-Nav tree in the simulator.
 
-Target (DESIGN.md, a tick never blocks): p99 tick duration < 5 ms while workers are
+Target (docs/architecture.md, a tick never blocks): p99 tick duration < 5 ms while workers are
 busy. Two worker modes are measured:
 
 - deferred (the simulator's mode): background jobs run between ticks;

@@ -10,7 +10,7 @@ a worker thread during ticks), with a ``vlm`` back end pointing at that server:
   VLM_ERROR after the timeout. Needs the CoarseDirection behaviour that calls the back
   end in the worker (the seams migration).
 
-Target (DESIGN.md, a tick never blocks): p99 tick < 5 ms while a call hangs.
+Target (docs/architecture.md, a tick never blocks): p99 tick < 5 ms while a call hangs.
 
     python benchmarks/bench_vlm_tick.py [--stage plan|coarse] [--timeout 3] [--no-fallback]
 """

@@ -1,4 +1,4 @@
-"""The seams of DESIGN.md: small Protocols the tree talks to, and the data they pass.
+"""The seams (docs/architecture.md): small Protocols the tree talks to, and the data they pass.
 
 Nothing above ``sim/`` and ``hardware/`` knows which body it drives: both implement
 ``Base`` and ``Clock``. Perception back ends implement ``Grounder``,

@@ -1,6 +1,6 @@
 """Background work for behaviours: a tick submits, later ticks poll, terminate() cancels.
 
-DESIGN.md: a tick never blocks. Anything slower than a few milliseconds (rendering a
+docs/architecture.md: a tick never blocks. Anything slower than a few milliseconds (rendering a
 panorama, OCR, a network call) runs here. A job gets a ``cancelled`` event it may
 check between stages; cancelling a job that has not started drops it.
 

@@ -264,7 +264,7 @@ def test_a_drive_ending_short_of_a_wall_goes_on_until_its_approach_measures_the_
 def test_a_look_is_weighed_in_the_worker_on_a_fork_of_the_belief(make_rig, monkeypatch):
     """Weighing every hypothesis with a look (and, after a new distance gain, moving what
     the belief holds: 1-2 s) runs in UpdateBelief's worker job, on a fork of the belief
-    that replaces it on the blackboard when done (DESIGN.md: a tick never blocks)."""
+    that replaces it on the blackboard when done (docs/architecture.md: a tick never blocks)."""
     rig = make_rig(Pose2D(0.0, 26.5, SOUTH), width=320, height=240)
     views = CaptureViews("LocalizeViews", rig.ctx, localization_yaws, read_signs, enough_doors)
     rig.expect(rig.run(views, max_ticks=600), Status.SUCCESS)
