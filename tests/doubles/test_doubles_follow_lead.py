@@ -13,8 +13,8 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours import follow_lead
 from pmnav_bt.behaviours.belief import DriveEnd
-from pmnav_bt.behaviours.follow_lead import SLIDE_ACROSS_M, WallLook
-from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M, BACKUP_SPEED
+from pmnav_bt.behaviours.follow_lead import BACK_OFF_S, SLIDE_ACROSS_M, WallLook
+from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M, BACKUP_SPEED, BACKUP_TIME_S, BackUp
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.trees.localize import follow_lead_subtree
 
@@ -206,6 +206,17 @@ def test_a_drive_refused_at_once_backs_up_only_as_far_as_the_body_lets_it(rig, m
     assert seen[-2][2] == (-BACKUP_SPEED, 0.0) and seen[-1][0] == Status.SUCCESS
     assert belief.pending_blocked is None
     assert r.get("drive_end") == DriveEnd.BLOCKED
+
+
+@pytest.mark.parametrize("timeout_s", [BACK_OFF_S, BACKUP_TIME_S])
+def test_a_backup_that_does_not_move_gives_up_after_its_timeout(rig, timeout_s):
+    """The drive's backing off gives up sooner than the recoveries' (its own timeout)."""
+    r = rig("straight_office", EAST)
+    r.base.max_linear = 0.0  # the body takes the command but does not move
+    backup = BackUp("BackUp", r.ctx, timeout_s=timeout_s)
+    seen = r.run(backup)
+    assert seen[-1] == Status.SUCCESS and "could not reverse" in backup.feedback_message
+    assert len(seen) == pytest.approx(timeout_s / PERIOD + 1, abs=1)
 
 
 def test_a_corner_early_in_the_drive_is_slid_past_and_the_drive_goes_on(rig, monkeypatch):
