@@ -40,7 +40,8 @@ KEYS = (
     "recovering_from",  # Failure | None: what the recovery under way started from
     "belief",  # CorridorBelief | None: where on the corridors, while localizing
     "pose_tracker",  # PoseTracker: map_T_odom's uncertainty, for verification and snapping
-    "drive_end",  # str | None: how the last localization drive ended (FollowLead)
+    "drive_end",  # DriveEnd | None: how the last localization drive ended (follow_lead)
+    "corridor_drive",  # CorridorDrive: the localization drive under way (follow_lead)
     # the map-less baseline (trees/mapless.py)
     "goal_entity",  # Entity: the goal room, from the sign vocabulary
     "grid",  # ExplorationGrid: what it has seen and where it has been (odometry frame)

@@ -7,7 +7,7 @@ import math
 
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.active_localize import wall_mask
+from pmnav_bt.behaviours.belief import wall_mask
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import map_pose
 from pmnav_bt.failures import FailureCode

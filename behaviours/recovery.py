@@ -1,10 +1,11 @@
 """Recoveries like Nav2's: back up, spin to look (or to the corridor axis), wait.
 
 Each is a small leaf; the tree picks them by the failure that triggered the recovery
-(``trees.localize.recovery_subtree``). Backing up stays within ``BACKUP_LIMIT_M``, the
-Create 3's backup limit (0.15 m): it has no cliff sensors at the back, and with its
-default ``safety_override: none`` it reverses only that far over floor it has just
-driven forward over (hazard BACKUP_LIMIT), so a recovery never asks for more.
+(``trees.recovery.recovery_subtree``), and the localization drive backs off a wall it
+ran into with ``BackUp`` too. Backing up stays within ``BACKUP_LIMIT_M``, the Create 3's
+backup limit (0.15 m): it has no cliff sensors at the back, and with its default
+``safety_override: none`` it reverses only that far over floor it has just driven
+forward over (hazard BACKUP_LIMIT), so a recovery never asks for more.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from pmnav_bt.seams import CREATE3_BACKUP_LIMIT_M, MotionStatus
 
 BACKUP_LIMIT_M = CREATE3_BACKUP_LIMIT_M  # the most a recovery reverses
 BACKUP_SPEED = 0.1  # m/s
-BACKUP_TIME_S = 8.0  # clock seconds before a backup that does not move gives up
+BACKUP_TIME_S = 8.0  # clock seconds before a backup that does not move gives up (default)
 
 
 class FailureIs(PmNavBehaviour):
@@ -44,14 +45,22 @@ class FailureIs(PmNavBehaviour):
 
 class BackUp(PmNavBehaviour):
     """Reverse ``distance`` metres (at most BACKUP_LIMIT_M) straight back, off a wall or
-    an obstacle. SUCCESS when covered, or when the body cannot reverse further (best effort).
+    an obstacle. SUCCESS when covered, or when the body cannot reverse further: it refuses
+    (BLOCKED) or has not covered it after ``timeout_s`` clock seconds (best effort).
     """
 
     STOPS_BASE = True
 
-    def __init__(self, name: str, ctx: Context, distance: float = BACKUP_LIMIT_M):
+    def __init__(
+        self,
+        name: str,
+        ctx: Context,
+        distance: float = BACKUP_LIMIT_M,
+        timeout_s: float = BACKUP_TIME_S,
+    ):
         super().__init__(name, ctx)
         self.distance = min(distance, BACKUP_LIMIT_M)
+        self.timeout_s = timeout_s
 
     def initialise(self) -> None:
         p = self.ctx.base.pose()
@@ -69,7 +78,7 @@ class BackUp(PmNavBehaviour):
             return Status.SUCCESS
         if (
             self._sent and base.motion_status() == MotionStatus.BLOCKED
-        ) or self.ctx.now() - self._t0 > BACKUP_TIME_S:
+        ) or self.ctx.now() - self._t0 > self.timeout_s:
             base.stop()
             self.feedback_message = f"backed up {moved:.2f} m (could not reverse further)"
             return Status.SUCCESS

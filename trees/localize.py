@@ -1,38 +1,53 @@
-"""Active localization and recoveries as explicit subtrees (issue 15).
+"""Active localization as an explicit subtree (issue 15).
 
-Localization: take the six-view panorama (and the six views between them when it read
-fewer than two signs: a plate on a seam between two 60-degree views is cut in both), add
-it to the corridor belief, fix the pose if the belief allows; otherwise drive along the
-corridor axis towards where the map says signs are readable, and try again. Recoveries
-(like Nav2's) are chosen by the failure that triggered them: BLOCKED backs off the wall
-and turns onto the corridor axis, TARGET_NOT_FOUND turns round to look back, TIMEOUT
-waits.
+Take the six-view panorama (and the six views between them when it read fewer than two
+signs: a plate on a seam between two 60-degree views is cut in both), add it to the
+corridor belief, fix the pose if the belief allows; otherwise drive along the corridor
+axis towards where the map says signs are readable (``follow_lead_subtree``), and try
+again::
+
+    Localize (Retry)
+      LocalizeOrExplore
+        LocalizeOnce
+          LocalizeLookOrNot: LookTellsNothing | Look (panorama, UpdateBelief)
+          LocalizeFix
+        LocalizeExplore
+          LocalizeAlongCorridor
+            ChooseLead, AlignWithCorridor, DriveAlongCorridor
+            CornerPassed: not at a corner | SlidePastCorner, AlignWithCorridor,
+                          DriveAlongCorridor
+            OffTheWall: not blocked | BackUp
+          TryAgain
+
+The recoveries are ``trees.recovery``.
 """
 
 from __future__ import annotations
 
-import math
-
 import py_trees
 from py_trees.behaviours import Failure as AlwaysFail
-from py_trees.behaviours import Success as AlwaysSucceed
 from py_trees.composites import Selector, Sequence
-from py_trees.decorators import Retry
+from py_trees.decorators import Inverter, Retry
 
-from pmnav_bt.behaviours.active_localize import (
+from pmnav_bt.behaviours.belief import (
+    DriveEnd,
     FixFromBelief,
-    FollowLead,
     LookTellsNothing,
     NoSignInReach,
     UpdateBelief,
 )
 from pmnav_bt.behaviours.capture import CaptureViews
 from pmnav_bt.behaviours.context import Context
+from pmnav_bt.behaviours.follow_lead import (
+    BACK_OFF_S,
+    AlignWithCorridor,
+    ChooseLead,
+    DriveAlongCorridor,
+    DriveEnded,
+    SlidePastCorner,
+)
 from pmnav_bt.behaviours.localize import SignsRead, enough_doors, localization_yaws, read_signs
-from pmnav_bt.behaviours.recovery import BackUp, FaceCorridor, FailureIs, Spin, Wait
-from pmnav_bt.failures import FailureCode
-
-WAIT_S = 2.0
+from pmnav_bt.behaviours.recovery import BackUp
 
 
 def panorama_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour.Behaviour:
@@ -90,7 +105,7 @@ def active_localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.be
         f"{name}Explore",
         memory=True,
         children=[
-            FollowLead(f"{name}AlongCorridor", ctx, cfg.explore_distance),
+            follow_lead_subtree(ctx, cfg.explore_distance, name),
             AlwaysFail(name="TryAgain"),
         ],
     )
@@ -101,30 +116,44 @@ def active_localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.be
     )
 
 
-def recovery_subtree(ctx: Context, name: str = "Recovery") -> py_trees.behaviour.Behaviour:
-    """The recovery the last failure calls for; SUCCESS when there is none to do."""
-    back_off = Sequence(
-        "BackOffWall",
+def follow_lead_subtree(
+    ctx: Context, max_distance: float, name: str = "Localize"
+) -> py_trees.behaviour.Behaviour:
+    """The drive along the corridor towards where the belief leads (``follow_lead``):
+    choose the lead, face it, drive; a corner met early in the drive is slid past, then
+    the drive faces its heading again and goes on; a drive that ended blocked backs off
+    the wall (``BackUp``, for at most ``BACK_OFF_S``). SUCCESS when the drive is over
+    (``drive_end`` says how)."""
+    slide = Sequence(
+        f"{name}SlidePast",
         memory=True,
         children=[
-            FailureIs("WasBlocked", ctx, FailureCode.BLOCKED),
-            BackUp("BackUp", ctx),
-            FaceCorridor("FaceCorridor", ctx),
+            SlidePastCorner(f"{name}SlidePastCorner", ctx),
+            AlignWithCorridor(f"{name}AlignAgain", ctx),
+            DriveAlongCorridor(f"{name}DriveOn", ctx),
         ],
     )
-    look_back = Sequence(
-        "LookBack",
+    at_corner = DriveEnded(f"{name}AtCorner", ctx, DriveEnd.CORNER)
+    blocked = DriveEnded(f"{name}Blocked", ctx, DriveEnd.BLOCKED)
+    return Sequence(
+        f"{name}AlongCorridor",
         memory=True,
         children=[
-            FailureIs("WasNotFound", ctx, FailureCode.TARGET_NOT_FOUND),
-            Spin("SpinToLook", ctx, math.pi),
+            ChooseLead(f"{name}ChooseLead", ctx, max_distance),
+            AlignWithCorridor(f"{name}Align", ctx),
+            DriveAlongCorridor(f"{name}Drive", ctx),
+            Selector(
+                f"{name}CornerPassed",
+                memory=True,
+                children=[Inverter(f"{name}NotAtCorner", at_corner), slide],
+            ),
+            Selector(
+                f"{name}OffTheWall",
+                memory=True,
+                children=[
+                    Inverter(f"{name}NotBlocked", blocked),
+                    BackUp(f"{name}BackUp", ctx, timeout_s=BACK_OFF_S),
+                ],
+            ),
         ],
-    )
-    wait = Sequence(
-        "WaitItOut",
-        memory=True,
-        children=[FailureIs("WasTimeout", ctx, FailureCode.TIMEOUT), Wait("Wait", ctx, WAIT_S)],
-    )
-    return Selector(
-        name, memory=True, children=[back_off, look_back, wait, AlwaysSucceed(name="NoRecovery")]
     )

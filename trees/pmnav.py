@@ -48,7 +48,8 @@ from pmnav_bt.behaviours.search import (
 )
 from pmnav_bt.perception.read_range import SearchRanges
 from pmnav_bt.seams import PixelGoalPolicy
-from pmnav_bt.trees.localize import active_localize_subtree, recovery_subtree
+from pmnav_bt.trees.localize import active_localize_subtree
+from pmnav_bt.trees.recovery import recovery_subtree
 
 VARIANTS = ("pmnav", "coarse_only")
 

@@ -55,7 +55,7 @@ def test_before_the_first_glimpse_the_map_says_if_the_views_between_are_worth_a_
     estimate: beside a door plate the views between are taken."""
     from py_trees.common import Status
 
-    from pmnav_bt.behaviours.active_localize import NoSignInReach
+    from pmnav_bt.behaviours.belief import NoSignInReach
 
     start = Pose2D(60.0, 45.0, math.radians(90.0))
     rig = make_rig(start, overrides=("sim.reading_width=640", "grounder.backend=sim_gt"))
@@ -96,7 +96,7 @@ def test_a_look_round_is_skipped_only_where_it_cannot_tell_and_after_a_plain_dri
     junction (its floor looks different), it is taken."""
     from py_trees.common import Status
 
-    from pmnav_bt.behaviours.active_localize import LookTellsNothing
+    from pmnav_bt.behaviours.belief import LookTellsNothing
     from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 
     start = Pose2D(60.0, 45.0, math.radians(90.0))

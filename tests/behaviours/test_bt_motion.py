@@ -8,7 +8,6 @@ import math
 import pytest
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.localize import Explore
 from pmnav_bt.behaviours.motion import (
     Approach,
     Arrive,
@@ -273,7 +272,6 @@ MOVERS = {
     "MoveToward": lambda ctx: MoveToward("MoveOn", ctx, keep=1.0),
     "DriveToWaypoint": lambda ctx: DriveToWaypoint("CornerCheck", ctx),
     "TurnOnto": lambda ctx: TurnOnto("TurnOnto", ctx),
-    "Explore": lambda ctx: Explore("Walk", ctx, distance=2.0),
 }
 
 
@@ -316,9 +314,8 @@ def test_terminate_cancels_the_depth_watch_in_flight(make_rig):
         lambda ctx: TurnOnto("TurnOnto", ctx),
         lambda ctx: Approach("Approach", ctx),
         lambda ctx: DriveToWaypoint("CornerCheck", ctx),
-        lambda ctx: Explore("Walk", ctx, distance=1.0),
     ],
-    ids=["CheckOpening", "TurnOnto", "Approach", "DriveToWaypoint", "Explore"],
+    ids=["CheckOpening", "TurnOnto", "Approach", "DriveToWaypoint"],
 )
 def test_stop_before_the_first_tick_is_harmless(make_rig, make):
     # A decorator's stop(INVALID) reaches its child even if the child never ran.
