@@ -11,11 +11,11 @@ import shapely
 
 from pmnav_bt.behaviours.active_localize import FREE_BEARINGS, RAY_HALF_WIDTH_M
 from pmnav_bt.geometry import se2_apply, se2_compose, se2_inverse, wrap_angle
-from pmnav_bt.pose.landmark_fix import Sighting, fix_pose
 from pmnav_bt.map.building import load_building
 from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
+from pmnav_bt.pose.landmark_fix import Sighting, fix_pose
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
@@ -230,7 +230,7 @@ def test_a_junction_a_few_metres_behind_the_start_is_seen(behind_m):
     b = CorridorBelief(pm)
     b.observe(Glimpse(Pose2D(*odom), {}, None, free), axis_odom=odom[2])
     w = b.weights()
-    here = _apply(b._map_T_odom(), (odom[0], odom[1]))
+    here = _apply(b.map_T_odoms(), (odom[0], odom[1]))
     at_cross = np.linalg.norm(here - np.array([30.0, 30.0]), axis=1) < 6.0
     assert w[at_cross].sum() > 0.5
 
@@ -437,8 +437,8 @@ def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_r
             if 4.6 < d < 5.8 and far is None:
                 far = (p, e)
     assert near and far
-    assert b._miss_log(near[1], np.array(near[0].xy)) == pytest.approx(math.log(0.25))
-    assert b._miss_log(far[1], np.array(far[0].xy)) > math.log(0.8)
+    assert b.signs.miss_log(near[1], np.array(near[0].xy)) == pytest.approx(math.log(0.25))
+    assert b.signs.miss_log(far[1], np.array(far[0].xy)) > math.log(0.8)
     # One bare glimpse at a place whose only signs in sight are far: with the reader's
     # recall the place keeps nearly all its weight, with a constant miss it loses 4x a sign.
     p = next(
@@ -476,9 +476,9 @@ def test_a_plate_seen_along_its_wall_is_no_evidence_when_not_read(fig2):
             d = float(np.linalg.norm(v))
             off = math.degrees(math.acos(float(v @ vis.sign_normal[k]) / d))
             if d < 2.5 and off < 45 and head_on is None:
-                head_on = b._miss_log(e, np.asarray(p.xy))
+                head_on = b.signs.miss_log(e, np.asarray(p.xy))
             if off > 77 and along is None:
-                along = b._miss_log(e, np.asarray(p.xy))
+                along = b.signs.miss_log(e, np.asarray(p.xy))
     assert head_on == pytest.approx(math.log(0.25)) and along == 0.0
 
 
@@ -494,8 +494,8 @@ def test_a_miss_is_judged_from_where_the_hypothesis_puts_the_robot_not_the_centr
     cfg = load_config(None, ["grounder.backend=ocr"])
     b = CorridorBelief(pm, read_range=6.0, recall=sign_recall(cfg, pm.building))
     room9 = Entity.room("room9")
-    assert b._miss_log(room9, np.array([10.0, 30.0])) == pytest.approx(math.log(0.25))
-    assert b._miss_log(room9, np.array([10.0, 30.7])) > 0.5 * math.log(0.25)
+    assert b.signs.miss_log(room9, np.array([10.0, 30.0])) == pytest.approx(math.log(0.25))
+    assert b.signs.miss_log(room9, np.array([10.0, 30.7])) > 0.5 * math.log(0.25)
     # Bare glimpses on the centre line 4 m east, then there: the truth is charged no
     # more than the far plate's likely miss and the near one's partial miss.
     b.observe(glimpse(pm, (14.0, 30.0, math.pi), ()), axis_odom=math.pi + ODOM_T_MAP[2])
@@ -544,7 +544,7 @@ def test_the_lead_goes_where_signs_are_read_reliably_not_where_they_may_be_seen(
         b = CorridorBelief(pm, read_range=6.0, lead_range=lead_range)
         b.observe(g, axis_odom=wrap_angle(truth[2] + ODOM_T_MAP[2]))
         # A belief sure of the place (as after a fix's prior): only the truth is live.
-        tfs = b._map_T_odom()
+        tfs = b.map_T_odoms()
         here = np.linalg.norm(tfs[:, :2] - np.array(se2_inverse(ODOM_T_MAP)[:2]), axis=1)
         turn = np.abs(np.angle(np.exp(1j * (tfs[:, 2] - se2_inverse(ODOM_T_MAP)[2]))))
         b.logw = np.where((here < 0.3) & (turn < 0.1), 0.0, -50.0)
@@ -618,7 +618,7 @@ def test_the_search_for_signs_heads_where_the_robot_is_going(room, east):
     for target in (None, entity_xy(pm, Entity.room(room))):
         b = CorridorBelief(pm, read_range=6.0, lead_range=3.5, target=target)
         b.observe(g, axis_odom=wrap_angle(truth[2] + ODOM_T_MAP[2]))
-        tfs = b._map_T_odom()  # a belief sure of the place, as with a prior
+        tfs = b.map_T_odoms()  # a belief sure of the place, as with a prior
         here = np.linalg.norm(tfs[:, :2] - np.array(se2_inverse(ODOM_T_MAP)[:2]), axis=1)
         turn = np.abs(np.angle(np.exp(1j * (tfs[:, 2] - se2_inverse(ODOM_T_MAP)[2]))))
         b.logw = np.where((here < 0.3) & (turn < 0.1), 0.0, -50.0)
@@ -678,7 +678,7 @@ def test_a_way_blocked_here_is_not_driven_into_again():
         )
         g = glimpse(pm, truth, (), blocked=blocked, depth=True)
         b.observe(g, axis_odom=east)
-        tfs = b._map_T_odom()  # a belief sure of the place
+        tfs = b.map_T_odoms()  # a belief sure of the place
         here = np.linalg.norm(tfs[:, :2] - np.array(se2_inverse(ODOM_T_MAP)[:2]), axis=1)
         turn = np.abs(np.angle(np.exp(1j * (tfs[:, 2] - se2_inverse(ODOM_T_MAP)[2]))))
         b.logw = np.where((here < 0.3) & (turn < 0.1), 0.0, -50.0)
@@ -693,7 +693,7 @@ def _apply(tfs: np.ndarray, p) -> np.ndarray:
 
 def _weight_near(b: CorridorBelief, odom, xy, yaw) -> float:
     """The weight of the hypothesis that puts the robot nearest ``xy`` facing ``yaw`` (map)."""
-    tfs = b._map_T_odom()
+    tfs = b.map_T_odoms()
     here = _apply(tfs, (odom.x, odom.y))
     err = np.linalg.norm(here - np.asarray(xy), axis=1) + 3.0 * np.abs(
         np.angle(np.exp(1j * (tfs[:, 2] + odom.yaw - yaw)))
@@ -745,7 +745,7 @@ def test_a_lead_worked_out_again_on_the_way_only_turns_when_the_belief_says_anot
     )
     g = glimpse(pm, truth, (), depth=True)
     b.observe(g, axis_odom=east)
-    tfs = b._map_T_odom()
+    tfs = b.map_T_odoms()
     here = np.linalg.norm(tfs[:, :2] - np.array(se2_inverse(ODOM_T_MAP)[:2]), axis=1)
     turn = np.abs(np.angle(np.exp(1j * (tfs[:, 2] - se2_inverse(ODOM_T_MAP)[2]))))
     b.logw = np.where((here < 0.3) & (turn < 0.1), 0.0, -50.0)  # sure of the place
@@ -770,7 +770,7 @@ def test_the_walls_seen_while_driving_keep_up_with_the_odometrys_heading_drift(
     b = CorridorBelief(pm)
     g = glimpse(pm, start, (), depth=True)
     b.observe(g, axis_odom=g.odom.yaw)
-    tfs = b._map_T_odom()
+    tfs = b.map_T_odoms()
     true_hyp = int(
         np.argmin(
             np.linalg.norm(_apply(tfs, (g.odom.x, g.odom.y)) - start[:2], axis=1)
@@ -789,7 +789,7 @@ def test_the_walls_seen_while_driving_keep_up_with_the_odometrys_heading_drift(
     at_cross = glimpse(pm, (30.0, 30.0, math.pi / 2), (), depth=True)
     free = tuple((odom.yaw + k * math.pi / 2, f) for k, (_, f) in enumerate(at_cross.free))
     b.observe(replace(at_cross, odom=odom, free=free), axis_odom=odom.yaw)
-    here = se2_apply(tuple(b._map_T_odom()[true_hyp]), tuple(b._straighten((odom.x, odom.y))))
+    here = se2_apply(tuple(b.map_T_odoms()[true_hyp]), tuple(b.straighten((odom.x, odom.y))))
     off = math.hypot(here[0] - 30.0, here[1] - 30.0)
     if axis_while_driving:
         assert off < 1.0
@@ -821,7 +821,7 @@ def test_a_look_round_from_beside_a_wall_is_weighed_from_the_centre_line(moved_t
     b = CorridorBelief(pm)
     b.observe(Glimpse(odom, {}, free=free, to_centre=to_centre), axis_odom=ODOM_T_MAP[2])
     idx, _ = b.best_cluster()
-    here = _apply(b._map_T_odom()[idx], (odom.x, odom.y)).mean(axis=0)
+    here = _apply(b.map_T_odoms()[idx], (odom.x, odom.y)).mean(axis=0)
     at_branch3 = math.hypot(here[0] - truth[0], here[1] - truth[1]) < 1.5
     assert at_branch3 == moved_to_centre, here
 
@@ -896,7 +896,7 @@ def test_a_drive_blocked_here_counts_in_the_share_of_the_belief_with_signs_in_re
     g = glimpse(pm, here, ())
     b.observe(g, axis_odom=g.odom.yaw)
     odom = Pose2D(*se2_compose(ODOM_T_MAP, here))
-    put = b._map_T_odom()
+    put = b.map_T_odoms()
     where = _apply(put, (b.ref.x, b.ref.y))
     turn = put[:, 2] + b.ref.yaw
 
