@@ -32,17 +32,10 @@ from pmnav_bt.geometry import fit_se2, se2_apply, se2_compose, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose import lead as leads
 from pmnav_bt.pose import telling
-from pmnav_bt.pose.evidence.doors import (
-    P_DOOR_MISS,
-    P_DOOR_SPURIOUS,
-    P_DRIVE_DOOR_MISS,
-    P_DRIVE_DOOR_SPURIOUS,
-    MapDoors,
-)
-from pmnav_bt.pose.evidence.floor import P_DEPTH, P_DRIVE_RAY, Floor
+from pmnav_bt.pose.evidence import Evidence
 from pmnav_bt.pose.evidence.prior import weigh_prior
-from pmnav_bt.pose.evidence.signs import PLACE_SIGMA_M, SIGHT_SIGMA_M, Signs, sight_sigma
-from pmnav_bt.pose.hypotheses import FIX_MASS, Hypotheses, Straightened, apply_many
+from pmnav_bt.pose.evidence.signs import PLACE_SIGMA_M, SIGHT_SIGMA_M
+from pmnav_bt.pose.hypotheses import FIX_MASS, Hypotheses, Straightened
 from pmnav_bt.pose.landmark_fix import sign_shift
 from pmnav_bt.pose.lead import Lead
 from pmnav_bt.pose.visibility import Visibility, entity_xy
@@ -116,9 +109,7 @@ class CorridorBelief:
         self.goal = Visibility.of(
             self.pm, self.read_range if self.lead_range is None else self.lead_range
         )
-        self.signs = Signs.of(self.pm, self.vis, self.recall)
-        self.floor = Floor.of(self.pm, self.vis)
-        self.doors = MapDoors.of(self.vis)
+        self.evidence = Evidence.of(self.pm, self.vis, self.recall)
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs
@@ -191,10 +182,10 @@ class CorridorBelief:
         if self.prior is not None:
             weigh_prior(self.logw, self.hyps, self.ref, *self.prior)
         for g in self.glimpses:
-            self._weigh(g)
+            self.evidence.look(self.logw, g, self.map_T_odoms(), self.ref)
         tfs = self.map_T_odoms()
         for r in self.rays:
-            self._weigh_ray(r, tfs)
+            self.evidence.drive_view(self.logw, r, tfs)
 
     # -- updates --------------------------------------------------------------------------
 
@@ -233,7 +224,7 @@ class CorridorBelief:
             door_views=tuple(wrap_angle(y - drift) for y in glimpse.door_views),
         )
         self.glimpses.append(g)
-        self._weigh(g)
+        self.evidence.look(self.logw, g, self.map_T_odoms(), self.ref)
 
     def observe_ray(
         self,
@@ -263,7 +254,7 @@ class CorridorBelief:
         if doors is not None:
             seen = tuple(tuple(self.straighten(xy)) for xy in doors)
             ray = replace(ray, doors=seen, door_views=(yaw,))
-        self._weigh_ray(ray, self.map_T_odoms())
+        self.evidence.drive_view(self.logw, ray, self.map_T_odoms())
         self.rays.append(ray)
 
     def rescale(self, gain: float) -> None:
@@ -301,36 +292,6 @@ class CorridorBelief:
         """Whether ``rescale(gain)`` would move what the belief holds and weigh every
         hypothesis again (too slow for a tick: behaviours do it in the worker)."""
         return self.ref is not None and abs(gain / self.gain - 1.0) >= RESCALE_MIN
-
-    def _weigh(self, g: Glimpse) -> None:
-        """Reweigh by a look round: where it was (inside a wall?), a blocked drive, depth
-        along each view, the doors seen along the walls and the signs read."""
-        tfs = self.map_T_odoms()
-        ref = self.ref
-        sigma = sight_sigma(math.hypot(g.odom.x - ref.x, g.odom.y - ref.y))
-        here = apply_many(tfs, (g.odom.x, g.odom.y))
-        near, off = self.vis.nearest_many(here)
-        self.floor.off_corridor(self.logw, near, off)
-        if g.blocked is not None:  # the corridor must end (or turn) just ahead
-            self.logw += self.floor.blocked_log(tfs, (g.odom.x, g.odom.y), g.blocked)
-        for yaw, free in g.free:
-            self.floor.wall_ahead(self.logw, tfs, g.odom, yaw, free)
-            self.floor.free_floor(self.logw, tfs, here, g.odom, yaw, free, P_DEPTH)
-        self.doors.weigh(
-            self.logw, self.floor.area, g.doors, g.door_views, tfs, here,
-            P_DOOR_MISS, P_DOOR_SPURIOUS, sigma,
-        )  # fmt: skip
-        self.signs.weigh(self.logw, g.seen, g.named, tfs, here, near, sigma)
-
-    def _weigh_ray(self, r: Glimpse, tfs: np.ndarray) -> None:
-        """Reweigh by the free floor seen ahead while driving (``observe_ray``)."""
-        here = apply_many(tfs, (r.odom.x, r.odom.y))
-        for yaw, free in r.free:
-            self.floor.free_floor(self.logw, tfs, here, r.odom, yaw, free, P_DRIVE_RAY)
-        self.doors.weigh(
-            self.logw, self.floor.area, r.doors, r.door_views, tfs, here,
-            P_DRIVE_DOOR_MISS, P_DRIVE_DOOR_SPURIOUS, SIGHT_SIGMA_M,
-        )  # fmt: skip
 
     # -- questions ------------------------------------------------------------------------
 

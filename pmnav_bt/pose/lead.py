@@ -195,7 +195,7 @@ def sign_in_reach(b: CorridorBelief, odom: Pose2D) -> float:
     p = b.straighten((odom.x, odom.y))
     tfs = b.map_T_odoms()
     if b.pending_blocked is not None:  # the drive here just met a wall: count it
-        w = w * np.exp(b.floor.blocked_log(tfs, p, b.pending_blocked - b.drift))
+        w = w * np.exp(b.evidence.floor.blocked_log(tfs, p, b.pending_blocked - b.drift))
         w = w / w.sum()
     near, _ = b.goal.nearest_many(apply_many(tfs, (p[0], p[1])))
     pts = b.goal.lattice_points

@@ -437,8 +437,8 @@ def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_r
             if 4.6 < d < 5.8 and far is None:
                 far = (p, e)
     assert near and far
-    assert b.signs.miss_log(near[1], np.array(near[0].xy)) == pytest.approx(math.log(0.25))
-    assert b.signs.miss_log(far[1], np.array(far[0].xy)) > math.log(0.8)
+    assert b.evidence.signs.miss_log(near[1], np.array(near[0].xy)) == pytest.approx(math.log(0.25))
+    assert b.evidence.signs.miss_log(far[1], np.array(far[0].xy)) > math.log(0.8)
     # One bare glimpse at a place whose only signs in sight are far: with the reader's
     # recall the place keeps nearly all its weight, with a constant miss it loses 4x a sign.
     p = next(
@@ -476,9 +476,9 @@ def test_a_plate_seen_along_its_wall_is_no_evidence_when_not_read(fig2):
             d = float(np.linalg.norm(v))
             off = math.degrees(math.acos(float(v @ vis.sign_normal[k]) / d))
             if d < 2.5 and off < 45 and head_on is None:
-                head_on = b.signs.miss_log(e, np.asarray(p.xy))
+                head_on = b.evidence.signs.miss_log(e, np.asarray(p.xy))
             if off > 77 and along is None:
-                along = b.signs.miss_log(e, np.asarray(p.xy))
+                along = b.evidence.signs.miss_log(e, np.asarray(p.xy))
     assert head_on == pytest.approx(math.log(0.25)) and along == 0.0
 
 
@@ -494,8 +494,8 @@ def test_a_miss_is_judged_from_where_the_hypothesis_puts_the_robot_not_the_centr
     cfg = load_config(None, ["grounder.backend=ocr"])
     b = CorridorBelief(pm, read_range=6.0, recall=sign_recall(cfg, pm.building))
     room9 = Entity.room("room9")
-    assert b.signs.miss_log(room9, np.array([10.0, 30.0])) == pytest.approx(math.log(0.25))
-    assert b.signs.miss_log(room9, np.array([10.0, 30.7])) > 0.5 * math.log(0.25)
+    assert b.evidence.signs.miss_log(room9, np.array([10.0, 30.0])) == pytest.approx(math.log(0.25))
+    assert b.evidence.signs.miss_log(room9, np.array([10.0, 30.7])) > 0.5 * math.log(0.25)
     # Bare glimpses on the centre line 4 m east, then there: the truth is charged no
     # more than the far plate's likely miss and the near one's partial miss.
     b.observe(glimpse(pm, (14.0, 30.0, math.pi), ()), axis_odom=math.pi + ODOM_T_MAP[2])
