@@ -145,15 +145,15 @@ def _arrow(
     ax, x: float, y: float, yaw: float, colour: str, label: str, small: bool, side: float
 ) -> None:
     """A pose as an arrow from a ring, drawn a little to ``side`` (+1 left, -1 right of
-    its heading) so that the true and the fixed pose do not hide each other, and under
-    the hypotheses (they are what the picture is about)."""
+    its heading) so that the true and the fixed pose do not hide each other; the arrow
+    under the hypotheses (they are what the picture is about), the ring over them."""
     size = 4.0 if small else 3.0
     off = 0.6 * side
     x, y = x - off * math.sin(yaw), y + off * math.cos(yaw)
     ax.annotate("", (x + size * math.cos(yaw), y + size * math.sin(yaw)), (x, y),
                 arrowprops={"arrowstyle": "-|>,head_width=0.4,head_length=0.8",
                             "color": colour, "lw": 2.0, "alpha": 0.85}, zorder=3)  # fmt: skip
-    ax.scatter([x], [y], facecolor="none", edgecolor=colour, s=40, lw=1.5, zorder=3,
+    ax.scatter([x], [y], facecolor="none", edgecolor=colour, s=70, lw=2.0, zorder=9,
                label=label)  # fmt: skip
 
 
