@@ -18,7 +18,6 @@ from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
-from pmnav_bt.localization import Sighting, fix_pose, sighting
 from pmnav_bt.perception.depth import surfaces
 from pmnav_bt.perception.door_sightings import find_doors
 from pmnav_bt.perception.geometry import free_distance
@@ -26,6 +25,7 @@ from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_vi
 from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse
 from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.landmark_fix import Sighting, fix_pose, sighting
 from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.pose.walls import axis_in_odom, wall_lines, wall_points, way_to_centre

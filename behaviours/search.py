@@ -11,8 +11,8 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import map_pose, thumbnail
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
-from pmnav_bt.localization import Sighting, fix_pose
 from pmnav_bt.planning.resolve import entity_position, step_entity
+from pmnav_bt.pose.landmark_fix import Sighting, fix_pose
 from pmnav_bt.seams import CoarseChoice, Entity, EntityKind, View
 
 # How far (m) a sighting may be from where the map puts the target and still be it, when

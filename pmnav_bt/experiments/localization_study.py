@@ -21,7 +21,7 @@ import json
 import math
 import random
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
@@ -110,8 +110,13 @@ def _within(building, pm, point, ranges: Mapping[str, float] | None) -> int:
     )
 
 
-def run_localization(start: LocStart, config: Config) -> LocResult:
-    """The localization subtree alone, from ``start``, in a fresh world."""
+def run_localization(
+    start: LocStart, config: Config, watch: Callable[[object, object], None] | None = None
+) -> LocResult:
+    """The localization subtree alone, from ``start``, in a fresh world. ``watch(ctx,
+    body)``, when given, is called after every tick with the tree's context and the
+    simulated body (its ``pose()`` is the truth), e.g. to draw the belief as it goes
+    (``experiments/belief_show.py``)."""
     import py_trees
 
     from pmnav_bt.behaviours.common import NAMESPACE
@@ -151,6 +156,8 @@ def run_localization(start: LocStart, config: Config) -> LocResult:
             while ctx.now() < MAX_CLOCK_S:
                 tree.tick()
                 ctx.odometer.update(ctx.base.pose())
+                if watch is not None:
+                    watch(ctx, inner)
                 status = tree.root.status
                 if status != py_trees.common.Status.RUNNING:
                     break

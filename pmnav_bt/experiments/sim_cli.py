@@ -468,3 +468,8 @@ def table3(
     typer.echo(header)
     typer.echo(table(results))
     typer.echo(f"wrote {md} and {out / 'results.json'}")
+
+
+from pmnav_bt.experiments.belief_show import belief as _belief  # noqa: E402 - its module's command
+
+app.command("belief")(_belief)

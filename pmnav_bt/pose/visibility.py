@@ -275,6 +275,13 @@ class Visibility:
     def _lattice_tree(self):
         return shapely.STRtree(shapely.points(self.lattice_xy))
 
+    def lattice_within(self, xy: np.ndarray, distance: float) -> np.ndarray:
+        """(2, K) pairs (index into ``xy``, lattice point) of every lattice point within
+        ``distance`` of each of the (N, 2) points ``xy``."""
+        return self._lattice_tree.query(
+            shapely.points(xy), predicate="dwithin", distance=distance
+        )
+
     def nearest_many(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For (N, 2) points: the nearest lattice point of each and the distance to it."""
         pairs, dist = self._lattice_tree.query_nearest(

@@ -287,7 +287,7 @@ def test_in_a_bare_stretch_the_belief_skips_the_views_between(make_rig, pm):
 
     b.observe(Glimpse(views[0].observation.pose, {}), axis_odom=start.yaw)  # odom = map
     b.logw[:] = -50.0  # a belief sure of the place: only the truth is live
-    tfs = b._map_T_odom()
+    tfs = b.map_T_odoms()
     truth = np.linalg.norm(tfs[:, :2], axis=1) < 0.3  # odometry is the map here
     turn = np.abs(np.angle(np.exp(1j * tfs[:, 2])))
     b.logw[truth & (turn < 0.1)] = 0.0

@@ -27,9 +27,9 @@ from pmnav_bt.behaviours.search import (
 )
 from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
-from pmnav_bt.localization import Sighting
 from pmnav_bt.pose.belief import CorridorBelief
 from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.landmark_fix import Sighting
 from pmnav_bt.seams import Entity, MotionStatus, Pose2D
 from pmnav_bt.trees.localize import follow_lead_subtree
 from pmnav_bt.trees.recovery import recovery_subtree

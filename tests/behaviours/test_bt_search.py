@@ -26,9 +26,9 @@ from pmnav_bt.behaviours.search import (
 )
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply
-from pmnav_bt.localization import Sighting
 from pmnav_bt.perception.coarse import DetectorCoarseDirection
 from pmnav_bt.planning.resolve import sign_text
+from pmnav_bt.pose.landmark_fix import Sighting
 from pmnav_bt.seams import CoarseChoice, Entity, Pose2D
 from pmnav_bt.trees.pmnav import step_subtree
 

@@ -9,6 +9,7 @@ sign, a false detection) are dropped by trying every consistent subset.
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,3 +96,33 @@ def fix_pose(sightings: list[Sighting], max_residual: float = MAX_RESIDUAL) -> F
         if best is not None:
             return best  # the largest consistent set wins
     return None
+
+
+SIGN_AGREE_M = 1.0  # signs fixing the position together must agree on it this well
+
+
+def sign_shift(tf, src, dst, placed) -> tuple[np.ndarray, float, float]:
+    """The shift that puts the signs read (``src``, odometry) on their map places (``dst``)
+    under ``tf`` (map_T_odom), its residual (m, RMS over the signs kept) and its
+    uncertainty (m) from how far each kept sign may be from its map place (``placed``, m
+    per sighting): a fix's position from signs too close together to fix a heading.
+
+    Each sign's shift is the mean of its sightings'; the signs kept are weighed by how
+    exactly they are placed. Signs that disagree by more than
+    ``SIGN_AGREE_M`` cannot all be right (a sign plate sits beside the door or elevator the
+    map places, up to 1.7 m off): those that agree with the sign asking for the smallest
+    shift, the one the belief's hypothesis (every sighting, depth, the corridors) already
+    agrees with, are kept."""
+    per: dict[tuple, list] = {}
+    sigma: dict[tuple, float] = {}
+    for s, d, p in zip(src, dst, placed, strict=True):
+        per.setdefault(tuple(d), []).append(d - se2_apply(tf, s))
+        sigma[tuple(d)] = p
+    shifts = np.array([np.mean(v, axis=0) for v in per.values()])
+    sig = np.array([sigma[k] for k in per])
+    least = shifts[int(np.argmin(np.linalg.norm(shifts, axis=1)))]
+    keep = np.linalg.norm(shifts - least, axis=1) <= SIGN_AGREE_M
+    kept, wk = shifts[keep], 1.0 / sig[keep] ** 2
+    shift = (kept * wk[:, None]).sum(axis=0) / wk.sum()
+    res = float(np.sqrt(np.mean(np.sum((kept - shift) ** 2, axis=1))))
+    return shift, res, float(1.0 / math.sqrt(wk.sum()))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pmnav_bt.geometry import se2_apply, se2_inverse
-from pmnav_bt.localization import Sighting, fix_pose
+from pmnav_bt.pose.landmark_fix import Sighting, fix_pose
 from pmnav_bt.seams import Entity, Pose2D
 
 R = Entity.room
