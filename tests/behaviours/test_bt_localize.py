@@ -18,6 +18,8 @@ from pmnav_bt.behaviours.localize import (
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.seams import Pose2D
 
+pytestmark = pytest.mark.world  # a pybullet world: these tests need geometry
+
 SOUTH = math.radians(-90)
 
 

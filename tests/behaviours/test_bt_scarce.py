@@ -33,6 +33,8 @@ from pmnav_bt.pose.correction import PoseTracker
 from pmnav_bt.seams import Entity, MotionStatus, Pose2D
 from pmnav_bt.trees.localize import recovery_subtree
 
+pytestmark = pytest.mark.world  # a pybullet world: these tests need geometry
+
 SOUTH = math.radians(-90)
 NORTH_OF_ROOM4 = Pose2D(0.0, 26.5, SOUTH)  # room4's door is at (1.2, 22)
 
