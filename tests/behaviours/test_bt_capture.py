@@ -1,9 +1,9 @@
-"""CaptureViews against the simulator: the sweep, the views, early stop, cancellation."""
+"""CaptureViews: the sweep, the views, early stop, cancellation. The order of the views and
+the interrupts on the test doubles; what a view reads, and the panorama, in pybullet."""
 
 from __future__ import annotations
 
 import math
-from concurrent.futures import CancelledError
 
 import numpy as np
 import pytest
@@ -92,6 +92,7 @@ def test_search_views_are_taken_nearest_the_targets_bearing_first():
     assert order(behind, 175) == [-180, -210, -240, -270, -150, -120, -90]
 
 
+@pytest.mark.world
 def test_capture_turns_through_the_yaws_taking_one_view_at_each(make_rig):
     rig = make_rig(SOUTH_AT_20)
     cap = CaptureViews("Views", rig.ctx, localization_yaws, read_signs)
@@ -151,6 +152,7 @@ def test_capture_stops_early_once_enough(make_rig):
     assert rig.yaw_error(rig.true_pose().yaw, SOUTH_AT_20.yaw + math.radians(90)) <= TOL
 
 
+@pytest.mark.world
 def test_localization_capture_stops_once_enough_doors_are_read(make_rig):
     # At (0, 24) facing south, room4 (104) is read at +30 deg and room1 (101) at -150 deg,
     # the fourth view: two doors, so the last two views are not needed.
@@ -182,8 +184,10 @@ def test_terminate_while_turning_stops_the_base(make_rig):
     cap.stop(Status.INVALID)  # what a higher-priority branch or an interrupt does
     assert cap.status == Status.INVALID
     assert rig.stopped()
+    turned = rig.true_pose().yaw
+    assert 0.0 < turned - SOUTH_AT_20.yaw < math.radians(30)  # on its way to +30 deg
     rig.wait(1.0)
-    assert rig.body.stats.rotation < math.radians(30)  # it did not go on turning
+    assert rig.true_pose().yaw == turned  # it did not go on turning
     assert rig.get("views") is None
 
 
@@ -200,8 +204,7 @@ def test_terminate_with_a_frame_in_flight_cancels_the_job_and_stops(make_rig):
     assert job.cancelled.is_set()
     release.set()
     rig.ctx.worker.drain()
-    with pytest.raises(CancelledError):
-        job.result()  # dropped before it ran
+    assert not job.started()  # dropped before it ran
     assert rig.stopped()
     assert rig.get("views") is None
     # Ticked again, it starts afresh and completes.
@@ -209,6 +212,7 @@ def test_terminate_with_a_frame_in_flight_cancels_the_job_and_stops(make_rig):
     assert len(rig.get("views")) == 1
 
 
+@pytest.mark.world
 def test_a_frame_the_grounder_cannot_read_fails_backend_error(make_rig):
     rig = make_rig(SOUTH_AT_20, segmentation=False)  # the ground-truth grounder needs it
     cap = CaptureViews("Views", rig.ctx, lambda b: [0.0, math.radians(30)], read_signs)
@@ -227,6 +231,7 @@ def _panorama(rig):
     return rig.get("views")
 
 
+@pytest.mark.world
 def test_a_panorama_reading_two_signs_takes_six_views_at_most(make_rig):
     rig = make_rig(SOUTH_AT_20)  # room2 and room4 either side
     views = _panorama(rig)
@@ -234,6 +239,7 @@ def test_a_panorama_reading_two_signs_takes_six_views_at_most(make_rig):
     assert len(distinct_landmarks(views)) >= 2
 
 
+@pytest.mark.world
 def test_a_panorama_reading_fewer_takes_the_six_views_between_the_first(make_rig, pm):
     """A plate on the seam of two 60-degree views is cut in both: with fewer than two
     signs read, the panorama goes on round through the directions half-way between."""
@@ -270,6 +276,7 @@ def test_an_extending_capture_adds_its_views_to_those_on_the_blackboard(make_rig
     assert len(rig.get("views")) == 1
 
 
+@pytest.mark.world
 def test_in_a_bare_stretch_the_belief_skips_the_views_between(make_rig, pm):
     """Where the belief so far puts no sign in reach, the six views between are not
     worth their turn: a second panorama there stops at six views."""
