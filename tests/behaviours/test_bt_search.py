@@ -31,6 +31,7 @@ from pmnav_bt.localization import Sighting
 from pmnav_bt.perception.coarse import DetectorCoarseDirection
 from pmnav_bt.planning.resolve import sign_text
 from pmnav_bt.seams import CoarseChoice, Entity, Pose2D
+from pmnav_bt.testing.doubles import ScriptedGrounder
 from pmnav_bt.trees.pmnav import step_subtree
 
 # On the start-turn1 corridor facing south, 4.5 m short of room4's door.
@@ -118,9 +119,8 @@ def test_coarse_direction_ignores_detections_below_min_score(make_rig):
     rig.expect(rig.run(CoarseDirection("Lenient", rig.ctx)), Status.SUCCESS)
 
 
-@pytest.mark.world
-def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig):
-    rig = make_rig(NORTH_OF_ROOM4)
+def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig, pm):
+    rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     rig.run(CoarseDirection("CoarseDirection", rig.ctx))
     view, det = choice(rig)
@@ -142,9 +142,8 @@ def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig
     assert abs(det2.centre[0] - k.cx) < abs(det.centre[0] - obs.intrinsics.cx)  # more central
 
 
-@pytest.mark.world
-def test_ground_keeps_the_coarse_detection_when_the_fresh_frame_misses(make_rig):
-    rig = make_rig(NORTH_OF_ROOM4)
+def test_ground_keeps_the_coarse_detection_when_the_fresh_frame_misses(make_rig, pm):
+    rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     rig.run(CoarseDirection("CoarseDirection", rig.ctx))
     coarse = rig.get("choice")
@@ -206,9 +205,8 @@ def fine_and_verify(rig, map_T_odom):
     return verify
 
 
-@pytest.mark.world
-def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_truth(make_rig):
-    rig = make_rig(NORTH_OF_ROOM4)
+def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_truth(make_rig, pm):
+    rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     # Odometry is the map frame here; the estimate is off by (0.5, 1.0) m.
     offset = (0.5, 1.0, 0.0)
@@ -239,9 +237,8 @@ def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_tru
     assert rig.failure is None
 
 
-@pytest.mark.world
-def test_verify_refits_heading_on_recent_sightings_spread_apart(make_rig):
-    rig = make_rig(NORTH_OF_ROOM4)
+def test_verify_refits_heading_on_recent_sightings_spread_apart(make_rig, pm):
+    rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     # Earlier verified sightings of room1 and room2, seen where they are (odom = map).
     recent = [
