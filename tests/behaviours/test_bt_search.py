@@ -164,7 +164,6 @@ def test_ground_terminate_while_turning_stops_the_base(make_rig):
     assert rig.stopped()
 
 
-@pytest.mark.world
 def test_the_tree_searches_first_where_the_map_puts_the_target(make_rig):
     """The tree's search views start at the one nearest the target's bearing by the map and
     stop once it is seen: room4's door, 3 m ahead and 1.2 m to the left (22 deg), is read in
