@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 from blackboard_kit import cleared
-from rig import BODIES, Rig, on_doubles, on_pybullet
+from rig import BODIES, Rig, build_rig
 
 from pmnav_bt.map.building import load_building
 from pmnav_bt.map.priori_map import parse_building
@@ -110,10 +110,8 @@ def make_rig(request, body, pm, clean_blackboard):
     made: list[Rig] = []
 
     def make(pose: Pose2D, **options) -> Rig:
-        if body == "pybullet":
-            rig = on_pybullet(request.getfixturevalue("world"), pm, pose, **options)
-        else:
-            rig = on_doubles(pm, pose, **options)
+        world = request.getfixturevalue("world") if body == "pybullet" else None
+        rig = build_rig(body, pm, pose, world=world, **options)
         made.append(rig)
         return rig
 

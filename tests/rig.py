@@ -155,39 +155,12 @@ class Rig(BlackboardAccess):
             self.body.close()
 
 
-def on_doubles(
+def build_rig(
+    body: str,
     pm: PrioriMap,
     pose: Pose2D,
     *,
-    width: int = 160,
-    height: int = 120,
-    seed: int = 0,
-    budget: int | None = None,
-    overrides: tuple[str, ...] = (),
-    grounder: ScriptedGrounder | None = None,
-    coarse: FakeCoarseDirection | None = None,
-    refiner: FakeRefiner | None = None,
-    planner: FakePlanner | None = None,
-) -> Rig:
-    """A Rig on the test doubles (any double not given is a default one); background
-    jobs start between ticks, as in simulation."""
-    body = FakeBase(pose, intrinsics=CameraIntrinsics.from_hfov(width, height, DOUBLES_HFOV))
-    backends = Backends(
-        grounder=grounder or ScriptedGrounder(pm),
-        coarse=coarse or FakeCoarseDirection(),
-        refiner=refiner or FakeRefiner(),
-        planner=planner or FakePlanner(),
-    )
-    cfg = load_config(overrides=[ORACLE, *overrides])
-    ctx = make_context(body, pm, cfg, seed, budget, deferred_work=True, backends=backends)
-    return Rig(body, body, ctx, pm, writer())
-
-
-def on_pybullet(
-    world,
-    pm: PrioriMap,
-    pose: Pose2D,
-    *,
+    world=None,
     width: int = 160,
     height: int = 120,
     seed: int = 0,
@@ -195,14 +168,38 @@ def on_pybullet(
     overrides: tuple[str, ...] = (),
     noise: float | None = None,
     segmentation: bool = True,
+    grounder: ScriptedGrounder | None = None,
+    coarse: FakeCoarseDirection | None = None,
+    refiner: FakeRefiner | None = None,
+    planner: FakePlanner | None = None,
 ) -> Rig:
-    """A Rig on a SimBase in ``world`` with the config's back ends; background jobs start at
-    once, in the worker's thread. ``noise``: drifting odometry (NoisyOdometry) around the
-    body; ``segmentation``: the camera's labels (the ground-truth grounder needs them)."""
-    from pmnav_bt.sim.odometry import NoisyOdometry
-    from pmnav_bt.sim.robot import SimBase
+    """A Rig at ``pose`` on ``body`` (one of BODIES), with the config (ORACLE + ``overrides``)
+    and a ``width`` x ``height`` camera.
 
-    body = SimBase(world, pose=pose, width=width, height=height, segmentation=segmentation)
-    base = body if noise is None else NoisyOdometry(body, noise, seed=seed)
-    ctx = make_context(base, pm, load_config(overrides=[ORACLE, *overrides]), seed, budget)
-    return Rig(body, base, ctx, pm, writer(), world)
+    ``"doubles"``: any double not given (``grounder``, ``coarse``, ``refiner``, ``planner``)
+    is a default one; background jobs start between ticks, as in simulation.
+    ``"pybullet"``: a SimBase in ``world`` with the config's back ends; background jobs start
+    at once, in the worker's thread. ``noise``: drifting odometry (NoisyOdometry) around the
+    body; ``segmentation``: the camera's labels (the ground-truth grounder needs them).
+    """
+    cfg = load_config(overrides=[ORACLE, *overrides])
+    doubles = (grounder, coarse, refiner, planner)
+    if body == "pybullet":
+        from pmnav_bt.sim.odometry import NoisyOdometry
+        from pmnav_bt.sim.robot import SimBase
+
+        assert all(d is None for d in doubles), "test doubles need the doubles body"
+        sim = SimBase(world, pose=pose, width=width, height=height, segmentation=segmentation)
+        base = sim if noise is None else NoisyOdometry(sim, noise, seed=seed)
+        return Rig(sim, base, make_context(base, pm, cfg, seed, budget), pm, writer(), world)
+    assert body == "doubles", f"no body {body!r}; choose from {BODIES}"
+    assert noise is None and segmentation, "drifting odometry and labels need pybullet"
+    fake = FakeBase(pose, intrinsics=CameraIntrinsics.from_hfov(width, height, DOUBLES_HFOV))
+    backends = Backends(
+        grounder=grounder or ScriptedGrounder(pm),
+        coarse=coarse or FakeCoarseDirection(),
+        refiner=refiner or FakeRefiner(),
+        planner=planner or FakePlanner(),
+    )
+    ctx = make_context(fake, pm, cfg, seed, budget, deferred_work=True, backends=backends)
+    return Rig(fake, fake, ctx, pm, writer())

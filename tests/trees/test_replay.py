@@ -158,13 +158,14 @@ def test_tick_record_missing_a_field(tmp_path, log):
 @pytest.fixture(scope="module")
 def episode_log(tmp_path_factory):
     """A real log: 60 ticks of PM-Nav on the test doubles in fig2_hospital's map."""
-    from rig import on_doubles
+    from rig import build_rig
 
     from pmnav_bt.map.building import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.seams import Pose2D
 
-    rig = on_doubles(parse_building(load_building("fig2_hospital")), Pose2D(22.0, 0.0, 0.0))
+    pm = parse_building(load_building("fig2_hospital"))
+    rig = build_rig("doubles", pm, Pose2D(22.0, 0.0, 0.0))
     path = tmp_path_factory.mktemp("episode") / "tree.jsonl"
     with open(path, "w", encoding="utf-8") as out:
         outcome = rig.mission("room17", max_ticks=60, log=out)
