@@ -1,11 +1,15 @@
-"""Shared fixtures: built-in buildings and their priori-maps."""
+"""Shared fixtures: built-in buildings and their priori-maps, and the tick rig's
+(``make_rig``: a Context on the test doubles, or on pybullet for tests marked ``world``)."""
 
 from __future__ import annotations
 
 import pytest
+from blackboard_kit import cleared
+from rig import BODIES, Rig, build_rig
 
 from pmnav_bt.map.building import load_building
 from pmnav_bt.map.priori_map import parse_building
+from pmnav_bt.seams import Pose2D
 
 
 @pytest.fixture(scope="session")
@@ -46,3 +50,71 @@ def hospital_grid():
     if path is None or not path.is_file():
         pytest.skip("the real hospital map is absent: set PMNAV_SHARED_MAPS to a maps/ folder")
     return path
+
+
+# -- the tick rig (tests/rig.py) ---------------------------------------------------------------
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers",
+        "world: the test needs a pybullet world (geometry: depth, walls, distances); "
+        "its make_rig builds SimBase bodies instead of the test doubles",
+    )
+
+
+@pytest.fixture
+def clean_blackboard():
+    yield from cleared()
+
+
+@pytest.fixture(scope="module")
+def building(fig2):
+    """The building of a module's rigs (override it in a module for another one)."""
+    return fig2
+
+
+@pytest.fixture(scope="module")
+def pm(building):
+    return parse_building(building)
+
+
+@pytest.fixture(scope="module")
+def world(building):
+    """The module's pybullet world (built only for tests whose rigs need it)."""
+    from pmnav_bt.sim.world import SimWorld
+
+    w = SimWorld(building)
+    yield w
+    w.close()
+
+
+@pytest.fixture
+def body(request) -> str:
+    """The body a test's rigs are built on: its parameter when a test is parametrized
+    over it (``indirect=True``), else ``"pybullet"`` for a test marked ``world``, else
+    ``"doubles"``."""
+    kind = getattr(request, "param", None)
+    if kind is None:
+        kind = "pybullet" if request.node.get_closest_marker("world") else "doubles"
+    assert kind in BODIES, f"no body {kind!r}; choose from {BODIES}"
+    return kind
+
+
+@pytest.fixture
+def make_rig(request, body, pm, clean_blackboard):
+    """``make_rig(pose, **options)`` -> Rig on the ``body`` fixture's body, in the module's
+    building; options: ``width``, ``height``, ``seed``, ``budget``, ``overrides`` (config)
+    for both bodies; ``grounder``, ``coarse``, ``refiner``, ``planner`` (doubles) on the
+    doubles; ``noise``, ``segmentation`` on pybullet. Everything is torn down afterwards."""
+    made: list[Rig] = []
+
+    def make(pose: Pose2D, **options) -> Rig:
+        world = request.getfixturevalue("world") if body == "pybullet" else None
+        rig = build_rig(body, pm, pose, world=world, **options)
+        made.append(rig)
+        return rig
+
+    yield make
+    for rig in made:
+        rig.close()

@@ -167,7 +167,8 @@ class ScriptedGrounder:
 
     ``hidden``: room/landmark IDs never seen; ``signs_readable``: False makes ``read_signs``
     see nothing (localization fails); ``error``: every call raises it (a buggy back end);
-    ``open_ahead``: what ``surfaces`` shows in the lower band (floor, or a wall).
+    ``open_ahead``: what ``surfaces`` shows in the lower band (floor, or a wall);
+    ``masks``: each detection carries its box as a mask (as a segmenting grounder's do).
     """
 
     pm: PrioriMap
@@ -177,6 +178,7 @@ class ScriptedGrounder:
     error: Exception | None = None
     open_ahead: bool = True
     score: float = 0.9
+    masks: bool = False
     needs_sim_labels = False
     calls: list[str] = field(default_factory=list)
 
@@ -227,7 +229,11 @@ class ScriptedGrounder:
         v = k.cy
         box = (u - 10.0, v - 10.0, u + 10.0, v + 10.0)
         text = sign_text(self.pm.building, entity)
-        return Detection(text, box, self.score, entity=entity, point=(x, y, 0.0))
+        mask = None
+        if self.masks:
+            mask = np.zeros((k.height, k.width), bool)
+            mask[int(v) - 10 : int(v) + 10, int(round(u)) - 10 : int(round(u)) + 10] = True
+        return Detection(text, box, self.score, mask=mask, entity=entity, point=(x, y, 0.0))
 
 
 @dataclass

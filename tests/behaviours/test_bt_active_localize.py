@@ -13,15 +13,14 @@ from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.visibility import Visibility
 from pmnav_bt.seams import Pose2D
-from pmnav_bt.sim.world import SimWorld
 from pmnav_bt.trees.localize import active_localize_subtree
+
+pytestmark = pytest.mark.world  # a pybullet world: these tests need geometry
 
 
 @pytest.fixture(scope="module")
-def world():  # overrides the fig2_hospital world of conftest
-    w = SimWorld(generate_sign_sparse(0))
-    yield w
-    w.close()
+def building():  # overrides the fig2_hospital building of conftest
+    return generate_sign_sparse(0)
 
 
 def test_a_start_in_a_sign_less_stretch_localizes_by_driving_along_the_axis(make_rig, pm):

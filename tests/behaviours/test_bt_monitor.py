@@ -1,4 +1,5 @@
-"""The mission monitor (action budget) and ClockTimeout (sim time, not wall time)."""
+"""The mission monitor (action budget, the body's faults) and ClockTimeout (the tree's
+clock, not wall time), on the test doubles: a kinematic body in fig2_hospital's map."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from py_trees.common import ParallelPolicy, Status
 from pmnav_bt.behaviours.decorators import ClockTimeout
 from pmnav_bt.behaviours.monitor import Monitor
 from pmnav_bt.behaviours.motion import MoveToward
-from pmnav_bt.failures import FailureCode
+from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.seams import FORWARD_STEP_M, Pose2D
 
 SOUTH_AT_28 = Pose2D(0.0, 28.0, math.radians(-90))
@@ -54,7 +55,35 @@ def test_monitor_counts_turning_too(make_rig):
     rig.expect(seen, Status.FAILURE)
     assert rig.failure.code == FailureCode.BUDGET_EXCEEDED
     assert rig.ctx.odometer.distance == 0.0
-    assert rig.body.stats.rotation == pytest.approx(math.radians(30 * 5.5), abs=0.11)
+    turned = rig.true_pose().yaw - SOUTH_AT_28.yaw  # under half a turn: no wrap
+    assert turned == pytest.approx(math.radians(30 * 5.5), abs=0.11)
+
+
+def test_monitor_fails_base_fault_once_the_body_faults(make_rig):
+    rig = make_rig(SOUTH_AT_28)
+    monitor = Monitor("Monitor", rig.ctx)
+    rig.body.set_velocity(0.2, 0.0)
+    rig.ticks(monitor, [Status.RUNNING, Status.RUNNING])
+    assert rig.failure is None
+    rig.body.faulted = True
+    assert rig.tick(monitor) == Status.FAILURE
+    assert rig.failure == Failure(FailureCode.BASE_FAULT, "the base reports a fault")
+    assert rig.body.velocity_command == (0.0, 0.0)  # stopped
+
+
+def test_monitor_reports_the_failure_a_body_s_fault_hook_gives_first(make_rig):
+    rig = make_rig(SOUTH_AT_28)
+    silent = Failure(FailureCode.SENSOR_TIMEOUT, "no odometry on /odom for 1.0 s")
+    reports = iter([None, silent])
+    rig.body.fault = lambda: next(reports)  # a hardware body's optional hook
+    rig.body.faulted = True  # also faulted: the hook's own failure is the one reported
+    rig.body.set_velocity(0.2, 0.0)
+    monitor = Monitor("Monitor", rig.ctx)
+    assert rig.tick(monitor) == Status.FAILURE  # faulted, the hook said nothing
+    assert rig.failure.code == FailureCode.BASE_FAULT
+    assert rig.tick(monitor) == Status.FAILURE
+    assert rig.failure == silent
+    assert rig.body.velocity_command == (0.0, 0.0)
 
 
 def test_monitor_beside_the_mission_stops_it_when_the_budget_is_spent(make_rig):

@@ -22,6 +22,8 @@ from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, point_towards
 from pmnav_bt.seams import Pose2D
 
+pytestmark = pytest.mark.world  # a pybullet world: these tests need geometry
+
 SOUTH, EAST, NORTH = math.radians(-90), 0.0, math.radians(90)
 
 

@@ -1,9 +1,9 @@
-"""Goal check, planning, target determination and update, and the bookkeeping of recovery."""
+"""Goal check, planning, target determination and update, and the bookkeeping of recovery,
+on the test doubles in fig2_hospital's priori-map (the planner is the real graph planner)."""
 
 from __future__ import annotations
 
 import math
-from concurrent.futures import CancelledError
 
 import pytest
 from py_trees.common import Status
@@ -131,8 +131,7 @@ def test_make_plan_terminate_cancels_the_planning_job(make_rig):
     assert job.cancelled.is_set()
     release.set()
     rig.ctx.worker.drain()
-    with pytest.raises(CancelledError):
-        job.result()
+    assert not job.started()  # dropped before it ran
     assert rig.get("plan") is None
 
 

@@ -1,12 +1,15 @@
-"""PolicyApproach against the simulator, with a scripted pixel-goal policy: the policy's
-actions drive the body step by step, grounding and acting run in the worker, and the
-map approach takes over for other targets and for a policy that never stops."""
+"""PolicyApproach with a scripted pixel-goal policy, on the test doubles (a grounder whose
+detections carry masks): the policy's actions drive the body step by step, grounding and
+acting run in the worker, the map approach takes over for other targets and for a policy
+that never stops, and the tree picks it only for a pixel-goal refiner. Stepping into the
+wall by the door needs the wall: pybullet."""
 
 from __future__ import annotations
 
 import math
 import threading
 
+import pytest
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.policy_approach import PolicyApproach
@@ -21,6 +24,7 @@ from pmnav_bt.seams import (
     Refinement,
     View,
 )
+from pmnav_bt.testing.doubles import ScriptedGrounder
 
 SOUTH = math.radians(-90)
 # 2.8 m from room4's door (1.2, 22), facing it: its sign is readable from here
@@ -66,8 +70,8 @@ def grounded(rig, goal="room4"):
     return step, CoarseChoice(View(0.0, obs, tuple(dets)), dets[0])
 
 
-def test_the_policy_drives_the_approach_step_by_step_until_it_stops(make_rig):
-    rig = make_rig(NEAR)
+def test_the_policy_drives_the_approach_step_by_step_until_it_stops(make_rig, pm):
+    rig = make_rig(NEAR, grounder=ScriptedGrounder(pm, masks=True))
     policy = ScriptedPolicy([DiscreteAction.FORWARD] * 4 + [DiscreteAction.TURN_LEFT])
     assert isinstance(policy, PixelGoalPolicy)
     rig.ctx.refiner = policy
@@ -87,8 +91,9 @@ def test_the_policy_drives_the_approach_step_by_step_until_it_stops(make_rig):
     assert all(name.startswith("pmnav-worker") for name in policy.threads)
 
 
-def test_a_stop_short_of_the_door_is_finished_by_the_map_approach(make_rig):
-    rig = make_rig(START)  # 2.8 m from the door; the policy stops after three steps
+def test_a_stop_short_of_the_door_is_finished_by_the_map_approach(make_rig, pm):
+    # 2.8 m from the door; the policy stops after three steps
+    rig = make_rig(START, grounder=ScriptedGrounder(pm, masks=True))
     policy = ScriptedPolicy([DiscreteAction.FORWARD] * 3)
     rig.ctx.refiner = policy
     step, choice = grounded(rig)
@@ -99,8 +104,8 @@ def test_a_stop_short_of_the_door_is_finished_by_the_map_approach(make_rig):
     assert math.dist((p.x, p.y), (1.2 - 0.6, 22.0)) < 0.2  # the map's stop point
 
 
-def test_a_landmark_on_the_way_is_approached_on_the_map_not_by_the_policy(make_rig):
-    rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
+def test_a_landmark_on_the_way_is_approached_on_the_map_not_by_the_policy(make_rig, pm):
+    rig = make_rig(Pose2D(0.0, 26.5, SOUTH), grounder=ScriptedGrounder(pm, masks=True))
     policy = ScriptedPolicy([DiscreteAction.TURN_LEFT])
     rig.ctx.refiner = policy
     step = rig.plan("0,29,-90", "room3").steps[0]  # {room4: go straight}
@@ -111,8 +116,8 @@ def test_a_landmark_on_the_way_is_approached_on_the_map_not_by_the_policy(make_r
     assert policy.acts == 0
 
 
-def test_a_policy_that_never_stops_hands_over_to_the_map_approach(make_rig):
-    rig = make_rig(START)
+def test_a_policy_that_never_stops_hands_over_to_the_map_approach(make_rig, pm):
+    rig = make_rig(START, grounder=ScriptedGrounder(pm, masks=True))
     policy = ScriptedPolicy([DiscreteAction.TURN_RIGHT], max_steps=4, forever=True)
     rig.ctx.refiner = policy
     step, choice = grounded(rig)
@@ -142,10 +147,10 @@ def test_the_tree_approaches_with_the_policy_only_when_the_refiner_is_one(make_r
     assert approaches(rig.ctx) == {Approach}  # coarse-only: no refiner, no policy
 
 
-def test_it_turns_to_face_the_door_before_the_policy_drives(make_rig):
+def test_it_turns_to_face_the_door_before_the_policy_drives(make_rig, pm):
     # The search left the body turned away from where the door was grounded: the turn
     # is a velocity command (MOVING until face() stops it), so it must not wait on it.
-    rig = make_rig(START)
+    rig = make_rig(START, grounder=ScriptedGrounder(pm, masks=True))
     policy = ScriptedPolicy([DiscreteAction.FORWARD])
     rig.ctx.refiner = policy
     step, choice = grounded(rig)
@@ -156,8 +161,8 @@ def test_it_turns_to_face_the_door_before_the_policy_drives(make_rig):
     assert abs(rig.true_pose().yaw - START.yaw) < math.radians(5)  # faced the door first
 
 
-def test_a_door_beyond_the_policy_range_is_approached_on_the_map(make_rig):
-    rig = make_rig(START)  # 2.8 m from the door
+def test_a_door_beyond_the_policy_range_is_approached_on_the_map(make_rig, pm):
+    rig = make_rig(START, grounder=ScriptedGrounder(pm, masks=True))  # 2.8 m from the door
     policy = ScriptedPolicy([DiscreteAction.TURN_LEFT])
     rig.ctx.refiner = policy
     cfg = rig.ctx.config
@@ -171,6 +176,7 @@ def test_a_door_beyond_the_policy_range_is_approached_on_the_map(make_rig):
     assert math.dist((p.x, p.y), (1.2 - 0.6, 22.0)) < 0.2  # the map's stop point
 
 
+@pytest.mark.world
 def test_a_policy_blocked_at_the_door_has_arrived(make_rig):
     # Stepping on into the wall by the door: as near as the body gets, not a failure.
     rig = make_rig(NEAR)

@@ -1,7 +1,8 @@
-"""Search against the simulator: coarse direction, grounding, fine direction, verification.
+"""Search: coarse direction, grounding, fine direction, verification.
 
-The views come from a real CaptureViews with the real ground-truth grounder; the
-targets are steps of a real plan: from (0, 29) south to room3, {room4: go straight}
+Tests marked ``world`` take their views with a real CaptureViews and the ground-truth
+grounder in pybullet; the others run on the test doubles. The targets are steps of a real
+plan: from (0, 29) south to room3, {room4: go straight}
 (door (1.2, 22)), {room5: go straight} (door (1.2, 14)), {room3: arrive}.
 """
 
@@ -30,6 +31,7 @@ from pmnav_bt.perception.coarse import DetectorCoarseDirection
 from pmnav_bt.planning.resolve import sign_text
 from pmnav_bt.pose.landmark_fix import Sighting
 from pmnav_bt.seams import CoarseChoice, Entity, Pose2D
+from pmnav_bt.testing.doubles import ScriptedGrounder
 from pmnav_bt.trees.pmnav import step_subtree
 
 # On the start-turn1 corridor facing south, 4.5 m short of room4's door.
@@ -76,6 +78,7 @@ def test_the_target_is_a_typed_entity_whose_sign_a_person_reads(make_rig):
     assert target_entity(cap) is None
 
 
+@pytest.mark.world
 def test_coarse_direction_picks_the_view_with_the_best_score(make_rig):
     rig = make_rig(NORTH_OF_ROOM4, width=320, height=240)  # room4 readable in two views
     views = search(rig, targets(rig)["room4"])
@@ -91,6 +94,7 @@ def test_coarse_direction_picks_the_view_with_the_best_score(make_rig):
     assert f"{math.degrees(view.relative_yaw):+.0f} deg" in coarse.feedback_message
 
 
+@pytest.mark.world
 def test_coarse_direction_fails_target_not_found_when_no_view_shows_it(make_rig):
     rig = make_rig(NORTH_OF_ROOM4)
     views = search(rig, targets(rig)["room3"])  # 16 m away: the sign is unreadable
@@ -102,6 +106,7 @@ def test_coarse_direction_fails_target_not_found_when_no_view_shows_it(make_rig)
     assert rig.get("choice") is None
 
 
+@pytest.mark.world
 def test_coarse_direction_ignores_detections_below_min_score(make_rig):
     rig = make_rig(NORTH_OF_ROOM4)
     views = search(rig, targets(rig)["room4"])
@@ -114,8 +119,8 @@ def test_coarse_direction_ignores_detections_below_min_score(make_rig):
     rig.expect(rig.run(CoarseDirection("Lenient", rig.ctx)), Status.SUCCESS)
 
 
-def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig):
-    rig = make_rig(NORTH_OF_ROOM4)
+def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig, pm):
+    rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     rig.run(CoarseDirection("CoarseDirection", rig.ctx))
     view, det = choice(rig)
@@ -137,8 +142,8 @@ def test_ground_faces_the_coarse_direction_and_grounds_in_a_fresh_frame(make_rig
     assert abs(det2.centre[0] - k.cx) < abs(det.centre[0] - obs.intrinsics.cx)  # more central
 
 
-def test_ground_keeps_the_coarse_detection_when_the_fresh_frame_misses(make_rig):
-    rig = make_rig(NORTH_OF_ROOM4)
+def test_ground_keeps_the_coarse_detection_when_the_fresh_frame_misses(make_rig, pm):
+    rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     rig.run(CoarseDirection("CoarseDirection", rig.ctx))
     coarse = rig.get("choice")
@@ -199,8 +204,8 @@ def fine_and_verify(rig, map_T_odom):
     return verify
 
 
-def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_truth(make_rig):
-    rig = make_rig(NORTH_OF_ROOM4)
+def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_truth(make_rig, pm):
+    rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     # Odometry is the map frame here; the estimate is off by (0.5, 1.0) m.
     offset = (0.5, 1.0, 0.0)
@@ -231,8 +236,8 @@ def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_tru
     assert rig.failure is None
 
 
-def test_verify_refits_heading_on_recent_sightings_spread_apart(make_rig):
-    rig = make_rig(NORTH_OF_ROOM4)
+def test_verify_refits_heading_on_recent_sightings_spread_apart(make_rig, pm):
+    rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     # Earlier verified sightings of room1 and room2, seen where they are (odom = map).
     recent = [
@@ -253,6 +258,7 @@ def test_verify_refits_heading_on_recent_sightings_spread_apart(make_rig):
     ]
 
 
+@pytest.mark.world
 def test_a_sighting_of_the_wrong_place_fails_target_not_found(make_rig):
     # room5's door (1.2, 14) is 12 m on: unreadable. The grounder misreads another sign in
     # view as "105" (every time), so the coarse direction picks a wrong place.
@@ -282,6 +288,7 @@ def test_coarse_only_places_the_target_straight_ahead_at_the_map_distance(make_r
     assert rig.yaw_error(seen_dir, p.yaw) < 1e-6
 
 
+@pytest.mark.world
 def test_detector_coarse_direction_seam_grounds_plain_views(make_rig):
     from pmnav_bt.seams import View
 

@@ -1,6 +1,6 @@
 """The declarative terminate of PmNavBehaviour: JOBS are cancelled whenever a leaf ends,
-the body is stopped only when the leaf is interrupted, and every leaf that submits a
-worker job names it in JOBS."""
+the body is stopped only when the leaf is interrupted (the test doubles' body, and a
+simulated one), and every leaf that submits a worker job names it in JOBS."""
 
 from __future__ import annotations
 
@@ -49,6 +49,7 @@ def test_a_leaf_that_fails_with_its_job_in_flight_cancels_the_job(make_rig):
     release.set()
 
 
+@pytest.mark.parametrize("body", ["doubles", "pybullet"], indirect=True)
 def test_an_interrupted_leaf_cancels_its_job_and_stops_the_body(make_rig):
     rig = make_rig(SOUTH_AT_20)
     release = rig.hold_worker()

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import pytest
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.capture import CaptureViews
@@ -14,6 +15,7 @@ from pmnav_bt.behaviours.planning import MakePlan
 from pmnav_bt.behaviours.search import CoarseDirection, FineDirection, target_entity
 from pmnav_bt.errors import SensorError, VlmError
 from pmnav_bt.failures import Failure, FailureCode
+from pmnav_bt.map.building import load_building
 from pmnav_bt.seams import CoarseChoice, Entity, PlanConstraints, Pose2D
 from pmnav_bt.testing.doubles import (
     FakeCoarseDirection,
@@ -23,6 +25,11 @@ from pmnav_bt.testing.doubles import (
 )
 
 EAST = Pose2D(4.0, 0.0, 0.0)  # straight_office: the corridor runs east along y = 0
+
+
+@pytest.fixture(scope="module")
+def building():
+    return load_building("straight_office")
 
 
 def search_views(rig, landmark: str):
@@ -35,8 +42,8 @@ def search_views(rig, landmark: str):
     return rig.get("views")
 
 
-def test_a_silent_camera_fails_sensor_timeout_not_an_escape(rig, office):
-    r = rig("straight_office", EAST)
+def test_a_silent_camera_fails_sensor_timeout_not_an_escape(make_rig, pm):
+    r = make_rig(EAST)
     r.base.observe_error = SensorError("no camera frame on /camera/image_raw for 1.0 s")
     seen = r.run(CaptureViews("Views", r.ctx, localization_yaws, read_signs))
     assert seen[-1] == Status.FAILURE
@@ -44,47 +51,46 @@ def test_a_silent_camera_fails_sensor_timeout_not_an_escape(rig, office):
     assert "no camera frame on /camera/image_raw" in r.failure.message
 
 
-def test_a_buggy_grounder_fails_internal_error_with_its_message(rig, office):
-    r = rig("straight_office", EAST, grounder=ScriptedGrounder(office))
-    r.grounder.error = ZeroDivisionError("division by zero")
+def test_a_buggy_grounder_fails_internal_error_with_its_message(make_rig, pm):
+    r = make_rig(EAST, grounder=ScriptedGrounder(pm))
+    r.ctx.grounder.error = ZeroDivisionError("division by zero")
     seen = r.run(CaptureViews("Views", r.ctx, localization_yaws, read_signs))
     assert seen[-1] == Status.FAILURE
     assert r.failure.code == FailureCode.INTERNAL_ERROR
     assert "ZeroDivisionError: division by zero" in r.failure.message
 
 
-def test_the_coarse_choice_runs_in_the_worker(rig, office):
-    r = rig("straight_office", EAST)
+def test_the_coarse_choice_runs_in_the_worker(make_rig, pm):
+    r = make_rig(EAST)
     views = search_views(r, "room2")
     coarse = CoarseDirection("CoarseDirection", r.ctx)
     coarse.tick_once()
-    assert coarse.status == Status.RUNNING and r.coarse.threads == []  # not in the tick
+    assert coarse.status == Status.RUNNING and r.ctx.coarse.threads == []  # not in the tick
     seen = r.run(coarse)
     assert seen[-1] == Status.SUCCESS
-    assert len(r.coarse.threads) == 1 and r.coarse.threads[0].startswith("pmnav-worker")
+    assert len(r.ctx.coarse.threads) == 1 and r.ctx.coarse.threads[0].startswith("pmnav-worker")
     choice = r.get("choice")
     assert isinstance(choice, CoarseChoice) and choice.view in views
     assert choice.detection.entity == Entity.room("room2")
 
 
-def test_a_vlm_error_in_the_coarse_direction_fails_vlm_error(rig, office):
-    r = rig("straight_office", EAST, coarse=FakeCoarseDirection(error=VlmError("timed out")))
+def test_a_vlm_error_in_the_coarse_direction_fails_vlm_error(make_rig, pm):
+    r = make_rig(EAST, coarse=FakeCoarseDirection(error=VlmError("timed out")))
     search_views(r, "room2")
     assert r.run(CoarseDirection("CoarseDirection", r.ctx))[-1] == Status.FAILURE
     assert r.failure == Failure(FailureCode.VLM_ERROR, "choosing the coarse direction: timed out")
 
 
-def test_a_target_in_no_view_fails_target_not_found(rig, office):
-    pm = office
-    r = rig("straight_office", EAST, grounder=ScriptedGrounder(pm, hidden=frozenset({"room2"})))
+def test_a_target_in_no_view_fails_target_not_found(make_rig, pm):
+    r = make_rig(EAST, grounder=ScriptedGrounder(pm, hidden=frozenset({"room2"})))
     search_views(r, "room2")
     assert r.run(CoarseDirection("CoarseDirection", r.ctx))[-1] == Status.FAILURE
     assert r.failure.code == FailureCode.TARGET_NOT_FOUND
 
 
-def test_fine_direction_takes_the_range_from_the_refinement_else_from_the_map(rig, office):
+def test_fine_direction_takes_the_range_from_the_refinement_else_from_the_map(make_rig, pm):
     for gives_range in (True, False):
-        r = rig("straight_office", Pose2D(4.0, 0.3, 0.0), refiner=FakeRefiner(gives_range))
+        r = make_rig(Pose2D(4.0, 0.3, 0.0), refiner=FakeRefiner(gives_range))
         search_views(r, "room2")
         r.run(CoarseDirection("CoarseDirection", r.ctx))
         assert r.run(FineDirection("FineDirection", r.ctx))[-1] == Status.SUCCESS
@@ -93,8 +99,8 @@ def test_fine_direction_takes_the_range_from_the_refinement_else_from_the_map(ri
         assert math.dist(s.odom_xy, s.map_xy) < 1e-6  # exact odometry: seen where it is
 
 
-def test_make_plan_gives_the_planner_the_pose_and_the_constraints(rig, office):
-    r = rig("straight_office", Pose2D(10.0, 0.2, math.pi))
+def test_make_plan_gives_the_planner_the_pose_and_the_constraints(make_rig, pm):
+    r = make_rig(Pose2D(10.0, 0.2, math.pi))
     first = r.ctx.planner.inner.plan(r.pm, Pose2D(11.0, 0.2, math.pi), "Kitchen").steps[0]
     r.set(
         goal="Kitchen",
@@ -103,23 +109,23 @@ def test_make_plan_gives_the_planner_the_pose_and_the_constraints(rig, office):
         blocked_segments=frozenset(),
     )
     assert r.run(MakePlan("Plan", r.ctx))[-1] == Status.SUCCESS
-    (start,) = r.planner.starts
+    (start,) = r.ctx.planner.starts
     assert start == Pose2D(11.0, 0.2, math.pi)  # map_T_odom applied; radians, not text
     avoided = PlanConstraints(avoid_landmarks=frozenset({first.look_for}))
-    assert r.planner.constraints == [avoided]
+    assert r.ctx.planner.constraints == [avoided]
     assert all(s.look_for != first.look_for for s in r.get("plan").steps)
 
 
-def test_a_buggy_planner_fails_internal_error(rig, office):
-    r = rig("straight_office", EAST, planner=FakePlanner(error=KeyError("seg99")))
+def test_a_buggy_planner_fails_internal_error(make_rig, pm):
+    r = make_rig(EAST, planner=FakePlanner(error=KeyError("seg99")))
     r.set(goal="Kitchen")
     assert r.run(MakePlan("Plan", r.ctx))[-1] == Status.FAILURE
     assert r.failure.code == FailureCode.INTERNAL_ERROR
     assert r.failure.message == "planning: KeyError: 'seg99'"
 
 
-def test_a_failure_during_a_recovery_keeps_the_root_cause(rig, office):
-    r = rig("straight_office", EAST)
+def test_a_failure_during_a_recovery_keeps_the_root_cause(make_rig, pm):
+    r = make_rig(EAST)
     root = Failure(FailureCode.TARGET_NOT_FOUND, "room2 not seen in 6 views")
     r.set(recovering_from=root)
     r.base.observe_error = SensorError("no camera frame")
@@ -128,8 +134,8 @@ def test_a_failure_during_a_recovery_keeps_the_root_cause(rig, office):
     assert str(r.failure).endswith(f"(after {root})")
 
 
-def test_the_way_watch_reports_a_silent_camera_not_an_obstacle(rig, office):
-    r = rig("straight_office", EAST)
+def test_the_way_watch_reports_a_silent_camera_not_an_obstacle(make_rig, pm):
+    r = make_rig(EAST)
     plan = r.ctx.planner.plan(r.pm, "start", "room13")
     r.set(target=plan.steps[-1])
     r.base.observe_error = SensorError("no camera frame")
@@ -139,10 +145,9 @@ def test_the_way_watch_reports_a_silent_camera_not_an_obstacle(rig, office):
     assert r.base.velocity_command == (0.0, 0.0)
 
 
-def test_check_opening_fails_when_a_wall_fills_the_way(rig, office):
-    pm = office
+def test_check_opening_fails_when_a_wall_fills_the_way(make_rig, pm):
     for open_ahead, status in ((True, Status.SUCCESS), (False, Status.FAILURE)):
-        r = rig("straight_office", EAST, grounder=ScriptedGrounder(pm, open_ahead=open_ahead))
+        r = make_rig(EAST, grounder=ScriptedGrounder(pm, open_ahead=open_ahead))
         r.set(target=r.ctx.planner.plan(r.pm, "start", "room13").steps[0])
         assert r.run(CheckOpening("ForkChoice", r.ctx))[-1] == status
-        assert r.grounder.calls == ["surfaces"]
+        assert r.ctx.grounder.calls == ["surfaces"]

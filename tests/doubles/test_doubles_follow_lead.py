@@ -15,8 +15,15 @@ from pmnav_bt.behaviours import follow_lead
 from pmnav_bt.behaviours.belief import DriveEnd
 from pmnav_bt.behaviours.follow_lead import BACK_OFF_S, SLIDE_ACROSS_M, WallLook
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M, BACKUP_SPEED, BACKUP_TIME_S, BackUp
+from pmnav_bt.map.building import load_building
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.trees.localize import follow_lead_subtree
+
+
+@pytest.fixture(scope="module")
+def building():
+    return load_building("straight_office")
+
 
 EAST = Pose2D(4.0, 0.0, 0.0)  # straight_office: the corridor runs east along y = 0
 PERIOD = 0.1  # clock seconds a tick (as the rig's run)
@@ -76,8 +83,8 @@ def plain(pose, n) -> WallLook:
     return look(pose, free=20.0)
 
 
-def rig_with(rig, monkeypatch, script=plain, belief=None):
-    r = rig("straight_office", EAST)
+def rig_with(make_rig, monkeypatch, script=plain, belief=None):
+    r = make_rig(EAST)
     monkeypatch.setattr(follow_lead, "look_at_walls", Looks(script))
     r.set(belief=belief, views=[])
     return r
@@ -113,9 +120,9 @@ def leaves(seen) -> list[str]:
 
 
 def test_without_a_belief_the_drive_covers_two_metres_towards_the_most_open_view(
-    rig, monkeypatch
+    make_rig, monkeypatch
 ):
-    r = rig_with(rig, monkeypatch)
+    r = rig_with(make_rig, monkeypatch)
     tree = follow_lead_subtree(r.ctx, max_distance=4.0)
     seen = run(r, tree)
     assert seen[-1][0] == Status.SUCCESS
@@ -126,10 +133,10 @@ def test_without_a_belief_the_drive_covers_two_metres_towards_the_most_open_view
 
 
 def test_the_lead_is_chosen_in_the_worker_and_the_drive_turns_onto_it_at_once(
-    rig, monkeypatch
+    make_rig, monkeypatch
 ):
     belief = ScriptedBelief(Lead(heading=math.pi / 2, distance=1.0))
-    r = rig_with(rig, monkeypatch, belief=belief)
+    r = rig_with(make_rig, monkeypatch, belief=belief)
     tree = follow_lead_subtree(r.ctx, max_distance=4.0)
     status, leaf, cmd = tick(r, tree)  # the lead is worked out between ticks
     assert (status, leaf, cmd) == (Status.RUNNING, "LocalizeChooseLead", (0.0, 0.0))
@@ -141,18 +148,18 @@ def test_the_lead_is_chosen_in_the_worker_and_the_drive_turns_onto_it_at_once(
     assert p.y == pytest.approx(1.0, abs=0.05) and p.x == pytest.approx(EAST.x, abs=0.05)
 
 
-def test_a_sign_read_ahead_cuts_the_distance_short(rig, monkeypatch):
+def test_a_sign_read_ahead_cuts_the_distance_short(make_rig, monkeypatch):
     """A sign 3.5 m ahead in the first look: the drive stops 2.5 m short of it, 1 m on,
     and says why (the next look round is not skipped)."""
     belief = ScriptedBelief(Lead(heading=0.0, distance=6.0))
-    r = rig_with(rig, monkeypatch, lambda p, n: look(p, free=20.0, signs=(3.5,)), belief)
+    r = rig_with(make_rig, monkeypatch, lambda p, n: look(p, free=20.0, signs=(3.5,)), belief)
     seen = run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
     assert seen[-1][0] == Status.SUCCESS
     assert r.get("drive_end") == DriveEnd.SIGN
     assert r.base.pose().x - EAST.x == pytest.approx(1.0, abs=0.05)
 
 
-def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(rig, monkeypatch):
+def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(make_rig, monkeypatch):
     """Depth shows a wall 0.6 m ahead 2 m into the drive: stop in that tick, SUCCESS,
     and the belief notes the drive's heading blocked."""
     belief = ScriptedBelief(Lead(heading=0.0, distance=6.0))
@@ -160,7 +167,7 @@ def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(rig, monkeypatch)
     def wall_at_6(p, n):
         return look(p, free=0.6 if p.x >= 6.0 else 20.0)
 
-    r = rig_with(rig, monkeypatch, wall_at_6, belief)
+    r = rig_with(make_rig, monkeypatch, wall_at_6, belief)
     seen = run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
     assert (seen[-1][0], seen[-1][2]) == (Status.SUCCESS, (0.0, 0.0))
     assert seen[-2][1] == "LocalizeDrive" and seen[-2][2][0] > 0.0  # driving until then
@@ -169,11 +176,11 @@ def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(rig, monkeypatch)
     assert 6.0 <= r.base.pose().x < 7.2  # a wall look a second
 
 
-def test_a_blocked_drive_rests_a_tick_then_backs_off_the_wall(rig, monkeypatch):
+def test_a_blocked_drive_rests_a_tick_then_backs_off_the_wall(make_rig, monkeypatch):
     """The body blocked 1 m into the drive: the drive stops it (a tick at rest), notes the
     way blocked, and the BackUp recovery reverses BACKUP_LIMIT_M off the wall."""
     belief = ScriptedBelief(Lead(heading=0.0, distance=6.0))
-    r = rig_with(rig, monkeypatch, belief=belief)
+    r = rig_with(make_rig, monkeypatch, belief=belief)
     tree = follow_lead_subtree(r.ctx, max_distance=8.0)
     while r.base.pose().x < EAST.x + 1.0:
         assert tick(r, tree)[0] == Status.RUNNING
@@ -190,11 +197,11 @@ def test_a_blocked_drive_rests_a_tick_then_backs_off_the_wall(rig, monkeypatch):
     assert r.get("drive_end") == DriveEnd.BLOCKED
 
 
-def test_a_drive_refused_at_once_backs_up_only_as_far_as_the_body_lets_it(rig, monkeypatch):
+def test_a_drive_refused_at_once_backs_up_only_as_far_as_the_body_lets_it(make_rig, monkeypatch):
     """Blocked before it moved 0.2 m: a brush with a wall, not the corridor's end (the
     belief is not told); BackUp gives up when the body refuses to reverse."""
     belief = ScriptedBelief(Lead(heading=0.0, distance=6.0))
-    r = rig_with(rig, monkeypatch, belief=belief)
+    r = rig_with(make_rig, monkeypatch, belief=belief)
     r.base.blocked = True
     seen = run(r, follow_lead_subtree(r.ctx, max_distance=8.0), max_ticks=20)
     assert [s[1] for s in seen][-4:] == [
@@ -209,9 +216,9 @@ def test_a_drive_refused_at_once_backs_up_only_as_far_as_the_body_lets_it(rig, m
 
 
 @pytest.mark.parametrize("timeout_s", [BACK_OFF_S, BACKUP_TIME_S])
-def test_a_backup_that_does_not_move_gives_up_after_its_timeout(rig, timeout_s):
+def test_a_backup_that_does_not_move_gives_up_after_its_timeout(make_rig, timeout_s):
     """The drive's backing off gives up sooner than the recoveries' (its own timeout)."""
-    r = rig("straight_office", EAST)
+    r = make_rig(EAST)
     r.base.max_linear = 0.0  # the body takes the command but does not move
     backup = BackUp("BackUp", r.ctx, timeout_s=timeout_s)
     seen = r.run(backup)
@@ -219,7 +226,7 @@ def test_a_backup_that_does_not_move_gives_up_after_its_timeout(rig, timeout_s):
     assert len(seen) == pytest.approx(timeout_s / PERIOD + 1, abs=1)
 
 
-def test_a_corner_early_in_the_drive_is_slid_past_and_the_drive_goes_on(rig, monkeypatch):
+def test_a_corner_early_in_the_drive_is_slid_past_and_the_drive_goes_on(make_rig, monkeypatch):
     """The first look shows a wall 0.6 m ahead with open floor 40 deg to the left: the
     drive stops (a tick at rest), slides left until SLIDE_ACROSS_M across its heading,
     faces its heading, looks at the walls again and covers the rest of its distance."""
@@ -230,7 +237,7 @@ def test_a_corner_early_in_the_drive_is_slid_past_and_the_drive_goes_on(rig, mon
             return look(p, free=0.6, beside=math.radians(40.0))
         return look(p, free=20.0)
 
-    r = rig_with(rig, monkeypatch, corner_first, belief)
+    r = rig_with(make_rig, monkeypatch, corner_first, belief)
     seen = run(r, follow_lead_subtree(r.ctx, max_distance=4.0))
     assert leaves(seen) == [
         "LocalizeChooseLead",
@@ -249,11 +256,11 @@ def test_a_corner_early_in_the_drive_is_slid_past_and_the_drive_goes_on(rig, mon
     assert math.hypot(p.x - EAST.x, p.y) == pytest.approx(3.0, abs=0.05)
 
 
-def test_a_second_corner_in_one_drive_is_a_wall(rig, monkeypatch):
+def test_a_second_corner_in_one_drive_is_a_wall(make_rig, monkeypatch):
     """One slide a drive: a wall ahead again after it ends the drive."""
     belief = ScriptedBelief(Lead(heading=0.0, distance=3.0))
     r = rig_with(
-        rig, monkeypatch, lambda p, n: look(p, free=0.6, beside=math.radians(40.0)), belief
+        make_rig, monkeypatch, lambda p, n: look(p, free=0.6, beside=math.radians(40.0)), belief
     )
     seen = run(r, follow_lead_subtree(r.ctx, max_distance=4.0))
     # the drive on ends in the tick it starts: the wall again
@@ -263,13 +270,13 @@ def test_a_second_corner_in_one_drive_is_a_wall(rig, monkeypatch):
 
 
 @pytest.mark.parametrize("another_way", [True, False])
-def test_the_lead_is_worked_out_again_every_three_metres(rig, monkeypatch, another_way):
+def test_the_lead_is_worked_out_again_every_three_metres(make_rig, monkeypatch, another_way):
     """3 m into a 6 m drive the lead is worked out again (worker) along the drive's
     heading; when it now goes another way the drive stops in the tick the answer comes
     (``rethought``: look again from here), else it drives on."""
     turned = Lead(heading=math.pi, distance=2.0) if another_way else None
     belief = ScriptedBelief(Lead(heading=0.0, distance=6.0), turned=turned)
-    r = rig_with(rig, monkeypatch, belief=belief)
+    r = rig_with(make_rig, monkeypatch, belief=belief)
     seen = run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
     assert len(belief.asked_again) >= 1
     x, heading = belief.asked_again[0]
@@ -283,16 +290,16 @@ def test_the_lead_is_worked_out_again_every_three_metres(rig, monkeypatch, anoth
         assert r.base.pose().x - EAST.x == pytest.approx(6.0, abs=0.05)
 
 
-def test_the_drive_tells_the_belief_the_floor_ahead_every_metre(rig, monkeypatch):
+def test_the_drive_tells_the_belief_the_floor_ahead_every_metre(make_rig, monkeypatch):
     belief = ScriptedBelief(Lead(heading=0.0, distance=4.5))
-    r = rig_with(rig, monkeypatch, belief=belief)
+    r = rig_with(make_rig, monkeypatch, belief=belief)
     run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
     steps = [b - a for a, b in zip([EAST.x, *belief.rays], belief.rays, strict=False)]
     assert len(belief.rays) >= 3 and all(s >= 1.0 for s in steps), belief.rays
 
 
-def test_an_interrupted_drive_stops_the_body(rig, monkeypatch):
-    r = rig_with(rig, monkeypatch, belief=ScriptedBelief(Lead(heading=0.0, distance=6.0)))
+def test_an_interrupted_drive_stops_the_body(make_rig, monkeypatch):
+    r = rig_with(make_rig, monkeypatch, belief=ScriptedBelief(Lead(heading=0.0, distance=6.0)))
     tree = follow_lead_subtree(r.ctx, max_distance=8.0)
     for _ in range(10):
         tick(r, tree)

@@ -7,86 +7,59 @@ import math
 
 import pytest
 
-from pmnav_bt.config import load_config
 from pmnav_bt.errors import SensorError
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.registry import Backends
+from pmnav_bt.map.building import load_building
 from pmnav_bt.seams import Pose2D
-from pmnav_bt.testing.doubles import (
-    FakeBase,
-    FakeCoarseDirection,
-    FakePlanner,
-    FakeRefiner,
-    ScriptedGrounder,
-)
-from pmnav_bt.testing.oracle import ORACLE
-from pmnav_bt.trees.runner import RunOutcome, make_context, run_tree
+from pmnav_bt.testing.doubles import FakePlanner, ScriptedGrounder
 
 START = Pose2D(4.0, 0.0, 0.0)  # straight_office, facing east down the corridor
 KITCHEN_DOOR = (48.5, 1.1)
+MAX_TICKS = 20_000
 
 
-def mission(
-    pm: PrioriMap,
-    goal: str = "Kitchen",
-    *,
-    grounder: ScriptedGrounder | None = None,
-    base: FakeBase | None = None,
-    overrides: tuple[str, ...] = (),
-    on_tick=None,
-    max_ticks: int = 20_000,
-) -> tuple[RunOutcome, FakeBase, object]:
-    base = base or FakeBase(START)
-    backends = Backends(
-        grounder or ScriptedGrounder(pm), FakeCoarseDirection(), FakeRefiner(), FakePlanner()
-    )
-    ctx = make_context(
-        base, pm, load_config(overrides=[ORACLE, *overrides]), deferred_work=True, backends=backends
-    )
-    hook = (lambda tree: on_tick(ctx)) if on_tick is not None else None
-    out = run_tree(ctx, goal, max_ticks=max_ticks, on_tick=hook)
-    return out, base, ctx
+@pytest.fixture(scope="module")
+def building():
+    return load_building("straight_office")
 
 
-def test_a_mission_on_doubles_reaches_the_goal_door(office):
-    out, base, ctx = mission(office)
+def test_a_mission_on_doubles_reaches_the_goal_door(make_rig):
+    rig = make_rig(START)
+    out = rig.mission("Kitchen", max_ticks=MAX_TICKS)
     assert out.success and out.failure is None, out.failure
-    p = base.pose()
+    p = rig.true_pose()
     assert math.dist((p.x, p.y), KITCHEN_DOOR) < 1.0
     assert out.fix_attempts == 1 and out.replans == 0
-    kinds = [e.kind for e in ctx.trace]
+    kinds = [e.kind for e in rig.ctx.trace]
     assert kinds[0] == "fix" and kinds[-1] == "arrive" and "detection" in kinds
 
 
-def test_a_landmark_never_found_is_retried_then_avoided_by_a_replan(office):
-    plan = FakePlanner().plan(office, "4,0,0", "room13")
+def test_a_landmark_never_found_is_retried_then_avoided_by_a_replan(make_rig, pm):
+    plan = FakePlanner().plan(pm, "4,0,0", "room13")
     hidden = next(s.look_for for s in plan.steps[1:-1] if s.look_for.startswith("room"))
-    grounder = ScriptedGrounder(office, hidden=frozenset({hidden}))
-    out, base, ctx = mission(office, grounder=grounder)
+    rig = make_rig(START, grounder=ScriptedGrounder(pm, hidden=frozenset({hidden})))
+    out = rig.mission("Kitchen", max_ticks=MAX_TICKS)
     assert out.success, out.failure
     assert out.replans == 1
-    replan = next(e for e in ctx.trace if e.kind == "replan")
+    replan = next(e for e in rig.ctx.trace if e.kind == "replan")
     assert replan.label.startswith("TARGET_NOT_FOUND") and hidden in replan.label
-    searches = [e for e in ctx.trace if e.kind == "plan"]
+    searches = [e for e in rig.ctx.trace if e.kind == "plan"]
     assert len(searches) == 2 and all(hidden not in " ".join(e.data["steps"]) for e in searches[1:])
 
 
-def test_the_root_cause_survives_a_failed_relocalization(office):
+def test_the_root_cause_survives_a_failed_relocalization(make_rig, pm):
     # The goal's sign is covered (TARGET_NOT_FOUND); the recovery's re-localization then
     # reads no signs at all (LOCALIZATION_FAILED). The run reports both, root cause kept.
-    grounder = ScriptedGrounder(office, hidden=frozenset({"room13"}))
+    grounder = ScriptedGrounder(pm, hidden=frozenset({"room13"}))
+    rig = make_rig(
+        START, grounder=grounder, overrides=("tree.replans=0", "tree.localization_attempts=1")
+    )
 
-    def blind_after_the_first_fix(ctx):
-        if any(e.kind == "fix" for e in ctx.trace):
+    def blind_after_the_first_fix(tree):
+        if any(e.kind == "fix" for e in rig.ctx.trace):
             grounder.signs_readable = False
 
-    out, _, _ = mission(
-        office,
-        grounder=grounder,
-        overrides=("tree.replans=0", "tree.localization_attempts=1"),
-        on_tick=blind_after_the_first_fix,
-    )
+    out = rig.mission("Kitchen", max_ticks=MAX_TICKS, on_tick=blind_after_the_first_fix)
     assert not out.success
     assert out.failure.code == FailureCode.LOCALIZATION_FAILED
     assert out.cause is not None and out.cause.code == FailureCode.TARGET_NOT_FOUND
@@ -94,36 +67,38 @@ def test_the_root_cause_survives_a_failed_relocalization(office):
     assert str(out.failure).endswith(f"(after {out.cause})")
 
 
-def test_a_silent_camera_ends_the_run_with_sensor_timeout(office):
-    base = FakeBase(START)
-    base.observe_error = SensorError("no camera frame on /camera/image_raw for 1.0 s")
-    out, _, _ = mission(office, base=base, overrides=("tree.localization_attempts=2",))
+def test_a_silent_camera_ends_the_run_with_sensor_timeout(make_rig):
+    rig = make_rig(START, overrides=("tree.localization_attempts=2",))
+    rig.body.observe_error = SensorError("no camera frame on /camera/image_raw for 1.0 s")
+    out = rig.mission("Kitchen", max_ticks=MAX_TICKS)
     assert not out.success and out.failure.code == FailureCode.SENSOR_TIMEOUT
 
 
-def test_a_buggy_back_end_ends_the_run_with_internal_error(office):
-    grounder = ScriptedGrounder(office, error=IndexError("list index out of range"))
-    out, _, _ = mission(office, grounder=grounder, overrides=("tree.localization_attempts=1",))
+def test_a_buggy_back_end_ends_the_run_with_internal_error(make_rig, pm):
+    grounder = ScriptedGrounder(pm, error=IndexError("list index out of range"))
+    rig = make_rig(START, grounder=grounder, overrides=("tree.localization_attempts=1",))
+    out = rig.mission("Kitchen", max_ticks=MAX_TICKS)
     assert not out.success and out.failure.code == FailureCode.INTERNAL_ERROR
     assert "IndexError: list index out of range" in out.failure.message
 
 
-def test_an_exception_in_a_tick_is_a_failure_not_a_crash(office):
-    base = FakeBase(START)
+def test_an_exception_in_a_tick_is_a_failure_not_a_crash(make_rig):
+    rig = make_rig(START)
 
     def broken_pose():
         raise RuntimeError("odometry message malformed")
 
-    def break_after_a_second(ctx):
-        if ctx.now() > 1.0:
-            base.pose = broken_pose
+    def break_after_a_second(tree):
+        if rig.ctx.now() > 1.0:
+            rig.body.pose = broken_pose
 
-    out, _, _ = mission(office, base=base, on_tick=break_after_a_second)
+    out = rig.mission("Kitchen", max_ticks=MAX_TICKS, on_tick=break_after_a_second)
     assert not out.success and out.failure.code == FailureCode.INTERNAL_ERROR
     assert "RuntimeError: odometry message malformed" in out.failure.message
 
 
 @pytest.mark.parametrize("variant", ["pmnav", "coarse_only"])
-def test_both_tree_variants_arrive_on_doubles(office, variant):
-    out, base, _ = mission(office, "room4", overrides=(f"tree.variant={variant}",))
+def test_both_tree_variants_arrive_on_doubles(make_rig, variant):
+    rig = make_rig(START, overrides=(f"tree.variant={variant}",))
+    out = rig.mission("room4", max_ticks=MAX_TICKS)
     assert out.success, out.failure

@@ -4,7 +4,6 @@ user errors (missing or bad log, a tick not in it) are one-line PmNavErrors."""
 from __future__ import annotations
 
 import io
-import math
 
 import py_trees
 import pytest
@@ -158,22 +157,18 @@ def test_tick_record_missing_a_field(tmp_path, log):
 
 @pytest.fixture(scope="module")
 def episode_log(tmp_path_factory):
-    """A real log: 60 ticks of PM-Nav in the pybullet fig2_hospital (localizes at ~46)."""
+    """A real log: 60 ticks of PM-Nav on the test doubles in fig2_hospital's map."""
+    from rig import build_rig
+
     from pmnav_bt.map.building import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.seams import Pose2D
-    from pmnav_bt.sim.robot import SimBase
-    from pmnav_bt.sim.world import SimWorld
-    from pmnav_bt.testing.oracle import oracle_config
-    from pmnav_bt.trees.runner import make_context, run_tree
 
-    b = load_building("fig2_hospital")
+    pm = parse_building(load_building("fig2_hospital"))
+    rig = build_rig("doubles", pm, Pose2D(22.0, 0.0, 0.0))
     path = tmp_path_factory.mktemp("episode") / "tree.jsonl"
-    with SimWorld(b) as world:
-        base = SimBase(world, pose=Pose2D(22.0, 0.0, math.radians(0)))
-        ctx = make_context(base, parse_building(b), oracle_config())
-        with open(path, "w", encoding="utf-8") as out:
-            outcome = run_tree(ctx, "room17", max_ticks=60, log=out)
+    with open(path, "w", encoding="utf-8") as out:
+        outcome = rig.mission("room17", max_ticks=60, log=out)
     assert outcome.ticks == 60
     return path
 
