@@ -348,9 +348,12 @@ class Refiner(Protocol):
     """Observation + grounded goal (pixel/mask) -> a precise bearing, and range if known.
 
     ``gives_range``: whether ``refine`` measures the range (else callers take it from the map).
+    ``drives_approach``: whether it is also a ``PixelGoalPolicy`` that drives the approach
+    to the goal door in closed loop (the tree then approaches with ``PolicyApproach``).
     """
 
     gives_range: bool
+    drives_approach: bool
 
     def refine(self, obs: Observation, goal: Detection) -> Refinement: ...
 
