@@ -182,7 +182,8 @@ def run(
     overrides: list[str] | None = SET_OPT,
 ) -> None:
     """Run one PM-Nav episode and print its result; write the tree log and trajectory plot."""
-    from pmnav_bt.experiments.evaluation import VARIANT_NAMES, custom_episode, run_episode
+    from pmnav_bt.experiments.evaluation import custom_episode, run_episode
+    from pmnav_bt.trees.variants import TREE_VARIANTS
 
     cli_values.seed(seed)
     cli_values.index(index)
@@ -208,7 +209,7 @@ def run(
 
         live = LiveTree()
     typer.echo(
-        f"{VARIANT_NAMES[cfg.tree.variant]} [{grounder_label(cfg.grounder.backend)}] in "
+        f"{TREE_VARIANTS.spec(cfg.tree.variant).label} [{grounder_label(cfg.grounder.backend)}] in "
         f"{ep.building}: {ep.id} ({ep.tier}), "
         f"start ({ep.start_x:.1f}, {ep.start_y:.1f}, {math.degrees(ep.start_yaw):.0f} deg), "
         f"corridor route {ep.route_length:.1f} m"
