@@ -14,13 +14,7 @@ from pmnav_bt.config import load_config
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.registry import Backends
 from pmnav_bt.seams import Observation, Pose2D
-from pmnav_bt.testing.doubles import (
-    FakeBase,
-    FakeCoarseDirection,
-    FakePlanner,
-    FakeRefiner,
-    ScriptedGrounder,
-)
+from pmnav_bt.testing import doubles
 from pmnav_bt.testing.oracle import ORACLE
 from pmnav_bt.trees.runner import make_context, run_tree
 from pmnav_bt.trees.variants import TREE_VARIANTS
@@ -30,11 +24,11 @@ GOAL = "room2"  # its door (10, 1.1) is in view from the start
 
 
 @dataclasses.dataclass
-class BoxAhead(FakeBase):
+class BoxAhead(doubles.FakeBase):
     """A FakeBase whose frames taken while it drives forward have depth: the floor and,
     straight ahead at ``box_m``, a thin box (``half_width`` m either side of the optical
     axis) that moves with the camera, so that every drive finds its way blocked with open
-    floor beside it. Frames taken standing have no depth (as FakeBase's)."""
+    floor beside it. Frames taken standing have no depth (as doubles.FakeBase's)."""
 
     box_m: float = 1.0
     half_width: float = 0.08
@@ -53,13 +47,20 @@ class BoxAhead(FakeBase):
         return dataclasses.replace(obs, depth=depth)
 
 
-def ticked(variant: str, office):
-    base = BoxAhead(START)
+def on_doubles(office, variant: str, base=None, **kw):
+    """``variant``'s context (``make_context``) on the doubles over ``office``."""
     backends = Backends(
-        ScriptedGrounder(office), FakeCoarseDirection(), FakeRefiner(), FakePlanner()
+        doubles.ScriptedGrounder(office),
+        doubles.FakeCoarseDirection(),
+        doubles.FakeRefiner(),
+        doubles.FakePlanner(),
     )
     cfg = load_config(overrides=[ORACLE, f"tree.variant={variant}", "tree.replans=0"])
-    ctx = make_context(base, office, cfg, budget=80, deferred_work=True, backends=backends)
+    return make_context(base or doubles.FakeBase(START), office, cfg, backends=backends, **kw)
+
+
+def ticked(variant: str, office):
+    ctx = on_doubles(office, variant, BoxAhead(START), budget=80, deferred_work=True)
     return run_tree(ctx, GOAL, max_ticks=4000), ctx
 
 
@@ -76,21 +77,12 @@ def test_each_variant_goes_round_a_box_without_an_internal_error(variant, office
 
 
 def test_the_map_less_context_holds_the_sign_vocabulary_and_no_map_check(office):
-    base = FakeBase(START)
-    cfg = load_config(overrides=[ORACLE, "tree.variant=mapless"])
-    backends = Backends(
-        ScriptedGrounder(office), FakeCoarseDirection(), FakeRefiner(), FakePlanner()
-    )
-    ctx = make_context(base, office, cfg, backends=backends)
-    try:
-        assert ctx.planner is None and ctx.detour_check is None
-        assert ctx.pm is not office and ctx.pm.building.waypoints == ()
-    finally:
-        ctx.worker.shutdown()
-    ctx = make_context(FakeBase(START), office, load_config(overrides=[ORACLE]), backends=backends)
-    try:
-        assert ctx.pm is office and ctx.planner is backends.planner
-        # the map's check: 0.5 m off the centre line of the 2.2 m corridor is 0.6 m from a wall
-        assert ctx.detour_check((6.0, 0.5), 0.3) and not ctx.detour_check((6.0, 1.0), 0.3)
-    finally:
-        ctx.worker.shutdown()
+    ctx = on_doubles(office, "mapless")
+    ctx.worker.shutdown()
+    assert ctx.planner is None and ctx.detour_check is None
+    assert ctx.pm is not office and ctx.pm.building.waypoints == ()
+    ctx = on_doubles(office, "pmnav")
+    ctx.worker.shutdown()
+    assert ctx.pm is office and ctx.planner is not None
+    # the map's check: 0.5 m off the centre line of the 2.2 m corridor is 0.6 m from a wall
+    assert ctx.detour_check((6.0, 0.5), 0.3) and not ctx.detour_check((6.0, 1.0), 0.3)

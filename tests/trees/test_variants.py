@@ -81,9 +81,7 @@ def _tiny(ctx, goal):
 
 
 def test_a_new_variant_registers_by_name_and_gets_its_context_and_tree(fig2_map):
-    TREE_VARIANTS.register(
-        TreeVariant("tiny", f"{__name__}:_tiny", PRIORI_MAP, "tiny", "one leaf")
-    )
+    TREE_VARIANTS.register(TreeVariant("tiny", f"{__name__}:_tiny", PRIORI_MAP, "tiny", "one leaf"))
     try:
         ctx = context(fig2_map, "tiny")
         try:
