@@ -8,10 +8,9 @@ the machine's speed; on the robot it never waits.
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TextIO
 
 import py_trees
@@ -79,7 +78,7 @@ def make_context(
     if backends is None:
         backends = build_backends(config, known, on_robot=on_robot, seed=seed, planner=knows.plans)
     elif not knows.plans:
-        backends = dataclasses.replace(backends, planner=None)
+        backends = replace(backends, planner=None)
     return Context.wired(
         base, known, config, backends, budget, deferred_work,
         detour_check=knows.detour_check(known),
