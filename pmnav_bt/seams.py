@@ -285,7 +285,9 @@ class Grounder(Protocol):
     the floor/wall surfaces (corner, opening and obstacle checks).
 
     ``needs_sim_labels``: True for back ends that read the simulator's segmentation;
-    the factory refuses them on a robot.
+    the factory refuses them on a robot. How far and how often it names signs (its
+    reading model) and whether it is an oracle are declared, by name, in its registry
+    spec (``registry.GrounderSpec``): read before any grounder is built.
     """
 
     needs_sim_labels: bool
