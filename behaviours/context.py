@@ -6,6 +6,7 @@ the Context holds the things a behaviour *uses* (injected once, not looked up).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,6 +19,12 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose.odometry import CalibratedBase
 from pmnav_bt.seams import Base, CoarseDirection, Grounder, Planner, Pose2D, Refiner
 from pmnav_bt.worker import Worker
+
+# Whether a point (x, y) round an obstacle stays ``margin`` m clear of the walls, by what
+# the tree variant knows of them (PM-Nav: the priori-map's corridors); the drive's depth
+# has already shown the floor free up to it. Given to the Context where the variant is
+# built (trees/variants.py); None: the variant knows no walls (the map-less baseline).
+DetourCheck = Callable[[tuple[float, float], float], bool]
 
 
 @dataclass
@@ -46,6 +53,7 @@ class Context:
     refiner: Refiner
     planner: Planner | None  # None: the map-less baseline
     worker: Worker
+    detour_check: DetourCheck | None  # None: no walls known beyond what depth shows
     odometer: Odometer = field(default_factory=Odometer)
     trace: list[TraceEvent] = field(default_factory=list)
     budget_actions: int = 500
@@ -60,10 +68,11 @@ class Context:
     @classmethod
     def wired(
         cls, base: Base, pm: Any, config: Config, backends: Any, budget: int | None,
-        deferred_work: bool,
+        deferred_work: bool, *, detour_check: DetourCheck | None,
     ) -> Context:  # fmt: skip
         """The back ends ``backends`` (a ``registry.Backends``) wired to ``base`` and ``pm``,
-        with a fresh Worker and the config's action budget unless ``budget`` is given."""
+        with a fresh Worker and the config's action budget unless ``budget`` is given;
+        ``detour_check``: see ``DetourCheck`` (the tree variant decides it)."""
         return cls(
             base=base,
             pm=pm,
@@ -73,6 +82,7 @@ class Context:
             refiner=backends.refiner,
             planner=backends.planner,
             worker=Worker(deferred=deferred_work),
+            detour_check=detour_check,
             budget_actions=budget if budget is not None else config.tree.budget_actions,
         )
 

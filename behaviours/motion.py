@@ -16,7 +16,7 @@ import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
-from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
+from pmnav_bt.behaviours.context import Context, DetourCheck, heading_error, map_pose, thumbnail
 from pmnav_bt.behaviours.pose import keep_on_axis, measure_walls
 from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
@@ -36,7 +36,8 @@ WALL_ARRIVAL_NEAR_M = 3.0
 OBSTACLE_RANGE = 2.0
 # Round an obstacle: the nearest bearing off the way to the goal (either side, in view)
 # along which the floor is free DETOUR_PAST_M beyond the obstacle's near face (and a
-# margin), to a point that far past it, inside the map's corridors; at most MAX_DETOURS
+# margin), to a point that far past it, clear of the walls the tree variant knows (PM-Nav:
+# inside the map's corridors, Context.detour_check); at most MAX_DETOURS
 # a drive (each watched like the drive: another obstacle, another detour).
 DETOUR_BEARINGS = tuple(math.radians(a) for a in (10.0, 15.0, 20.0, 25.0, 30.0))
 DETOUR_PAST_M = 0.6
@@ -146,7 +147,7 @@ class DriveTo(PmNavBehaviour):
             if now - self._watch_t >= WATCH_PERIOD_S:
                 self._watch_t = now
                 base, goal, target = self.ctx.base, self._aim(), self.get("target")
-                tf, pm = self.get("map_T_odom"), self.ctx.pm
+                tf, clear = self.get("map_T_odom"), self.ctx.detour_check
 
                 def watch(cancelled):
                     obs = base.observe()
@@ -156,7 +157,7 @@ class DriveTo(PmNavBehaviour):
                     found["ahead"] = ahead = _toward_goal(obs, est, goal)
                     blocked = _closer_than_goal(ahead, est, goal)
                     if blocked is not None:
-                        found["detour"] = detour(obs, est, goal, blocked, pm)
+                        found["detour"] = detour(obs, est, goal, blocked, clear)
                     return obs, blocked, found
 
                 self._watch_job = self.ctx.worker.submit(watch)
@@ -187,11 +188,12 @@ class DriveTo(PmNavBehaviour):
         return None
 
 
-def detour(obs, est, goal, free: float, pm) -> tuple[float, float] | None:
+def detour(obs, est, goal, free: float, clear: DetourCheck | None) -> tuple[float, float] | None:
     """A map point round an obstacle ``free`` m ahead on the way from ``est`` to ``goal``:
     along the nearest bearing off that way (``DETOUR_BEARINGS``, the more open side first)
     with the floor free ``DETOUR_PAST_M`` beyond the obstacle's near face, that far past it
-    and inside the map's corridors; None when there is none (the corridor is shut)."""
+    and, where the variant knows the walls (``clear``: PM-Nav's map corridors), at least
+    ``DETOUR_MARGIN_M`` from them; None when there is none (the corridor is shut)."""
     way = wrap_angle(heading((est.x, est.y), goal) - est.yaw)
     in_view = abs(obs.intrinsics.pixel_bearing(0.0)) - DETOUR_VIEW_MARGIN
     past = free + DETOUR_PAST_M
@@ -207,8 +209,7 @@ def detour(obs, est, goal, free: float, pm) -> tuple[float, float] | None:
         for _, b in sorted(sides, reverse=True):
             a = est.yaw + b
             p = (est.x + reach * math.cos(a), est.y + reach * math.sin(a))
-            loc = pm.locate(*p)
-            if loc.offset <= loc.segment.width / 2.0 - DETOUR_MARGIN_M:
+            if clear is None or clear(p, DETOUR_MARGIN_M):
                 return float(p[0]), float(p[1])
     return None
 

@@ -11,7 +11,7 @@ from pmnav_bt.behaviours.search import target_entity
 from pmnav_bt.eval.task import SUCCESS_RADIUS_M
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action
-from pmnav_bt.seams import DiscreteAction, MotionStatus, PixelGoalPolicy
+from pmnav_bt.seams import DiscreteAction, MotionStatus
 
 # A policy STOP farther than this from the door on the map is finished by the map approach:
 # the success radius less a margin for the estimate's error (STOP is the policy's weak
@@ -20,10 +20,11 @@ STOP_CHECK_M = SUCCESS_RADIUS_M - 0.2
 
 
 class PolicyApproach(Approach):
-    """Approach the goal room's door with the context's pixel-goal policy, one discrete
-    step per frame, until the policy stops (the paper's fine-grained actions). It first
-    turns to face the door where it was grounded (the search may have turned away since);
-    the turn is a velocity command, so the body reads MOVING until ``face`` stops it.
+    """Approach the goal room's door with the context's pixel-goal policy (a refiner that
+    ``drives_approach``: a ``seams.PixelGoalPolicy``), one discrete step per frame, until
+    the policy stops (the paper's fine-grained actions). It first turns to face the door
+    where it was grounded (the search may have turned away since); the turn is a velocity
+    command, so the body reads MOVING until ``face`` stops it.
 
     Reads ``target``, ``choice`` (the grounded detection), ``map_T_odom``. The goal pixel
     is the grounder's mask centre: re-grounded in the current frame at the start and every
@@ -48,7 +49,7 @@ class PolicyApproach(Approach):
         t, choice = self.get("target"), self.get("choice")
         policy = self.ctx.refiner
         self._closed_loop = (
-            isinstance(policy, PixelGoalPolicy)
+            policy.drives_approach
             and t is not None
             and t.action == Action.ARRIVE
             and choice is not None

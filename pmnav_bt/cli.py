@@ -66,11 +66,7 @@ def backends() -> None:
         default = getattr(defaults, seam).backend
         for name in registry.names():
             spec = registry.spec(name)
-            tags = [
-                t
-                for t, on in (("default", name == default), ("sim only", spec.needs_sim_labels))
-                if on
-            ]
+            tags = ["default"] * (name == default) + spec.tags
             tag = f" [{', '.join(tags)}]" if tags else ""
             typer.echo(f"{seam + '.backend':<17} {name:<12} {spec.summary}{tag}")
 

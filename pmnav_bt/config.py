@@ -156,10 +156,12 @@ class VlmConfig(_Section):
 
 
 class TreeConfig(_Section):
-    variant: Literal["pmnav", "coarse_only", "mapless"] = Field(
+    variant: str = Field(
         "pmnav",
-        description="coarse_only: no grounding or refinement (paper Table 4); mapless: the "
-        "map-less frontier-exploring baseline (docs/baseline.md)",
+        description="the tree, by name (registered in trees/variants.py: the context and "
+        "tree are built, and an unknown name refused, from there): pmnav; coarse_only: no "
+        "grounding or refinement (paper Table 4); mapless: the map-less frontier-exploring "
+        "baseline (docs/baseline.md)",
     )
     tick_hz: float = Field(
         10.0, ge=0.5, le=1000.0, description="tree ticks per second of the clock"

@@ -8,15 +8,17 @@ unless configured. A factory takes the ``BackendDeps`` and returns the back end.
     >>> GROUNDERS.names()
     ['sim_gt', ...]
 
-New back ends: ``GROUNDERS.register(BackendSpec("mine", "my_pkg.grounder:build", ...))``
-and ``--set grounder.backend=mine``.
+New back ends: ``GROUNDERS.register(GrounderSpec("mine", "my_pkg.grounder:build", ...,
+reading="my_pkg.grounder:MY_READING"))`` and ``--set grounder.backend=mine``. A grounder's
+spec also declares how far and how often it names signs (its *reading model*, which the
+tree's search ranges and the localization belief's recall follow:
+``perception/read_range.py``) and whether it is an oracle (results label it so).
 """
 
 from __future__ import annotations
 
 import difflib
 import importlib
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -37,6 +39,32 @@ class BackendSpec:
     summary: str
     needs_sim_labels: bool = False
 
+    @property
+    def tags(self) -> list[str]:
+        """What ``pmnav backends`` says of it besides its summary."""
+        return ["sim only"] if self.needs_sim_labels else []
+
+
+# A grounder's reading model when it reads every sign in sight up to ``grounder.max_range``
+# (the simulator's labels), with misses at the belief's constant rate: no measured tables.
+ORACLE_READING = "oracle"
+
+
+@dataclass(frozen=True)
+class GrounderSpec(BackendSpec):
+    """A named grounder. ``reading``: its reading model, ``"package.module:NAME"`` of a
+    ``perception.read_range.ReadingModel`` (its measured range and recall by distance),
+    imported when asked for, or ``ORACLE_READING``; None: it declares none, and asking for
+    its search ranges is an error (never another reader's tables). ``oracle``: its figures
+    are an upper bound, not perception (results label it ``(oracle)``)."""
+
+    reading: str | None = None
+    oracle: bool = False
+
+    @property
+    def tags(self) -> list[str]:
+        return super().tags + (["oracle"] if self.oracle else [])
+
 
 @dataclass
 class BackendDeps:
@@ -49,24 +77,30 @@ class BackendDeps:
     grounder: Grounder | None = None  # built first; for back ends that ground (coarse)
 
 
-class Registry:
-    """The named back ends of one seam."""
+class Named:
+    """Specs by name, each with a ``name``, declared with one spec class (``kind``): what a
+    config key (``key``, e.g. ``grounder.backend``, ``tree.variant``) may name. An unknown
+    name is one ConfigError that lists the registered ones."""
 
-    def __init__(self, seam: str, specs: list[BackendSpec]):
-        self.seam = seam
-        self._specs: dict[str, BackendSpec] = {}
+    def __init__(self, key: str, what: str, specs: list, kind: type):
+        self.key = key
+        self.what = what  # "back end", "tree variant": for messages
+        self.kind = kind
+        self._specs: dict[str, Any] = {}
         for spec in specs:
             self.register(spec)
 
-    def register(self, spec: BackendSpec) -> None:
+    def register(self, spec) -> None:
+        if not isinstance(spec, self.kind):
+            raise TypeError(f"a {self.key} {self.what} is declared with a {self.kind.__name__}")
         if spec.name in self._specs and self._specs[spec.name] != spec:
-            raise ValueError(f"{self.seam} back end {spec.name!r} is registered already")
+            raise ValueError(f"{self.key} {self.what} {spec.name!r} is registered already")
         self._specs[spec.name] = spec
 
     def names(self) -> list[str]:
         return list(self._specs)
 
-    def spec(self, name: str) -> BackendSpec:
+    def spec(self, name: str) -> Any:
         """The entry for ``name``; an unknown name lists the registered ones."""
         try:
             return self._specs[name]
@@ -74,9 +108,18 @@ class Registry:
             close = difflib.get_close_matches(name, self._specs, n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise ConfigError(
-                f"{self.seam}.backend: unknown back end {name!r}{hint}; "
+                f"{self.key}: unknown {self.what} {name!r}{hint}; "
                 f"registered: {', '.join(self._specs)}"
             ) from None
+
+
+class Registry(Named):
+    """The named back ends of one seam (``kind``: the spec class they declare themselves
+    with, e.g. ``GrounderSpec``)."""
+
+    def __init__(self, seam: str, specs: list[BackendSpec], kind: type = BackendSpec):
+        self.seam = seam
+        super().__init__(f"{seam}.backend", "back end", specs, kind)
 
     def build(self, name: str, deps: BackendDeps) -> Any:
         """Build the back end ``name`` (refusing simulator-only back ends on a robot)."""
@@ -87,41 +130,49 @@ class Registry:
                 f"{self.seam}.backend {name!r} reads the simulator's segmentation labels and "
                 f"cannot run on a robot; choose one of: {', '.join(others) or '(none)'}"
             )
-        return _load(spec.factory)(deps)
+        return load(spec.factory)(deps)
 
 
-def _load(target: str) -> Callable[[BackendDeps], Any]:
+def load(target: str) -> Any:
+    """The object ``"package.module:NAME"`` names (a factory, a reading model), imported now."""
     module, _, attr = target.partition(":")
     return getattr(importlib.import_module(module), attr)
 
 
+PP_OCR_READING = "pmnav_bt.perception.read_range:PP_OCR"  # measured by bench_signs.py
+
 GROUNDERS = Registry(
     "grounder",
     [
-        BackendSpec(
+        GrounderSpec(
             "sim_gt",
             "pmnav_bt.perception.grounders.ground_truth:build",
             "the simulator's segmentation (oracle; misses/noise configurable)",
             needs_sim_labels=True,
+            reading=ORACLE_READING,
+            oracle=True,
         ),
-        BackendSpec(
+        GrounderSpec(
             "ocr",
             "pmnav_bt.perception.grounders.ocr:build",
             "reads door and landmark signs (PP-OCR); floor and walls from depth",
+            reading=PP_OCR_READING,
         ),
-        BackendSpec(
+        GrounderSpec(
             "gdino_sam",
             "pmnav_bt.perception.grounders.gdino_sam:build",
             "GroundingDINO + SAM (transformers, local weights); signs by OCR; depth surfaces",
+            reading=PP_OCR_READING,  # its signs are read by the same PP-OCR reader
         ),
     ],
+    kind=GrounderSpec,
 )
 
 
 def grounder_label(name: str) -> str:
-    """The grounder's name as results print it: ``sim_gt (oracle)`` for a back end that
-    reads the simulator's labels, so an oracle's figures are never taken for perception."""
-    return f"{name} (oracle)" if GROUNDERS.spec(name).needs_sim_labels else name
+    """The grounder's name as results print it: ``sim_gt (oracle)`` for a back end declared
+    an oracle, so an oracle's figures are never taken for perception."""
+    return f"{name} (oracle)" if GROUNDERS.spec(name).oracle else name
 
 
 COARSE = Registry(
@@ -186,7 +237,8 @@ def build_backends(
     config: Config, pm: PrioriMap, *, on_robot: bool, seed: int = 0, planner: bool = True
 ) -> Backends:
     """Every seam's back end, as ``config`` names them (the simulator and the robot alike);
-    ``planner=False``: no planner (``build_perception``)."""
+    ``planner=False``: no planner (a tree variant that plans nothing, e.g. the map-less
+    baseline, whose ``pm`` is then its sign vocabulary: ``map.signs_only.SignsOnly``)."""
     deps = BackendDeps(config=config, pm=pm, seed=seed, on_robot=on_robot)
     deps.grounder = GROUNDERS.build(config.grounder.backend, deps)
     return Backends(
@@ -195,9 +247,3 @@ def build_backends(
         refiner=REFINERS.build(config.refiner.backend, deps),
         planner=PLANNERS.build(config.planner.backend, deps) if planner else None,
     )
-
-
-def build_perception(config: Config, pm: Any, *, on_robot: bool, seed: int = 0) -> Backends:
-    """The perception back ends only (grounder, coarse direction, refiner), no planner:
-    the map-less baseline's, with ``pm`` its sign vocabulary (``map.signs_only.SignsOnly``)."""
-    return build_backends(config, pm, on_robot=on_robot, seed=seed, planner=False)

@@ -285,7 +285,9 @@ class Grounder(Protocol):
     the floor/wall surfaces (corner, opening and obstacle checks).
 
     ``needs_sim_labels``: True for back ends that read the simulator's segmentation;
-    the factory refuses them on a robot.
+    the factory refuses them on a robot. How far and how often it names signs (its
+    reading model) and whether it is an oracle are declared, by name, in its registry
+    spec (``registry.GrounderSpec``): read before any grounder is built.
     """
 
     needs_sim_labels: bool
@@ -348,9 +350,12 @@ class Refiner(Protocol):
     """Observation + grounded goal (pixel/mask) -> a precise bearing, and range if known.
 
     ``gives_range``: whether ``refine`` measures the range (else callers take it from the map).
+    ``drives_approach``: whether it is also a ``PixelGoalPolicy`` that drives the approach
+    to the goal door in closed loop (the tree then approaches with ``PolicyApproach``).
     """
 
     gives_range: bool
+    drives_approach: bool
 
     def refine(self, obs: Observation, goal: Detection) -> Refinement: ...
 

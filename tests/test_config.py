@@ -21,7 +21,7 @@ def test_defaults_and_overrides(tmp_path):
     "overrides, words",
     [
         (["grounder.miss_rate=2"], "grounder.miss_rate"),
-        (["tree.variant=fast"], "tree.variant"),
+        (["tree.variant=1"], "tree.variant"),  # a name; unknown names: tests/trees/test_variants.py
         (["grounder.colour=red"], "grounder.colour"),
         (["novalue"], "expected section.key=value"),
     ],

@@ -12,7 +12,15 @@ from pmnav_bt.perception.coarse import DetectorCoarseDirection
 from pmnav_bt.perception.grounders.ground_truth import GroundTruthGrounder
 from pmnav_bt.perception.refiners.geometric import GeometricRefiner
 from pmnav_bt.planning.graph_planner import GraphPlanner
-from pmnav_bt.registry import GROUNDERS, REGISTRIES, BackendSpec, build_backends
+from pmnav_bt.registry import (
+    GROUNDERS,
+    ORACLE_READING,
+    REGISTRIES,
+    BackendSpec,
+    GrounderSpec,
+    build_backends,
+    grounder_label,
+)
 from pmnav_bt.seams import CoarseDirection, Grounder, Planner, Refiner
 
 
@@ -50,7 +58,10 @@ def _scripted(deps):
 
 
 def test_a_new_back_end_registers_by_name_and_runs_on_a_robot(fig2_map):
-    GROUNDERS.register(BackendSpec("scripted", f"{__name__}:_scripted", "test double"))
+    with pytest.raises(TypeError, match="GrounderSpec"):  # a grounder says how it reads
+        GROUNDERS.register(BackendSpec("scripted", f"{__name__}:_scripted", "test double"))
+    spec = GrounderSpec("scripted", f"{__name__}:_scripted", "test double", reading=ORACLE_READING)
+    GROUNDERS.register(spec)
     try:
         cfg = load_config(overrides=["grounder.backend=scripted"])
         b = build_backends(cfg, fig2_map, on_robot=True)
@@ -68,5 +79,21 @@ def test_pmnav_backends_lists_every_registered_back_end(capsys):
         for name in registry.names():
             line = next(x for x in out.splitlines() if x.split()[:2] == [f"{seam}.backend", name])
             assert registry.spec(name).summary in line
-    assert "[sim only]" in next(x for x in out.splitlines() if " sim_gt " in x)
+    assert "[sim only, oracle]" in next(x for x in out.splitlines() if " sim_gt " in x)
     assert "[default]" in next(x for x in out.splitlines() if " ocr " in x)
+
+
+def test_the_oracle_label_follows_the_declared_flag_not_the_simulator_labels():
+    assert grounder_label("sim_gt") == "sim_gt (oracle)" and grounder_label("ocr") == "ocr"
+    specs = [
+        GrounderSpec("fiducials", f"{__name__}:_scripted", "", reading=ORACLE_READING, oracle=True),
+        GrounderSpec("sim_ocr", f"{__name__}:_scripted", "", needs_sim_labels=True),
+    ]
+    for spec in specs:
+        GROUNDERS.register(spec)
+    try:
+        assert grounder_label("fiducials") == "fiducials (oracle)"
+        assert grounder_label("sim_ocr") == "sim_ocr"
+    finally:
+        for spec in specs:
+            GROUNDERS._specs.pop(spec.name)

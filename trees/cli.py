@@ -68,7 +68,9 @@ def _build_tree(variant: str):
 
 @app.command()
 def render(
-    variant: str = typer.Option("pmnav", "--variant", help="pmnav, coarse_only, mapless."),
+    variant: str = typer.Option(
+        "pmnav", "--variant", help="A tree variant by name (registered in trees/variants.py)."
+    ),
     out: Path = typer.Option(Path("."), "--out", help="Folder for the pictures."),
     name: str | None = typer.Option(None, "--name", help="File name stem [default: the variant]."),
     formats: str = typer.Option(
@@ -116,11 +118,11 @@ def render(
             title=title,
         )
     else:
-        from pmnav_bt.trees.pmnav import VARIANTS
+        from pmnav_bt.trees.variants import TREE_VARIANTS
 
-        variants = (*VARIANTS, "mapless")
-        if variant not in variants:
-            raise PmNavError(f"--variant {variant!r}: choose from {', '.join(variants)}")
+        if variant not in TREE_VARIANTS.names():
+            choices = ", ".join(TREE_VARIANTS.names())
+            raise PmNavError(f"--variant {variant!r}: choose from {choices}")
         tree, close = _build_tree(variant)
         try:
             written = render_tree(

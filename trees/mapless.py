@@ -6,7 +6,9 @@ shows (its own occupancy grid in the odometry frame: corridors seen, branches no
 looked down, where it has been), reads signs as it looks around and as it drives, and
 once the goal room's sign and door are seen it places the door by the refiner's range
 and approaches it with PM-Nav's drive and stop. It knows the building's sign vocabulary
-(which sign names which room: ``map.signs_only.SignsOnly``) and nothing of where.
+(which sign names which room: ``map.signs_only.SignsOnly``) and nothing of where: it is
+registered so in ``trees/variants.py`` (``SIGN_VOCABULARY``), which builds its context with
+no planner, and drives round an obstacle where depth shows the floor free (no walls known).
 
     Mission
       StartExploring                       goal -> goal_entity, an empty grid
@@ -21,12 +23,10 @@ and approaches it with PM-Nav's drive and stop. It knows the building's sign voc
 
 from __future__ import annotations
 
-import dataclasses
-
 import py_trees
 from py_trees.behaviours import Failure as AlwaysFail
 from py_trees.common import Access
-from py_trees.composites import Parallel, Selector, Sequence
+from py_trees.composites import Selector
 
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
@@ -41,90 +41,46 @@ from pmnav_bt.behaviours.explore import (
     RecordViews,
     StartExploring,
 )
-from pmnav_bt.behaviours.monitor import Monitor
 from pmnav_bt.behaviours.motion import Arrive
 from pmnav_bt.behaviours.search import Ground
-from pmnav_bt.config import Config
-from pmnav_bt.map.building import Building
 from pmnav_bt.map.signs_only import SignsOnly
-from pmnav_bt.registry import Backends, build_perception
-from pmnav_bt.seams import Base
+from pmnav_bt.trees.mission import monitored_mission, sequence
 
 NEAR_M = 2.0  # the door is looked at again from this far before the final approach
-
-
-def make_mapless_context(
-    base: Base,
-    building: Building,
-    config: Config,
-    seed: int = 0,
-    budget: int | None = None,
-    deferred_work: bool = False,
-    *,
-    on_robot: bool = False,
-    backends: Backends | None = None,
-) -> Context:
-    """A Context whose ``pm`` is the building's sign vocabulary only (``SignsOnly``), with
-    the perception back ends the config names and no planner."""
-    signs = SignsOnly(building)
-    if backends is None:
-        backends = build_perception(config, signs, on_robot=on_robot, seed=seed)
-    # pm: a stand-in that refuses everything but signs; no planner, even if given one
-    backends = dataclasses.replace(backends, planner=None)
-    return Context.wired(base, signs, config, backends, budget, deferred_work)
 
 
 def build_mapless_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
     """The map-less baseline's tree for ``goal`` (a room as a person names it)."""
     if not isinstance(ctx.pm, SignsOnly):
         raise ValueError(
-            "the map-less tree runs on a map-free context (trees.mapless.make_mapless_context)"
+            "the map-less tree runs on a map-free context (trees.runner.make_context with "
+            "tree.variant mapless)"
         )
     over = py_trees.blackboard.Client(name="ExploreLoop", namespace=NAMESPACE)
     over.register_key(key="explore_over", access=Access.READ)
-    look = Sequence(
+    look = sequence(
         "LookAround",
-        memory=True,
-        children=[
-            Panorama("Panorama", ctx),
-            RecordViews("RecordViews", ctx),
-            ChooseView("ChooseView", ctx),
-        ],
+        Panorama("Panorama", ctx),
+        RecordViews("RecordViews", ctx),
+        ChooseView("ChooseView", ctx),
     )
-    move_on = Sequence(
-        "MoveOn",
-        memory=True,
-        children=[ExploreFrontier("ExploreFrontier", ctx), AlwaysFail(name="LookAgain")],
+    move_on = sequence(
+        "MoveOn", ExploreFrontier("ExploreFrontier", ctx), AlwaysFail(name="LookAgain")
     )
     explore = RetryWhile(
         "Explore",
         Selector("SeenOrExplore", memory=True, children=[look, move_on]),
         again=lambda: not (over.exists("explore_over") and over.explore_over),
     )
-    to_door = Sequence(
+    to_door = sequence(
         "ToTheDoor",
-        memory=True,
-        children=[
-            Ground("Grounding", ctx),
-            PlaceDoor("PlaceDoor", ctx),
-            ApproachDoor("ApproachNear", ctx, keep=NEAR_M),
-            LookAtDoor("LookAtDoor", ctx),
-            PlaceDoor("PlaceAgain", ctx),
-            ApproachDoor("Approach", ctx),
-            Arrive("Arrive", ctx),
-        ],
+        Ground("Grounding", ctx),
+        PlaceDoor("PlaceDoor", ctx),
+        ApproachDoor("ApproachNear", ctx, keep=NEAR_M),
+        LookAtDoor("LookAtDoor", ctx),
+        PlaceDoor("PlaceAgain", ctx),
+        ApproachDoor("Approach", ctx),
+        Arrive("Arrive", ctx),
     )
-    mission = Sequence(
-        "Mission",
-        memory=True,
-        children=[StartExploring("StartExploring", ctx), explore, to_door],
-    )
-    root = Parallel(
-        "Map-less",
-        policy=py_trees.common.ParallelPolicy.SuccessOnOne(),
-        children=[Monitor("Monitor", ctx), mission],
-    )
-    bb = py_trees.blackboard.Client(name="setup", namespace=NAMESPACE)
-    bb.register_key(key="goal", access=Access.WRITE)
-    bb.goal = goal
-    return py_trees.trees.BehaviourTree(root)
+    mission = sequence("Mission", StartExploring("StartExploring", ctx), explore, to_door)
+    return monitored_mission(ctx, "Map-less", mission, goal)

@@ -1,24 +1,23 @@
 """The PM-Nav tree: localize, plan, then per step "target determination -> search ->
 verification -> target update", with re-search, replanning and a budget.
 
-Variants (paper, Table 4; ``tree.variant``): ``pmnav`` refines the coarse direction with
-grounding and the refiner back end (``refiner.backend``; a pixel-goal policy such as
-``pixelnav`` also drives the approach to the goal door in closed loop); ``coarse_only`` keeps
-the coarse view direction and uses no refiner at all.
+Two tree variants (paper, Table 4; registered in ``trees/variants.py``): ``pmnav``
+(``build_pmnav_tree``) refines the coarse direction with grounding and the refiner back
+end (``refiner.backend``; a refiner that ``drives_approach``, a pixel-goal policy such as
+``pixelnav``, also drives the approach to the goal door in closed loop); ``coarse_only``
+(``build_coarse_only_tree``) keeps the coarse view direction and uses no refiner at all.
 """
 
 from __future__ import annotations
 
 import py_trees
 from py_trees.behaviours import Failure as AlwaysFail
-from py_trees.composites import Parallel, Selector, Sequence
+from py_trees.composites import Selector
 from py_trees.decorators import FailureIsSuccess, Repeat, Retry
 
 from pmnav_bt.behaviours.capture import CaptureViews, nearest_first, search_centre, search_yaws
-from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.decorators import ClockTimeout
-from pmnav_bt.behaviours.monitor import Monitor
 from pmnav_bt.behaviours.motion import (
     Approach,
     Arrive,
@@ -47,11 +46,9 @@ from pmnav_bt.behaviours.search import (
     target_entity,
 )
 from pmnav_bt.perception.read_range import SearchRanges
-from pmnav_bt.seams import PixelGoalPolicy
 from pmnav_bt.trees.localize import active_localize_subtree
+from pmnav_bt.trees.mission import monitored_mission, sequence
 from pmnav_bt.trees.recovery import recovery_subtree
-
-VARIANTS = ("pmnav", "coarse_only")
 
 
 def localize_subtree(ctx: Context, name: str = "Localize") -> py_trees.behaviour.Behaviour:
@@ -67,9 +64,10 @@ def search_views(b: py_trees.behaviour.Behaviour) -> list[float]:
     return nearest_first(search_yaws(b.get("last_action"), search_centre(bearing)), bearing)
 
 
-def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
+def step_subtree(ctx: Context, refine: bool = True) -> py_trees.behaviour.Behaviour:
     """One plan step: target determination, then search-verify-approach for a visible
-    target or drive-turn-check for an unseen turn or fork, then target update."""
+    target or drive-turn-check for an unseen turn or fork, then target update.
+    ``refine=False``: coarse-only (no grounding, no refiner, the map approach)."""
     cfg = ctx.config.tree
     # how close to go to read the target's sign: the reader's range for its plate kind
     # (perception/read_range.py), unless set in the config
@@ -82,97 +80,87 @@ def step_subtree(ctx: Context) -> py_trees.behaviour.Behaviour:
     def research_distance(b) -> float:
         return ranges.of(target_entity(b)).research_distance
 
-    coarse_only = cfg.variant == "coarse_only"
-    # A pixel-goal policy (refiner.backend=pixelnav) drives the approach in closed loop.
-    closed_loop = not coarse_only and isinstance(ctx.refiner, PixelGoalPolicy)
-    search_once = Sequence(
+    # A refiner that drives the approach (a pixel-goal policy, refiner.backend=pixelnav)
+    # does so in closed loop.
+    closed_loop = refine and ctx.refiner.drives_approach
+    search_once = sequence(
         "SearchOnce",
-        memory=True,
-        children=[
-            CaptureViews(
-                "SearchViews",
-                ctx,
-                search_views,
-                target_entity,
-                enough=lambda views: any(d.score >= 0.5 for d in views[-1].detections or ()),
-                sweep=False,
-            ),
-            CoarseDirection("CoarseDirection", ctx),
-            # coarse-only (Table 4): no grounding and no refinement of the view direction
-            *([] if coarse_only else [Ground("Grounding", ctx)]),
-            FineDirection("FineDirection", ctx, refine=not coarse_only),
-            Verify("Verification", ctx),
-            CorrectHeading("HeadingFromWalls", ctx),
-        ],
+        CaptureViews(
+            "SearchViews",
+            ctx,
+            search_views,
+            target_entity,
+            enough=lambda views: any(d.score >= 0.5 for d in views[-1].detections or ()),
+            sweep=False,
+        ),
+        CoarseDirection("CoarseDirection", ctx),
+        # coarse-only (Table 4): no grounding and no refinement of the view direction
+        *([Ground("Grounding", ctx)] if refine else []),
+        FineDirection("FineDirection", ctx, refine=refine),
+        Verify("Verification", ctx),
+        CorrectHeading("HeadingFromWalls", ctx),
     )
-    research = Sequence(
+    research = sequence(
         "MoveOnAndResearch",
-        memory=True,
-        children=[
-            # On up to level with the target (its node): a sign hangs beside its door,
-            # maybe on the far side, readable (not just visible) only from about there.
-            MoveToward("MoveOn", ctx, keep=0.0, distance=research_distance),
-            AlwaysFail(name="SearchAgain"),
-        ],
+        # On up to level with the target (its node): a sign hangs beside its door,
+        # maybe on the far side, readable (not just visible) only from about there.
+        MoveToward("MoveOn", ctx, keep=0.0, distance=research_distance),
+        AlwaysFail(name="SearchAgain"),
     )
-    visible = Sequence(
+    visible = sequence(
         "SeenTarget",
-        memory=True,
-        children=[
-            TargetIs("IsVisible", ctx, visible=True),
-            MoveToward("IntoSearchRange", ctx, keep=search_range),
-            Retry(
-                "Search",
-                Selector("SearchOrMoveOn", memory=True, children=[search_once, research]),
-                num_failures=cfg.search_attempts,
-            ),
-            (PolicyApproach if closed_loop else Approach)("Approach", ctx),
-        ],
+        TargetIs("IsVisible", ctx, visible=True),
+        MoveToward("IntoSearchRange", ctx, keep=search_range),
+        Retry(
+            "Search",
+            Selector("SearchOrMoveOn", memory=True, children=[search_once, research]),
+            num_failures=cfg.search_attempts,
+        ),
+        (PolicyApproach if closed_loop else Approach)("Approach", ctx),
     )
-    unseen = Sequence(
+    unseen = sequence(
         "UnseenWaypoint",
-        memory=True,
-        children=[
-            TargetIs("IsUnseen", ctx, visible=False),
-            DriveToWaypoint("CornerCheck", ctx),
-            TurnOnto("TurnOnto", ctx),
-            CheckOpening("ForkChoice", ctx),
-        ],
+        TargetIs("IsUnseen", ctx, visible=False),
+        DriveToWaypoint("CornerCheck", ctx),
+        TurnOnto("TurnOnto", ctx),
+        CheckOpening("ForkChoice", ctx),
     )
-    step = Sequence(
+    step = sequence(
         "Step",
-        memory=True,
-        children=[
-            DetermineTarget("TargetDetermination", ctx),
-            Selector("ByTargetKind", memory=True, children=[visible, unseen]),
-            UpdateTarget("TargetUpdate", ctx),
-        ],
+        DetermineTarget("TargetDetermination", ctx),
+        Selector("ByTargetKind", memory=True, children=[visible, unseen]),
+        UpdateTarget("TargetUpdate", ctx),
     )
     return ClockTimeout("StepTimeout", step, ctx.now, cfg.step_timeout_s)
 
 
 def build_pmnav_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
-    """The whole PM-Nav tree for ``goal``, for the variant named in ``ctx.config.tree``."""
+    """The whole PM-Nav tree for ``goal`` (tree variant ``pmnav``)."""
+    return _pmnav_tree(ctx, goal, refine=True)
+
+
+def build_coarse_only_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
+    """PM-Nav without grounding or refinement of the view direction, for ``goal`` (tree
+    variant ``coarse_only``, paper Table 4)."""
+    return _pmnav_tree(ctx, goal, refine=False)
+
+
+def _pmnav_tree(ctx: Context, goal: str, refine: bool) -> py_trees.trees.BehaviourTree:
     cfg = ctx.config.tree
-    if cfg.variant not in VARIANTS:
-        raise ValueError(f"unknown tree variant {cfg.variant!r}; choose from {VARIANTS}")
     follow = Selector(
         "FollowPlan",
         memory=False,
         children=[
             PlanComplete("PlanComplete", ctx),
-            Repeat("EachStep", step_subtree(ctx), num_success=-1),
+            Repeat("EachStep", step_subtree(ctx, refine), num_success=-1),
         ],
     )
-    recover = Sequence(
+    recover = sequence(
         "Recover",
-        memory=True,
-        children=[
-            NoteFailure("NoteFailure", ctx),
-            recovery_subtree(ctx),
-            FailureIsSuccess("TryRelocalize", localize_subtree(ctx, "Relocalize")),
-            AlwaysFail(name="Replan"),
-        ],
+        NoteFailure("NoteFailure", ctx),
+        recovery_subtree(ctx),
+        FailureIsSuccess("TryRelocalize", localize_subtree(ctx, "Relocalize")),
+        AlwaysFail(name="Replan"),
     )
     navigate = Retry(
         "Navigate",
@@ -180,32 +168,22 @@ def build_pmnav_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
             "PlanOrRecover",
             memory=True,
             children=[
-                Sequence(
+                sequence(
                     "PlanAndFollow",
-                    memory=True,
-                    children=[SnapToCorridor("SnapToCorridor", ctx), MakePlan("Plan", ctx), follow],
+                    SnapToCorridor("SnapToCorridor", ctx),
+                    MakePlan("Plan", ctx),
+                    follow,
                 ),
                 recover,
             ],
         ),
         num_failures=cfg.replans + 1,
     )
-    mission = Sequence(
+    mission = sequence(
         "Mission",
-        memory=True,
-        children=[
-            CheckGoal("CheckGoal", ctx),
-            localize_subtree(ctx),
-            navigate,
-            Arrive("Arrive", ctx),
-        ],
+        CheckGoal("CheckGoal", ctx),
+        localize_subtree(ctx),
+        navigate,
+        Arrive("Arrive", ctx),
     )
-    root = Parallel(
-        "PM-Nav",
-        policy=py_trees.common.ParallelPolicy.SuccessOnOne(),
-        children=[Monitor("Monitor", ctx), mission],
-    )
-    bb = py_trees.blackboard.Client(name="setup", namespace=NAMESPACE)
-    bb.register_key(key="goal", access=py_trees.common.Access.WRITE)
-    bb.goal = goal
-    return py_trees.trees.BehaviourTree(root)
+    return monitored_mission(ctx, "PM-Nav", mission, goal)

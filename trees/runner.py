@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TextIO
 
 import py_trees
@@ -23,8 +23,8 @@ from pmnav_bt.failures import Failure, FailureCode, failure_from, root_cause
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.registry import Backends, build_backends
 from pmnav_bt.seams import Base
-from pmnav_bt.trees.pmnav import build_pmnav_tree
 from pmnav_bt.trees.snapshots import SnapshotLogger
+from pmnav_bt.trees.variants import TREE_VARIANTS
 
 
 @dataclass
@@ -63,40 +63,32 @@ def make_context(
     on_robot: bool = False,
     backends: Backends | None = None,
 ) -> Context:
-    """The back ends the config names (``build_backends``), wired into a Context.
+    """The Context of the tree variant ``config.tree.variant`` (``trees.variants``): what
+    it may read of ``pm`` (the whole priori-map, or the sign vocabulary only), the back
+    ends the config names built on that (``build_backends``; a planner only for a variant
+    that plans), and its drives' detour check, wired together.
 
     ``deferred_work``: background jobs start between ticks (simulation; see Worker).
     ``on_robot``: the observations carry no simulator labels (back ends that need them are
-    refused). ``backends``: ready-made back ends instead (tests, test doubles).
-    ``tree.variant: mapless``: the map-less baseline's context, which keeps only the
-    building's sign vocabulary of ``pm`` (``trees.mapless.make_mapless_context``).
+    refused). ``backends``: ready-made back ends instead (tests, test doubles); a variant
+    that plans nothing drops their planner.
     """
-    if config.tree.variant == "mapless":  # the baseline gets the sign vocabulary only
-        from pmnav_bt.trees.mapless import make_mapless_context
-
-        return make_mapless_context(
-            base,
-            pm.building,
-            config,
-            seed,
-            budget,
-            deferred_work,
-            on_robot=on_robot,
-            backends=backends,
-        )
+    knows = TREE_VARIANTS.spec(config.tree.variant).knows
+    known = knows.known(pm)
     if backends is None:
-        backends = build_backends(config, pm, on_robot=on_robot, seed=seed)
-    return Context.wired(base, pm, config, backends, budget, deferred_work)
+        backends = build_backends(config, known, on_robot=on_robot, seed=seed, planner=knows.plans)
+    elif not knows.plans:
+        backends = replace(backends, planner=None)
+    return Context.wired(
+        base, known, config, backends, budget, deferred_work,
+        detour_check=knows.detour_check(known),
+    )  # fmt: skip
 
 
 def build_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
-    """The tree of ``ctx.config.tree.variant``: PM-Nav (``pmnav``, ``coarse_only``) or the
-    map-less baseline (``mapless``)."""
-    if ctx.config.tree.variant == "mapless":
-        from pmnav_bt.trees.mapless import build_mapless_tree
-
-        return build_mapless_tree(ctx, goal)
-    return build_pmnav_tree(ctx, goal)
+    """The tree of the variant ``ctx.config.tree.variant`` for ``goal``
+    (``trees.variants.TREE_VARIANTS``), on a context ``make_context`` built for it."""
+    return TREE_VARIANTS.spec(ctx.config.tree.variant).build_tree(ctx, goal)
 
 
 def _blackboard(key: str):

@@ -18,11 +18,10 @@ from pmnav_bt.config import Config
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
 from pmnav_bt.loading import atomic_write_text, safe_filename
 from pmnav_bt.registry import grounder_label
+from pmnav_bt.trees.variants import TREE_VARIANTS
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.sim.episodes import Episode
-
-VARIANT_NAMES = {"pmnav": "PM-Nav", "coarse_only": "coarse-only", "mapless": "map-less baseline"}
 
 
 @dataclass
@@ -197,7 +196,7 @@ def _plot(
     ]
     verdict = "SUCCESS" if result.success else f"FAILED ({result.failure_reason})"
     caption = (
-        f"{VARIANT_NAMES.get(config.tree.variant, config.tree.variant)} "
+        f"{TREE_VARIANTS.spec(config.tree.variant).label} "
         f"[{grounder_label(config.grounder.backend)}]: {verdict}; "
         f"SPL {result.spl:.2f}; {result.path_length:.1f} m driven, "
         f"{result.shortest_path_length:.1f} m shortest; {outcome.actions} actions"

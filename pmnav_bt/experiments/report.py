@@ -299,7 +299,7 @@ def report(
         _ranges_text,
         _tiers,
     )
-    from pmnav_bt.experiments.stored_run import run_stored_evaluation, run_stored_study
+    from pmnav_bt.experiments.stored_run import StoredRun, run_stored_evaluation, run_stored_study
     from pmnav_bt.experiments.variants import VARIANTS, variant_configs
     from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
 
@@ -342,15 +342,11 @@ def report(
     _write_meta(out, base, configs, ev, t3, total)
     echo = lambda text: typer.echo(text, err=True)  # noqa: E731
     echo(f"evaluation: {total} runs ({len(eps)} episodes x {len(configs)} variants)")
-    run = run_stored_evaluation(
-        eps, configs, out / "eval", jobs=jobs, ray=ray, resume=resume, echo=echo
-    )
+    run = run_stored_evaluation(eps, configs, StoredRun(out / "eval", jobs, ray, resume, echo))
     stopped = run.stopped_by
     if not stopped and starts:
         echo(f"Table 3 study: {len(starts)} localization runs")
-        study = run_stored_study(
-            starts, base, out / "table3", jobs=jobs, ray=ray, resume=resume, echo=echo
-        )
+        study = run_stored_study(starts, base, StoredRun(out / "table3", jobs, ray, resume, echo))
         stopped = study.stopped_by
     if not stopped and trajectories:
         from pmnav_bt.interrupts import Interrupted, stop_signals

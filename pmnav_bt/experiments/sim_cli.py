@@ -182,7 +182,8 @@ def run(
     overrides: list[str] | None = SET_OPT,
 ) -> None:
     """Run one PM-Nav episode and print its result; write the tree log and trajectory plot."""
-    from pmnav_bt.experiments.evaluation import VARIANT_NAMES, custom_episode, run_episode
+    from pmnav_bt.experiments.evaluation import custom_episode, run_episode
+    from pmnav_bt.trees.variants import TREE_VARIANTS
 
     cli_values.seed(seed)
     cli_values.index(index)
@@ -208,7 +209,7 @@ def run(
 
         live = LiveTree()
     typer.echo(
-        f"{VARIANT_NAMES[cfg.tree.variant]} [{grounder_label(cfg.grounder.backend)}] in "
+        f"{TREE_VARIANTS.spec(cfg.tree.variant).label} [{grounder_label(cfg.grounder.backend)}] in "
         f"{ep.building}: {ep.id} ({ep.tier}), "
         f"start ({ep.start_x:.1f}, {ep.start_y:.1f}, {math.degrees(ep.start_yaw):.0f} deg), "
         f"corridor route {ep.route_length:.1f} m"
@@ -319,7 +320,7 @@ def eval_(
         save_evaluation,
         variant_configs,
     )
-    from pmnav_bt.experiments.stored_run import run_stored_evaluation
+    from pmnav_bt.experiments.stored_run import StoredRun, run_stored_evaluation
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
@@ -334,7 +335,7 @@ def eval_(
     if not eps:
         raise PmNavError("no episodes to run")
     echo = lambda text: typer.echo(text, err=True)  # noqa: E731
-    run = run_stored_evaluation(eps, configs, out, jobs=jobs, ray=ray, resume=resume, echo=echo)
+    run = run_stored_evaluation(eps, configs, StoredRun(out, jobs, ray, resume, echo))
     header = eval_header(building, tier, n, seed, cfg, configs)
     results = {k: v for k, v in run.results.items() if v}
     if run.stopped_by:
@@ -429,7 +430,7 @@ def table3(
         save,
         table,
     )
-    from pmnav_bt.experiments.stored_run import run_stored_study
+    from pmnav_bt.experiments.stored_run import StoredRun, run_stored_study
     from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
 
     check_output_dir(out)
@@ -445,7 +446,7 @@ def table3(
     if not starts:
         raise PmNavError("no start poses to run")
     echo = lambda text: typer.echo(text, err=True)  # noqa: E731
-    run = run_stored_study(starts, cfg, out, jobs=jobs, ray=ray, resume=resume, echo=echo)
+    run = run_stored_study(starts, cfg, StoredRun(out, jobs, ray, resume, echo))
     results = run.results
     header = (
         f"# Localization by landmark density (paper Table 3)\n\nbuildings: {', '.join(names)}; "

@@ -5,6 +5,7 @@ and ETA. Shared by ``pmnav sim eval`` and ``pmnav report``."""
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from pathlib import Path
 
@@ -28,6 +29,19 @@ def result_of(row: dict) -> EpisodeResult:
     return EpisodeResult.from_dict({k: v for k, v in row.items() if k in _RESULT_FIELDS})
 
 
+@dataclass(frozen=True)
+class StoredRun:
+    """Where a stored run writes (``out``: its ``results.jsonl``, kept between sessions) and
+    how it runs: ``jobs`` worker processes (or a Ray cluster at ``ray``), ``resume`` the
+    runs already in ``out``, progress lines to ``echo``."""
+
+    out: Path
+    jobs: int = 1
+    ray: str | None = None
+    resume: bool = False
+    echo: Callable[[str], None] = print
+
+
 @dataclass
 class RunOutcome:
     results: dict[str, list[EpisodeResult]]
@@ -38,21 +52,14 @@ class RunOutcome:
     exit_code: int = 0
 
 
-def run_stored_evaluation(
-    episodes: list,
-    configs: dict[str, Config],
-    out: Path,
-    jobs: int = 1,
-    ray: str | None = None,
-    resume: bool = False,
-    echo=print,
-) -> RunOutcome:
-    """Run (or resume) the evaluation into ``out/results.jsonl``; on SIGINT/SIGTERM return
-    what finished with ``stopped_by`` set (the caller writes the partial table)."""
+def run_stored_evaluation(episodes: list, configs: dict[str, Config], run: StoredRun) -> RunOutcome:
+    """Run (or resume) the evaluation into ``run.out/results.jsonl``; on SIGINT/SIGTERM
+    return what finished with ``stopped_by`` set (the caller writes the partial table)."""
     from pmnav_bt.experiments.evaluation import evaluate
     from pmnav_bt.experiments.progress import LogProgress, bar_columns
     from pmnav_bt.interrupts import Interrupted, stop_signals
 
+    out, jobs, ray, resume, echo = run.out, run.jobs, run.ray, run.resume, run.echo
     shas = {e.id: episode_sha(e) for e in episodes}
     expected = [
         Expected(record_key(n, e.id), n, shas[e.id], config_hash(c))
@@ -117,15 +124,7 @@ class StudyOutcome:
 STUDY = "localization"
 
 
-def run_stored_study(
-    starts: list,
-    config: Config,
-    out: Path,
-    jobs: int = 1,
-    ray: str | None = None,
-    resume: bool = False,
-    echo=print,
-) -> StudyOutcome:
+def run_stored_study(starts: list, config: Config, run: StoredRun) -> StudyOutcome:
     """The Table 3 study as a run that survives (see ``run_stored_evaluation``)."""
     from dataclasses import asdict
 
@@ -133,6 +132,7 @@ def run_stored_study(
     from pmnav_bt.experiments.progress import LogProgress
     from pmnav_bt.interrupts import Interrupted, stop_signals
 
+    out, jobs, ray, resume, echo = run.out, run.jobs, run.ray, run.resume, run.echo
     keys = [record_key(STUDY, start_key(s)) for s in starts]
     chash = config_hash(config)
     expected = [

@@ -1,5 +1,7 @@
 """Named evaluation variants: a tree variant plus config overrides, a label, and whether
-it is an oracle (ground-truth perception, labelled so in every table).
+it is an oracle (ground-truth perception, labelled so in every table). The tree variant
+(``tree.variant``) must be one registered in ``trees/variants.py``: a row naming another
+is refused when its config is made.
 
 Adding a variant is one line in ``VARIANTS``, e.g.
 ``Variant("mapless", "map-less", (("tree.variant", "mapless"),), tables=("1",))``.
@@ -17,6 +19,7 @@ from dataclasses import dataclass
 
 from pmnav_bt.config import Config, ConfigError, _set_dotted
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.trees.variants import TREE_VARIANTS
 
 ORACLE_LABEL = "oracle: simulator labels"
 
@@ -39,14 +42,16 @@ class Variant:
         return f"{self.label} ({ORACLE_LABEL})" if self.oracle else self.label
 
     def config(self, base: Config) -> Config:
-        """``base`` with this variant's overrides applied."""
+        """``base`` with this variant's overrides applied (its tree variant registered)."""
         data = base.model_dump(mode="json")
         for key, value in self.overrides:
             _set_dotted(data, key, value, label=f"variant {self.name}")
         try:
-            return Config.model_validate(data)
-        except ValueError as err:
+            config = Config.model_validate(data)
+            TREE_VARIANTS.spec(config.tree.variant)
+        except (ValueError, ConfigError) as err:
             raise ConfigError(f"variant {self.name}: {err}".splitlines()[0]) from None
+        return config
 
 
 VARIANTS: dict[str, Variant] = {

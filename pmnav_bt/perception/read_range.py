@@ -1,6 +1,11 @@
 """How far a grounder names signs: the one source of the tree's search distances.
 
-The ``ocr`` reader's recall per distance band is measured by ``benchmarks/bench_signs.py``
+Each grounder declares its reading model in its registry spec (``GrounderSpec.reading``):
+``PP_OCR`` here for the readers that read signs with PP-OCR (``ocr``, ``gdino_sam``), or
+``ORACLE_READING`` (``sim_gt``: every sign in sight to its ``grounder.max_range``); a
+grounder that declares none has no search ranges (an error, never PP-OCR's by default).
+
+The PP-OCR reader's recall per distance band is measured by ``benchmarks/bench_signs.py``
 (docs/perception.md) at two camera sizes. A sign counts as readable up to the far end of
 the last band where the reader names at least ``RELIABLE_RECALL`` of the signs. Other
 widths are interpolated between the measured ones (below the smallest, in proportion to
@@ -8,8 +13,7 @@ the width: a sign's text is that many pixels smaller; above the largest, no fart
 the reader's crops are upscaled anyway). The width is the one signs are read at: the
 camera's wider reading view where it offers one (``sim.reading_width``, on a robot the
 camera's own width), else the frame's. Plates with a name read nearer than bare numbers:
-each ``plate_kind`` has its own measured table where it differs. The oracle (``sim_gt``)
-reads to its ``grounder.max_range``.
+each ``plate_kind`` has its own measured table where it differs.
 
 From the read range follow (``search_settings``, ``SearchRanges`` per plate kind): how
 close the tree goes to a target before searching for its sign (``tree.search_range``),
@@ -23,9 +27,11 @@ Values set in the config win.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from pmnav_bt.errors import ConfigError
 from pmnav_bt.geometry import side_of
 from pmnav_bt.seams import EntityKind
 
@@ -153,10 +159,38 @@ def angle_share(angle: float) -> float:
     return next((share for upto, share in ANGLE_RECALL if deg <= upto), 0.0)
 
 
-def _oracle(config: Config) -> bool:
-    from pmnav_bt.registry import GROUNDERS
+@dataclass(frozen=True)
+class ReadingModel:
+    """How far and how often a reader names signs (its *reading model*), as a grounder
+    declares it (``registry.GrounderSpec.reading``): ``read_range(width, recall, kind)``,
+    the far end (m) of where it names at least ``recall`` of the plates of ``kind`` (None:
+    all) with a camera ``width`` pixels wide; ``recall(width, distance, kind)``, the share
+    it names from ``distance`` m; ``angle_share(angle)``, the share of that kept ``angle``
+    rad off the plate's normal. A grounder whose reading model is ``ORACLE_READING`` has
+    none of these: it reads every sign in sight up to ``grounder.max_range``."""
 
-    return GROUNDERS.spec(config.grounder.backend).needs_sim_labels
+    read_range: Callable[[int, float, str | None], float]
+    recall: Callable[[int, float, str | None], float]
+    angle_share: Callable[[float], float]
+
+
+PP_OCR = ReadingModel(ocr_read_range, ocr_recall, angle_share)  # bench_signs.py's tables
+
+
+def reading_model(config: Config) -> ReadingModel | None:
+    """The configured grounder's declared reading model (``GrounderSpec.reading``); None
+    for ``ORACLE_READING`` (every sign in sight to ``grounder.max_range``). ConfigError
+    for a grounder that declares none: its ranges are unknown, not PP-OCR's."""
+    from pmnav_bt.registry import GROUNDERS, ORACLE_READING, load
+
+    spec = GROUNDERS.spec(config.grounder.backend)
+    if spec.reading is None:
+        raise ConfigError(
+            f"grounder.backend {spec.name!r} declares no reading model (how far and how often "
+            "it names signs: GrounderSpec.reading), which the tree's search ranges and the "
+            "localization belief need"
+        )
+    return None if spec.reading == ORACLE_READING else load(spec.reading)
 
 
 def reading_width(config: Config) -> int:
@@ -168,25 +202,27 @@ def reading_width(config: Config) -> int:
 def sign_read_range(config: Config, width: int | None = None, kind: str | None = None) -> float:
     """How far the configured grounder reliably names signs (m) of plate ``kind`` (None:
     all); ``width``: the reading camera's, if not ``reading_width(config)``."""
-    if _oracle(config):
+    model = reading_model(config)
+    if model is None:
         return config.grounder.max_range
-    return ocr_read_range(width or reading_width(config), kind=kind)
+    return model.read_range(width or reading_width(config), RELIABLE_RECALL, kind)
 
 
 def sign_visible_range(config: Config, width: int | None = None) -> float | None:
     """How far the localization belief expects signs to be read at all (m): a sign
     nearer and in sight but not read is a miss, one read from farther is unexpected.
     None for the oracle: the belief's own ``READ_RANGE_M``, checked against it."""
-    if _oracle(config):
+    model = reading_model(config)
+    if model is None:
         return None
-    return ocr_read_range(width or reading_width(config), POSSIBLE_RECALL)
+    return model.read_range(width or reading_width(config), POSSIBLE_RECALL, None)
 
 
 def sign_lead_range(config: Config, width: int | None = None) -> float | None:
     """How far the localization belief counts on signs being read (m): where it drives to
     read them, and where a panorama may have missed one. None for the oracle: the
     belief's own ``READ_RANGE_M``."""
-    if _oracle(config):
+    if reading_model(config) is None:
         return None
     return sign_read_range(config, width)
 
@@ -197,7 +233,8 @@ def sign_recall(config: Config, building: Building, width: int | None = None):
     plate's normal, for the localization belief's misses (a sign 4 m off that OCR reads one
     time in three, or one seen along its wall, is no evidence when not read). None for the
     oracle: its misses are the belief's constant ``P_MISS``."""
-    if _oracle(config):
+    model = reading_model(config)
+    if model is None:
         return None
     w = width or reading_width(config)
     kinds: dict = {}
@@ -206,7 +243,7 @@ def sign_recall(config: Config, building: Building, width: int | None = None):
         kind = kinds.get(entity)
         if kind is None:
             kind = kinds[entity] = entity_plate_kind(building, entity)
-        return ocr_recall(w, distance, kind) * angle_share(angle)
+        return model.recall(w, distance, kind) * model.angle_share(angle)
 
     return recall
 
@@ -249,7 +286,7 @@ def landmark_ranges(config: Config) -> dict[str, float] | None:
     """How far (m) the configured grounder reliably names each plate kind: the range
     within which a landmark counts as readable, e.g. for Table 3's start classes. None for
     the oracle: the priori-map's own ``visibility.READ_RANGE_M`` for every plate."""
-    if _oracle(config):
+    if reading_model(config) is None:
         return None
     return {k: sign_read_range(config, kind=k) for k in PLATE_KINDS}
 
@@ -285,7 +322,7 @@ class SearchRanges:
         self.building = building
         self.by_kind = {k: search_settings(config, width, k) for k in PLATE_KINDS}
         self.default = search_settings(config, width)
-        angled = not _oracle(config) and config.tree.search_range is None
+        angled = reading_model(config) is not None and config.tree.search_range is None
         self.beside = config.grounder.sign_to_door if angled else None
         self.config = config
 

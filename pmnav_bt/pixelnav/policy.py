@@ -55,6 +55,7 @@ class PixelNavPolicy:
     """A trained PixelNav network behind the Refiner and PixelGoalPolicy seams."""
 
     gives_range = True
+    drives_approach = True  # a PixelGoalPolicy: the tree approaches with PolicyApproach
     max_steps = MAX_STEPS
 
     def __init__(

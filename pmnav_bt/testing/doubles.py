@@ -264,6 +264,7 @@ class FakeRefiner:
 
     gives_range: bool = True
     error: Exception | None = None
+    drives_approach = False
 
     def refine(self, obs: Observation, goal: Detection) -> Refinement:
         if self.error is not None:

@@ -37,6 +37,7 @@ class ScriptedPolicy:
     """Plays ``script`` (then STOP, or forever its last action); records its calls."""
 
     gives_range = False
+    drives_approach = True
 
     def __init__(self, script, max_steps=64, forever=False):
         self.script, self.max_steps, self.forever = list(script), max_steps, forever
@@ -130,10 +131,10 @@ def test_a_policy_that_never_stops_hands_over_to_the_map_approach(make_rig, pm):
 
 def test_the_tree_approaches_with_the_policy_only_when_the_refiner_is_one(make_rig):
     from pmnav_bt.behaviours.motion import Approach
-    from pmnav_bt.trees.pmnav import build_pmnav_tree
+    from pmnav_bt.trees.runner import build_tree
 
     def approaches(ctx):
-        tree = build_pmnav_tree(ctx, "room4")
+        tree = build_tree(ctx, "room4")
         return {type(n) for n in tree.root.iterate() if isinstance(n, Approach)}
 
     rig = make_rig(START)

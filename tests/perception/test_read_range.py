@@ -1,4 +1,5 @@
-"""The reader's measured range is the one source of the tree's search distances."""
+"""The reader's measured range is the one source of the tree's search distances; each
+grounder declares its reading model, and one that declares none gets no PP-OCR tables."""
 
 from __future__ import annotations
 
@@ -7,18 +8,26 @@ import math
 import pytest
 
 from pmnav_bt.config import load_config
+from pmnav_bt.errors import ConfigError
 from pmnav_bt.perception.read_range import (
     MAX_SEARCH_ANGLE_DEG,
     MIN_ABREAST_M,
+    PLATE_KINDS,
+    ReadingModel,
+    SearchRanges,
     abreast_range,
+    landmark_ranges,
     ocr_read_range,
     plate_kind,
     reading_width,
     search_settings,
     sign_ahead,
     sign_read_range,
+    sign_recall,
     sign_visible_range,
 )
+from pmnav_bt.registry import GROUNDERS, ORACLE_READING, PP_OCR_READING, GrounderSpec
+from pmnav_bt.seams import Entity
 
 
 def test_the_measured_widths_read_to_the_last_reliable_band():
@@ -98,6 +107,7 @@ def test_plates_with_a_name_are_read_from_nearer():
 def test_the_built_tree_uses_them(fig2_map):
     from types import SimpleNamespace
 
+    from pmnav_bt.testing.doubles import FakeRefiner
     from pmnav_bt.trees.pmnav import step_subtree
 
     def keeps(
@@ -106,7 +116,7 @@ def test_the_built_tree_uses_them(fig2_map):
         """The search distances the tree's behaviours take for a step looking for
         ``look_for``, its door ``across`` m east of the centre line (None: no door), the
         robot arriving ``heading`` (default south: the door on its left)."""
-        ctx = SimpleNamespace(config=cfg, now=lambda: 0.0, refiner=None, pm=fig2_map)
+        ctx = SimpleNamespace(config=cfg, now=lambda: 0.0, refiner=FakeRefiner(), pm=fig2_map)
         root = step_subtree(ctx)
         door = None if across is None else (across, 0.0)
         target = SimpleNamespace(
@@ -170,3 +180,66 @@ def test_the_buildings_convention_says_which_side_of_its_door_a_sign_hangs():
     assert sign_ahead(cfg, math.pi / 2, (60.0, 5.5), (61.2, 5.5)) == -1  # heading north
     other = load_config(None, ["grounder.backend=ocr", "grounder.door_side=right"])
     assert sign_ahead(other, south, (60.0, 5.5), (61.2, 5.5)) == -1
+
+
+# A reader that names every sign to 5 m and none beyond, whatever the camera (a test's).
+FIVE_METRES = ReadingModel(
+    lambda width, recall, kind: 5.0,
+    lambda width, distance, kind: float(distance <= 5.0),
+    lambda angle: 1.0,
+)
+
+
+@pytest.fixture
+def grounder_named():
+    """Register grounder specs for one test (``grounder_named(name, **declared)``)."""
+    made = []
+
+    def register(name: str, **declared) -> object:
+        GROUNDERS.register(GrounderSpec(name, "never.built:here", "", **declared))
+        made.append(name)
+        return load_config(None, [f"grounder.backend={name}"])
+
+    yield register
+    for name in made:
+        GROUNDERS._specs.pop(name)
+
+
+def test_each_grounder_reads_by_the_model_it_declares(fig2_map, grounder_named):
+    ocr = load_config(None, ["grounder.backend=ocr"])
+    gdino = load_config(None, ["grounder.backend=gdino_sam"])  # its signs: the same PP-OCR
+    assert search_settings(gdino) == search_settings(ocr)
+    assert sign_visible_range(gdino) == sign_visible_range(ocr) == 6.0
+    assert sign_recall(gdino, fig2_map.building)(Entity.room("room5"), 3.0) == pytest.approx(
+        sign_recall(ocr, fig2_map.building)(Entity.room("room5"), 3.0)
+    )
+    own = grounder_named("five", reading=f"{__name__}:FIVE_METRES")
+    assert sign_read_range(own) == 5.0 and sign_visible_range(own) == 5.0
+    assert search_settings(own).search_range == 4.5  # 5 - 0.5
+    recall = sign_recall(own, fig2_map.building)
+    assert (recall(Entity.room("room5"), 4.9), recall(Entity.room("room5"), 5.1)) == (1.0, 0.0)
+    assert landmark_ranges(own) == {k: 5.0 for k in PLATE_KINDS}
+
+
+def test_the_oracle_flag_is_not_the_reading_model(fig2_map, grounder_named):
+    # An oracle that reads signs with PP-OCR has PP-OCR's ranges; an oracle reading model
+    # reads to grounder.max_range whatever the flag says.
+    flagged = grounder_named("flagged", reading=PP_OCR_READING, oracle=True)
+    assert sign_read_range(flagged) == 3.5 and sign_recall(flagged, fig2_map.building)
+    reads_all = grounder_named("reads_all", reading=ORACLE_READING)
+    assert sign_read_range(reads_all) == 9.0 and sign_recall(reads_all, fig2_map.building) is None
+    assert landmark_ranges(reads_all) is None and sign_visible_range(reads_all) is None
+
+
+def test_a_grounder_that_declares_no_reading_model_gets_no_ranges(fig2_map, grounder_named):
+    silent = grounder_named("silent")
+    for ask in (
+        sign_read_range,
+        sign_visible_range,
+        search_settings,
+        landmark_ranges,
+        lambda c: sign_recall(c, fig2_map.building),
+        lambda c: SearchRanges(c, fig2_map.building),
+    ):
+        with pytest.raises(ConfigError, match="'silent' declares no reading model"):
+            ask(silent)

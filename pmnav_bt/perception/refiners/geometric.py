@@ -24,6 +24,7 @@ class GeometricRefiner:
     median depth over the mask (None without depth)."""
 
     gives_range = True
+    drives_approach = False
 
     def refine(self, obs: Observation, goal: Detection) -> Refinement:
         u, _ = goal.centre
