@@ -12,12 +12,20 @@ import pytest
 
 from pmnav_bt.config import load_config
 from pmnav_bt.failures import FailureCode
+from pmnav_bt.map.building import load_building
+from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.registry import Backends
 from pmnav_bt.seams import Observation, Pose2D
 from pmnav_bt.testing import doubles
 from pmnav_bt.testing.oracle import ORACLE
 from pmnav_bt.trees.runner import make_context, run_tree
 from pmnav_bt.trees.variants import TREE_VARIANTS
+
+
+@pytest.fixture(scope="module")
+def office():
+    return parse_building(load_building("straight_office"))
+
 
 START = Pose2D(4.0, 0.0, 0.0)  # straight_office, facing east down the corridor
 GOAL = "room2"  # its door (10, 1.1) is in view from the start
