@@ -26,7 +26,7 @@ from pmnav_bt.experiments.evaluation import custom_episode
 
 
 def run(ep, deferred: bool, overrides=()) -> tuple[list[float], float, bool, int]:
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.odometry import NoisyOdometry
     from pmnav_bt.sim.robot import SimBase

@@ -210,12 +210,12 @@ class PmNavController:
         from std_msgs.msg import Empty, String
         from visualization_msgs.msg import MarkerArray
 
+        from pmnav_bt.backends import build_backends
         from pmnav_bt.config import load_config
         from pmnav_bt.hardware import qos
         from pmnav_bt.hardware.create3 import Create3Base
-        from pmnav_bt.map.building import load_building
+        from pmnav_bt.map.catalogue import load_building
         from pmnav_bt.map.priori_map import parse_building
-        from pmnav_bt.registry import build_backends
         from pmnav_bt.trees import runner  # noqa: F401 - import the tree now, not at the first
         # goal: a long import holds the GIL and would starve the executor (odometry "stale")
 

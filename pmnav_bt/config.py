@@ -16,7 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from pmnav_bt.errors import ConfigError, PmNavError
 from pmnav_bt.eval.task import BUDGET_ACTIONS, BUDGET_PATH_FACTOR, STOP_OFFSET_M
 from pmnav_bt.loading import InputFileError, load_yaml, parse_yaml_value
-from pmnav_bt.planning.graph_planner import MAX_GAP_M
+from pmnav_bt.planning.plan import MAX_GAP_M
 from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR
 
 # The pixel-goal policy's reliable range (m): its skill eval (docs/pixelnav.md) gives SR 100 %

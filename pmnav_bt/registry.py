@@ -1,9 +1,12 @@
-"""Back ends by name: one registry per seam, one factory for the simulator and the robot.
+"""Back ends by name: one registry per seam.
 
 Each seam (grounder, coarse direction, refiner, planner) has a registry of named back
 ends. An entry points at its factory as ``"module:function"`` and is imported only when
 chosen, so heavy back ends (OCR models, torch networks, an HTTP client) cost nothing
-unless configured. A factory takes the ``BackendDeps`` and returns the back end.
+unless configured. A factory takes the ``backends.BackendDeps`` and returns the back end;
+``backends.build_backends`` builds a run's back ends from the config, for the simulator
+and the robot alike. The config checks its ``backend`` names here, so this module knows
+nothing of the config.
 
     >>> GROUNDERS.names()
     ['sim_gt', ...]
@@ -18,14 +21,9 @@ import difflib
 import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from pmnav_bt.errors import BackendError, ConfigError
-
-if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.config import Config
-    from pmnav_bt.map.priori_map import PrioriMap
-    from pmnav_bt.seams import CoarseDirection, Grounder, Planner, Refiner
 
 
 @dataclass(frozen=True)
@@ -38,15 +36,11 @@ class BackendSpec:
     needs_sim_labels: bool = False
 
 
-@dataclass
-class BackendDeps:
-    """What a factory may use to build its back end."""
+class FactoryDeps(Protocol):
+    """What a registry reads of a factory's inputs (``backends.BackendDeps``) before it
+    builds: whether the run is on a robot."""
 
-    config: Config
-    pm: PrioriMap
-    seed: int = 0
-    on_robot: bool = False
-    grounder: Grounder | None = None  # built first; for back ends that ground (coarse)
+    on_robot: bool
 
 
 class Registry:
@@ -78,7 +72,7 @@ class Registry:
                 f"registered: {', '.join(self._specs)}"
             ) from None
 
-    def build(self, name: str, deps: BackendDeps) -> Any:
+    def build(self, name: str, deps: FactoryDeps) -> Any:
         """Build the back end ``name`` (refusing simulator-only back ends on a robot)."""
         spec = self.spec(name)
         if spec.needs_sim_labels and deps.on_robot:
@@ -90,7 +84,7 @@ class Registry:
         return _load(spec.factory)(deps)
 
 
-def _load(target: str) -> Callable[[BackendDeps], Any]:
+def _load(target: str) -> Callable[[FactoryDeps], Any]:
     module, _, attr = target.partition(":")
     return getattr(importlib.import_module(module), attr)
 
@@ -170,34 +164,3 @@ PLANNERS = Registry(
     ],
 )
 REGISTRIES = {r.seam: r for r in (GROUNDERS, COARSE, REFINERS, PLANNERS)}
-
-
-@dataclass
-class Backends:
-    """The back ends of one run, built from the config."""
-
-    grounder: Grounder
-    coarse: CoarseDirection
-    refiner: Refiner
-    planner: Planner | None  # None: the map-less baseline plans nothing
-
-
-def build_backends(
-    config: Config, pm: PrioriMap, *, on_robot: bool, seed: int = 0, planner: bool = True
-) -> Backends:
-    """Every seam's back end, as ``config`` names them (the simulator and the robot alike);
-    ``planner=False``: no planner (``build_perception``)."""
-    deps = BackendDeps(config=config, pm=pm, seed=seed, on_robot=on_robot)
-    deps.grounder = GROUNDERS.build(config.grounder.backend, deps)
-    return Backends(
-        grounder=deps.grounder,
-        coarse=COARSE.build(config.coarse.backend, deps),
-        refiner=REFINERS.build(config.refiner.backend, deps),
-        planner=PLANNERS.build(config.planner.backend, deps) if planner else None,
-    )
-
-
-def build_perception(config: Config, pm: Any, *, on_robot: bool, seed: int = 0) -> Backends:
-    """The perception back ends only (grounder, coarse direction, refiner), no planner:
-    the map-less baseline's, with ``pm`` its sign vocabulary (``map.signs_only.SignsOnly``)."""
-    return build_backends(config, pm, on_robot=on_robot, seed=seed, planner=False)

@@ -9,7 +9,7 @@ import pytest
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.experiments.sim_cli import _buildings
-from pmnav_bt.map.generate import family_members, generated_family
+from pmnav_bt.map.catalogue import family_members, generated_family
 from pmnav_bt.sim.episodes import episode_building_file, generate_episodes
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+from pmnav_bt.backends import build_backends
 from pmnav_bt.cli import main
 from pmnav_bt.config import load_config
 from pmnav_bt.errors import BackendError, ConfigError
@@ -12,7 +13,7 @@ from pmnav_bt.perception.coarse import DetectorCoarseDirection
 from pmnav_bt.perception.grounders.ground_truth import GroundTruthGrounder
 from pmnav_bt.perception.refiners.geometric import GeometricRefiner
 from pmnav_bt.planning.graph_planner import GraphPlanner
-from pmnav_bt.registry import GROUNDERS, REGISTRIES, BackendSpec, build_backends
+from pmnav_bt.registry import GROUNDERS, REGISTRIES, BackendSpec
 from pmnav_bt.seams import CoarseDirection, Grounder, Planner, Refiner
 
 

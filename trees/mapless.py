@@ -28,6 +28,7 @@ from py_trees.behaviours import Failure as AlwaysFail
 from py_trees.common import Access
 from py_trees.composites import Parallel, Selector, Sequence
 
+from pmnav_bt.backends import Backends, build_perception
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.decorators import RetryWhile
@@ -47,7 +48,6 @@ from pmnav_bt.behaviours.search import Ground
 from pmnav_bt.config import Config
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.signs_only import SignsOnly
-from pmnav_bt.registry import Backends, build_perception
 from pmnav_bt.seams import Base
 
 NEAR_M = 2.0  # the door is looked at again from this far before the final approach

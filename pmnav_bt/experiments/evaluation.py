@@ -39,7 +39,7 @@ def custom_episode(building: str, goal: str, start: str | None = None, seed: int
     start waypoint (facing along its corridor)."""
     from pmnav_bt.eval.task import action_budget
     from pmnav_bt.eval.tiers import classify
-    from pmnav_bt.map.building import building_sha256, load_building, resolve_building_path
+    from pmnav_bt.map.catalogue import building_sha256, load_building, resolve_building_path
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.planning.resolve import resolve_room, resolve_start
     from pmnav_bt.seams import Pose2D
@@ -95,7 +95,7 @@ def run_episode(
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     """
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.episodes import episode_building_file, goal_geodesic, score_episode
     from pmnav_bt.sim.odometry import NoisyOdometry

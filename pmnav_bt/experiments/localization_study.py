@@ -76,7 +76,7 @@ def classified_starts(
     """Up to ``n`` start poses of each landmark-density class in ``building`` (seeded),
     counting the landmarks readable within ``ranges`` (m per plate kind, as
     ``read_range.landmark_ranges``; None: ``READ_RANGE_M`` for every plate)."""
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
 
     b = load_building(building)
@@ -115,7 +115,7 @@ def run_localization(start: LocStart, config: Config) -> LocResult:
     import py_trees
 
     from pmnav_bt.behaviours.common import NAMESPACE
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.seams import Pose2D
     from pmnav_bt.sim.odometry import NoisyOdometry

@@ -73,7 +73,8 @@ def route(
             pm, start, goal
         )
     else:
-        from pmnav_bt.registry import PLANNERS, BackendDeps
+        from pmnav_bt.backends import BackendDeps
+        from pmnav_bt.registry import PLANNERS
 
         gap = [] if max_gap is None else [f"planner.max_gap={max_gap}"]
         cfg = load_config(config, [*(overrides or []), *gap])

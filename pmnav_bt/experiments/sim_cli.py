@@ -104,8 +104,7 @@ def _tiers(tier: str) -> list[str]:
 
 def _buildings(building: str) -> list[str]:
     """Comma-separated files, built-in names, 'all' (every built-in) and FAMILY:N."""
-    from pmnav_bt.map.building import builtin_buildings
-    from pmnav_bt.map.generate import family_members
+    from pmnav_bt.map.catalogue import builtin_buildings, family_members
 
     out: list[str] = []
     for part in (b.strip() for b in building.split(",") if b.strip()):

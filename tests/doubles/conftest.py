@@ -15,11 +15,11 @@ import pytest
 from blackboard_kit import BlackboardAccess, cleared, writer
 from py_trees.common import Status
 
+from pmnav_bt.backends import Backends
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.config import load_config
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
-from pmnav_bt.registry import Backends
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.testing.doubles import (
     FakeBase,

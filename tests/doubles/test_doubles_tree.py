@@ -7,11 +7,11 @@ import math
 
 import pytest
 
+from pmnav_bt.backends import Backends
 from pmnav_bt.config import load_config
 from pmnav_bt.errors import SensorError
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.registry import Backends
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.testing.doubles import (
     FakeBase,

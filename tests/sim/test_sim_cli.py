@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from pmnav_bt.experiments.cli import main
-from pmnav_bt.map.building import BUILTIN_DIR, load_building
+from pmnav_bt.map.catalogue import BUILTIN_DIR, load_building
 from pmnav_bt.map.floorplan import rasterize_building, save_ros_map
 from pmnav_bt.testing.oracle import ORACLE_SET
 
@@ -101,7 +101,7 @@ def test_eval_exits_non_zero_and_counts_errored_episodes(capsys, own_building, m
 
 def test_eval_all_means_every_builtin_building(monkeypatch):
     from pmnav_bt.experiments.sim_cli import _buildings
-    from pmnav_bt.map.building import builtin_buildings
+    from pmnav_bt.map.catalogue import builtin_buildings
 
     assert _buildings("all") == builtin_buildings()
     assert _buildings("a.yaml, t_school") == ["a.yaml", "t_school"]

@@ -159,7 +159,7 @@ def test_tick_record_missing_a_field(tmp_path, log):
 @pytest.fixture(scope="module")
 def episode_log(tmp_path_factory):
     """A real log: 60 ticks of PM-Nav in the pybullet fig2_hospital (localizes at ~46)."""
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.seams import Pose2D
     from pmnav_bt.sim.robot import SimBase
