@@ -41,7 +41,10 @@ MAX_WIDTH_M = 50.0  # corridor width
 MAX_WALL_HEIGHT_M = 20.0
 MAX_WAYPOINTS = 2000
 MAX_EDGES = 4000
-MAX_ROOMS = 5000
+# Rooms: the planner's scale target (benchmarks/bench_plan.py plans on 10,000 rooms). A real
+# building has that many: the largest hospital, Zhengzhou University's First Affiliated
+# Hospital, reports over 10,000 beds (2022), with its wards, offices and labs besides.
+MAX_ROOMS = 10_000
 MAX_LANDMARKS = 5000
 MAX_ALIASES = 32
 MAX_ID_CHARS = 64
