@@ -289,17 +289,9 @@ def report(
     """Run (or resume) the evaluation and the Table 3 study, then write report.md with
     Tables 1, 3 and 4 beside the paper's, plots, trajectories, config and commit."""
     from pmnav_bt import cli_values
+    from pmnav_bt.experiments import options
     from pmnav_bt.experiments.evaluation import episodes_for
     from pmnav_bt.experiments.localization_study import classified_starts
-    from pmnav_bt.experiments.options import (
-        building_names,
-        class_ranges,
-        job_count,
-        ranges_text,
-        run_config,
-        table3_building_names,
-        tier_names,
-    )
     from pmnav_bt.experiments.stored_run import run_stored_evaluation, run_stored_study
     from pmnav_bt.experiments.variants import VARIANTS, variant_configs
 
@@ -309,12 +301,12 @@ def report(
         return
     cli_values.count(n, "-n")
     cli_values.seed(seed)
-    jobs = job_count(jobs)
-    base = run_config(config, overrides)
+    jobs = options.job_count(jobs)
+    base = options.run_config(config, overrides)
     check_output_dir(out)
     names = [v.strip() for v in variants.split(",") if v.strip()] or list(VARIANTS)
     configs = variant_configs(base, names)
-    eps, notes = episodes_for(building_names(building), tier_names(tier), n, seed)
+    eps, notes = episodes_for(options.building_names(building), options.tier_names(tier), n, seed)
     for note in notes:
         typer.echo(f"note: {note}", err=True)
     if not eps:
@@ -322,14 +314,14 @@ def report(
     starts: list = []
     t3 = None
     if not no_table3:
-        t3_names = table3_building_names(table3_building, family_size)
-        ranges = class_ranges("stack", base)
+        t3_names = options.table3_building_names(table3_building, family_size)
+        ranges = options.class_ranges("stack", base)
         starts = [s for b in t3_names for s in classified_starts(b, table3_n, seed, ranges)]
         t3 = {
             "building": ", ".join(t3_names),
             "n": table3_n,
             "grounder": base.grounder.backend,
-            "class_range": ranges_text(ranges),
+            "class_range": options.ranges_text(ranges),
         }
     ev = {"building": building, "tier": tier, "n": n, "seed": seed}
     out.mkdir(parents=True, exist_ok=True)
