@@ -70,7 +70,7 @@ class Context:
         cls, base: Base, pm: Any, config: Config, backends: Any, budget: int | None,
         deferred_work: bool, *, detour_check: DetourCheck | None,
     ) -> Context:  # fmt: skip
-        """The back ends ``backends`` (a ``registry.Backends``) wired to ``base`` and ``pm``,
+        """The back ends ``backends`` (a ``backends.Backends``) wired to ``base`` and ``pm``,
         with a fresh Worker and the config's action budget unless ``budget`` is given;
         ``detour_check``: see ``DetourCheck`` (the tree variant decides it)."""
         return cls(

@@ -18,7 +18,8 @@ import math
 import statistics
 from pathlib import Path
 
-from pmnav_bt.map.building import WaypointKind, builtin_buildings, load_building
+from pmnav_bt.map.building import WaypointKind
+from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.pose.odometry import CalibratedBase
 from pmnav_bt.seams import Pose2D

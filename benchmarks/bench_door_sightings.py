@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from pmnav_bt.map.building import builtin_buildings, load_building, resolve_building_path
+from pmnav_bt.map.catalogue import builtin_buildings, load_building, resolve_building_path
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.perception.depth import back_project, surfaces
 from pmnav_bt.perception.door_sightings import BAND_M, find_doors

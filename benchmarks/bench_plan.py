@@ -16,7 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from pmnav_bt.map.building import load_building, save_building
+from pmnav_bt.map.building import save_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.generate import generate_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.planning.graph_planner import GraphPlanner

@@ -31,7 +31,7 @@ from collections import defaultdict
 
 import numpy as np
 
-from pmnav_bt.map.building import builtin_buildings
+from pmnav_bt.map.catalogue import builtin_buildings
 from pmnav_bt.perception.grounders.ocr import OcrGrounder
 from pmnav_bt.perception.read_range import PLATE_KINDS, plate_kind
 from pmnav_bt.seams import EntityKind, landmark_label, sign_label

@@ -10,7 +10,7 @@ import argparse
 import math
 import time
 
-from pmnav_bt.map.building import builtin_buildings, load_building
+from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.seams import DiscreteAction, MotionStatus, Pose2D
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.robot import RADIUS, SimBase

@@ -22,7 +22,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from pmnav_bt.map.building import builtin_buildings
+from pmnav_bt.map.catalogue import builtin_buildings
 from pmnav_bt.perception.corner import MaskRatios, central_band, is_corner, is_opening
 from pmnav_bt.perception.depth import surfaces
 from pmnav_bt.seams import CameraIntrinsics, Observation, Pose2D

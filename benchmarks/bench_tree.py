@@ -26,10 +26,9 @@ from pmnav_bt.experiments.evaluation import custom_episode
 
 
 def run(ep, deferred: bool, overrides=()) -> tuple[list[float], float, bool, int]:
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
-    from pmnav_bt.sim.odometry import NoisyOdometry
-    from pmnav_bt.sim.robot import SimBase
+    from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import make_context, run_tree
 
@@ -39,14 +38,7 @@ def run(ep, deferred: bool, overrides=()) -> tuple[list[float], float, bool, int
     durations: list[float] = []
     t0 = time.perf_counter()
     with SimWorld(b) as world:
-        inner = SimBase(
-            world,
-            pose=ep.start_pose,
-            width=cfg.sim.width,
-            height=cfg.sim.height,
-            reading_width=cfg.sim.reading_width,
-        )
-        base = NoisyOdometry(inner, cfg.sim.odometry_noise, seed=ep.seed)
+        _, base = simulated_robot(world, cfg.sim, ep.start_pose, ep.seed)
         ctx = make_context(
             base, pm, cfg, seed=ep.seed, budget=ep.step_budget * 2, deferred_work=deferred
         )

@@ -56,7 +56,7 @@ def main() -> None:
 
     import py_trees
 
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.robot import SimBase
     from pmnav_bt.sim.world import SimWorld

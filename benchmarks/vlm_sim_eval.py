@@ -71,12 +71,13 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("out/vlm_sim_eval"))
     args = ap.parse_args()
 
-    from pmnav_bt.experiments.sim_cli import _buildings, _tiers
+    from pmnav_bt.experiments.options import building_names, tier_names
     from pmnav_bt.planning.graph_planner import GraphPlanner
     from pmnav_bt.sim.episodes import tier_definition
 
     cfg = load_config()
-    eps, notes = episodes_for(_buildings(args.building), _tiers(args.tier), args.n, args.seed)
+    buildings, tiers = building_names(args.building), tier_names(args.tier)
+    eps, notes = episodes_for(buildings, tiers, args.n, args.seed)
     server = None
     if args.endpoint is None:
         responder = PlanningResponder(args.wrong, args.seed)

@@ -384,28 +384,20 @@ class Create3Base:
         with self._lock:
             odom_age = self._age(self._odom_arrival)
             cam_age = self._age(self._camera_arrival)
-        if odom_age is None:
-            return Failure(
-                FailureCode.SENSOR_TIMEOUT,
-                f"no odometry received on {self._topic(opt.odom_topic)}",
-            )
-        if odom_age > opt.odom_fault_s:
-            return Failure(
-                FailureCode.SENSOR_TIMEOUT,
-                f"no odometry on {self._topic(opt.odom_topic)} for {odom_age:.2f} s "
-                f"(odom_fault_s {opt.odom_fault_s:.2f} s)",
-            )
-        if cam_age is None:
-            return Failure(
-                FailureCode.SENSOR_TIMEOUT,
-                f"no camera frame received on {self._topic(opt.image_topic)}",
-            )
-        if cam_age > opt.camera_timeout:
-            return Failure(
-                FailureCode.SENSOR_TIMEOUT,
-                f"no camera frame on {self._topic(opt.image_topic)} for {cam_age:.1f} s "
-                f"(camera_timeout {opt.camera_timeout:.1f} s)",
-            )
+        for age, what, topic, limit, name, digits in (
+            (odom_age, "odometry", opt.odom_topic, opt.odom_fault_s, "odom_fault_s", 2),
+            (cam_age, "camera frame", opt.image_topic, opt.camera_timeout, "camera_timeout", 1),
+        ):
+            if age is None:
+                return Failure(
+                    FailureCode.SENSOR_TIMEOUT, f"no {what} received on {self._topic(topic)}"
+                )
+            if age > limit:
+                return Failure(
+                    FailureCode.SENSOR_TIMEOUT,
+                    f"no {what} on {self._topic(topic)} for {age:.{digits}f} s "
+                    f"({name} {limit:.{digits}f} s)",
+                )
         return None
 
     def sensors(self) -> dict[str, float | None]:

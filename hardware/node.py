@@ -210,12 +210,12 @@ class PmNavController:
         from std_msgs.msg import Empty, String
         from visualization_msgs.msg import MarkerArray
 
+        from pmnav_bt.backends import build_backends
         from pmnav_bt.config import load_config
         from pmnav_bt.hardware import qos
         from pmnav_bt.hardware.create3 import Create3Base
-        from pmnav_bt.map.building import load_building
+        from pmnav_bt.map.catalogue import load_building
         from pmnav_bt.map.priori_map import parse_building
-        from pmnav_bt.registry import build_backends
         from pmnav_bt.trees import runner  # noqa: F401 - import the tree now, not at the first
         # goal: a long import holds the GIL and would starve the executor (odometry "stale")
 
@@ -729,8 +729,6 @@ def split_record(args: list[str]) -> tuple[str, list[str]]:
 
 def main(argv: list[str] | None = None) -> None:
     """Console script ``pmnav-ros``: ``pmnav-ros --ros-args -p building:=fig2_hospital``."""
-    from pmnav_bt.hardware.runtime import RosRuntime
-
     args = list(sys.argv if argv is None else argv)
     if wants_help(args):
         print(usage("pmnav-ros [--record FILE.mcap]", HELP, PARAMETERS, EXAMPLE))
@@ -743,34 +741,23 @@ def main(argv: list[str] | None = None) -> None:
     # The cmd_vel heartbeat thread must get the GIL quickly while the tree and the
     # perception worker run: hand it over every 1 ms instead of 5 ms.
     sys.setswitchinterval(0.001)
-    try:
-        runtime = RosRuntime(args=args)
-    except PmNavError as err:  # rclpy missing, or bad --ros-args
-        print(f"pmnav-ros: {err}", file=sys.stderr)
-        sys.exit(2)
-    from rclpy.node import Node
+    from pmnav_bt.hardware.runtime import run_node
 
-    node = Node("pmnav", context=runtime.context)
-    controller = None
-    code = 0
-    try:
-        controller = PmNavController(node, runtime, record=record)
-        runtime.add(node)
-        runtime.install_signals(controller.request_stop)
-        runtime.start()
-        controller.spin()
-    except PmNavError as err:
-        print(f"pmnav-ros: {err}", file=sys.stderr)
-        code = 1
-    except KeyboardInterrupt:
-        pass
-    finally:
-        if controller is not None:
-            controller.base.close()
-        runtime.shutdown()
-        if controller is not None and controller.recorder is not None:
-            controller.recorder.close()
-    sys.exit(code)
+    run_node(
+        "pmnav-ros",
+        "pmnav",
+        args,
+        lambda node, runtime: PmNavController(node, runtime, record=record),
+        serve=PmNavController.spin,
+        on_signal=PmNavController.request_stop,
+        before_shutdown=lambda controller: controller.base.close(),
+        after_shutdown=_close_recorder,
+    )
+
+
+def _close_recorder(controller: PmNavController) -> None:
+    if controller.recorder is not None:
+        controller.recorder.close()
 
 
 if __name__ == "__main__":  # pragma: no cover

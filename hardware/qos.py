@@ -29,30 +29,26 @@ def sensor():
 
 
 def command():
-    q = _qos()
-    return q.QoSProfile(
-        depth=1,
-        history=q.HistoryPolicy.KEEP_LAST,
-        reliability=q.ReliabilityPolicy.RELIABLE,
-        durability=q.DurabilityPolicy.VOLATILE,
-    )
+    return _reliable(depth=1, transient_local=False)
 
 
 def latched():
-    q = _qos()
-    return q.QoSProfile(
-        depth=1,
-        history=q.HistoryPolicy.KEEP_LAST,
-        reliability=q.ReliabilityPolicy.RELIABLE,
-        durability=q.DurabilityPolicy.TRANSIENT_LOCAL,
-    )
+    return _reliable(depth=1, transient_local=True)
 
 
 def events(depth: int = 10):
+    return _reliable(depth=depth, transient_local=False)
+
+
+def _reliable(depth: int, transient_local: bool):
+    """Reliable, keep last ``depth``; transient local (a late subscriber gets the last
+    messages) or volatile."""
     q = _qos()
     return q.QoSProfile(
         depth=depth,
         history=q.HistoryPolicy.KEEP_LAST,
         reliability=q.ReliabilityPolicy.RELIABLE,
-        durability=q.DurabilityPolicy.VOLATILE,
+        durability=(
+            q.DurabilityPolicy.TRANSIENT_LOCAL if transient_local else q.DurabilityPolicy.VOLATILE
+        ),
     )

@@ -11,11 +11,15 @@ from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
 from collections.abc import Callable
+from typing import Any, NoReturn, TypeVar
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.hardware.env import import_rclpy
+
+T = TypeVar("T")
 
 
 class RosArgumentsError(PmNavError):
@@ -109,3 +113,54 @@ class RosRuntime:
         self.rclpy.try_shutdown(context=self.context)
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=2.0)
+
+
+def run_node(
+    program: str,
+    node_name: str,
+    args: list[str],
+    start: Callable[[Any, RosRuntime], T],
+    *,
+    serve: Callable[[T], None] | None = None,
+    on_signal: Callable[[T], None] | None = None,
+    before_shutdown: Callable[[T], None] | None = None,
+    after_shutdown: Callable[[T], None] | None = None,
+) -> NoReturn:
+    """A console script's life on one rclpy node, then ``sys.exit``: start rclpy (exit 2 on
+    a bad ``--ros-args`` or no rclpy), ``start(node, runtime)`` the program, spin, install
+    the signal handlers (a signal calls ``on_signal``), ``serve`` it (default: wait for a
+    stop), and on the way out ``before_shutdown`` (e.g. a last zero cmd_vel, while the
+    context still lives), the runtime's shutdown, ``after_shutdown``. A ``PmNavError``
+    prints ``program: message`` and exits 1."""
+    try:
+        runtime = RosRuntime(args=args)
+    except PmNavError as err:  # rclpy missing, or bad --ros-args
+        print(f"{program}: {err}", file=sys.stderr)
+        sys.exit(2)
+    from rclpy.node import Node
+
+    node = Node(node_name, context=runtime.context)
+    owner = None
+    code = 0
+    try:
+        owner = start(node, runtime)
+        runtime.add(node)
+        runtime.install_signals(None if on_signal is None else lambda: on_signal(owner))
+        runtime.start()
+        if serve is not None:
+            serve(owner)
+        else:
+            while not runtime.stop_requested.wait(0.2):
+                pass
+    except PmNavError as err:
+        print(f"{program}: {err}", file=sys.stderr)
+        code = 1
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if owner is not None and before_shutdown is not None:
+            before_shutdown(owner)
+        runtime.shutdown()
+        if owner is not None and after_shutdown is not None:
+            after_shutdown(owner)
+    sys.exit(code)

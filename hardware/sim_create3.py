@@ -268,7 +268,7 @@ def main(argv: list[str] | None = None) -> None:
     """Console script ``pmnav-sim-create3``: ``pmnav-sim-create3 --ros-args -p
     building:=fig2_hospital -p start_pose:=22,0,0``."""
     from pmnav_bt.hardware.params import usage, wants_help
-    from pmnav_bt.hardware.runtime import RosRuntime
+    from pmnav_bt.hardware.runtime import run_node
 
     args = list(sys.argv if argv is None else argv)
     if wants_help(args):
@@ -276,33 +276,13 @@ def main(argv: list[str] | None = None) -> None:
                     "pmnav-sim-create3 --ros-args -p building:=fig2_hospital "
                     "-p start_pose:=47,20,0"))  # fmt: skip
         sys.exit(0)
-    try:
-        runtime = RosRuntime(args=args)
-    except PmNavError as err:  # rclpy missing, or bad --ros-args
-        print(f"pmnav-sim-create3: {err}", file=sys.stderr)
-        sys.exit(2)
-    from rclpy.node import Node
-
-    node = Node("sim_create3", context=runtime.context)
-    sim = None
-    code = 0
-    try:
-        sim = SimCreate3(node)
-        runtime.add(node)
-        runtime.install_signals()
-        runtime.start()
-        while not runtime.stop_requested.wait(0.2):
-            pass
-    except PmNavError as err:
-        print(f"pmnav-sim-create3: {err}", file=sys.stderr)
-        code = 1
-    except KeyboardInterrupt:
-        pass
-    finally:
-        runtime.shutdown()
-        if sim is not None:
-            sim.close()
-    sys.exit(code)
+    run_node(
+        "pmnav-sim-create3",
+        "sim_create3",
+        args,
+        lambda node, _runtime: SimCreate3(node),
+        after_shutdown=SimCreate3.close,
+    )
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -32,7 +32,7 @@ FILE_HELP = "A building file (YAML) or the name of a built-in building (see 'pmn
 
 
 def _priori_map(file: str):
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
 
     return parse_building(load_building(file))
@@ -40,7 +40,7 @@ def _priori_map(file: str):
 
 def _folder(file: str) -> Path:
     """The folder a building file's relative paths (floor plan) are resolved against."""
-    from pmnav_bt.map.building import resolve_building_path
+    from pmnav_bt.map.catalogue import resolve_building_path
 
     return resolve_building_path(file).parent
 
@@ -48,7 +48,7 @@ def _folder(file: str) -> Path:
 @app.command()
 def buildings() -> None:
     """List the built-in buildings."""
-    from pmnav_bt.map.building import builtin_buildings, load_building
+    from pmnav_bt.map.catalogue import builtin_buildings, load_building
 
     for name in builtin_buildings():
         b = load_building(name)
@@ -77,7 +77,7 @@ def validate(
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as problems (exit 1)."),
 ) -> None:
     """Check a building file: list every problem (exit 1), then warnings about runs."""
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.checks import building_warnings
     from pmnav_bt.map.priori_map import parse_building
 

@@ -16,7 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from pmnav_bt.errors import ConfigError, PmNavError
 from pmnav_bt.eval.task import BUDGET_ACTIONS, BUDGET_PATH_FACTOR, STOP_OFFSET_M
 from pmnav_bt.loading import InputFileError, load_yaml, parse_yaml_value
-from pmnav_bt.planning.graph_planner import MAX_GAP_M
+from pmnav_bt.planning.plan import MAX_GAP_M
 from pmnav_bt.seams import CREATE3_MAX_ANGULAR, CREATE3_MAX_LINEAR
 
 # The pixel-goal policy's reliable range (m): its skill eval (docs/pixelnav.md) gives SR 100 %
@@ -45,6 +45,10 @@ def _registered(seam: str):
 
 
 class GrounderConfig(_Section):
+    """The grounder: reads door and landmark signs, and finds floor and walls, in a view.
+    The `miss_rate` ... `hidden` keys shape the `sim_gt` oracle only; see
+    [perception.md](perception.md) for the `ocr` and `gdino_sam` back ends."""
+
     backend: str = Field(
         "ocr",
         description="grounder back end (pmnav backends lists them); sim_gt: the simulator's "
@@ -68,10 +72,15 @@ class GrounderConfig(_Section):
         default_factory=list, description="room/landmark IDs whose signs are never read"
     )
     # -- ocr and gdino_sam (real perception) --
-    ocr_threads: int = Field(1, ge=1, description="ocr: onnxruntime threads per model")
-    ocr_max_candidates: int = Field(4, ge=1, description="ocr: sign plates read per frame")
+    ocr_threads: int = Field(1, ge=1, description="ocr, gdino_sam: onnxruntime threads per model")
+    ocr_max_candidates: int = Field(
+        4, ge=1, description="ocr, gdino_sam: sign plates read per frame"
+    )
     ocr_min_score: float = Field(
-        0.6, ge=0.0, le=1.0, description="ocr: text lines read with a lower score are dropped"
+        0.6,
+        ge=0.0,
+        le=1.0,
+        description="ocr, gdino_sam: text lines read with a lower score are dropped",
     )
     sign_to_door: float = Field(
         1.14, gt=0.0, description="m from a door sign's centre to its door's centre"
@@ -90,12 +99,21 @@ class GrounderConfig(_Section):
 
 
 class CoarseConfig(_Section):
+    """Coarse direction: which view of a panorama shows the target."""
+
     backend: str = Field("detector", description="panorama views -> the view of the target")
     _check_backend = _registered("coarse")
     min_score: float = Field(0.3, ge=0.0, le=1.0, description="weaker detections are ignored")
 
 
 class RefinerConfig(_Section):
+    """The refiner: the goal pixel in the chosen view -> a bearing and range to the door.
+    It serves the full `pmnav` variant; the coarse-only ablation of the paper's Table 4 is a
+    tree shape, so `tree.variant` is its one switch: `coarse_only` leaves the grounding step
+    out of the tree and does not call the refiner (the target is taken straight ahead of the
+    view it was seen in, at the distance the map predicts), and `refiner.backend` has no
+    `coarse_only` value."""
+
     backend: str = Field("geometric", description="goal pixel -> bearing (and range)")
     _check_backend = _registered("refiner")
     weights: str = Field(
@@ -109,11 +127,15 @@ class RefinerConfig(_Section):
         gt=0.0,
         le=100.0,
         description="pixelnav: the policy approaches a door at most this far (m) on the map "
-        "when grounded; farther, the map approach (its skill eval: SR >= 84.6 % up to 4 m)",
+        "when grounded; farther, the map approach (chosen from the first, 16-frame model's "
+        "skill eval: SR >= 84.6 % up to 4 m; docs/pixelnav.md)",
     )
 
 
 class PlannerConfig(_Section):
+    """The global planner: the priori-map, a start and a goal room -> a plan of
+    `{landmark: action}` steps."""
+
     backend: str = Field("graph", description="priori-map + start + goal -> plan")
     _check_backend = _registered("planner")
     max_gap: float = Field(
@@ -122,7 +144,8 @@ class PlannerConfig(_Section):
 
 
 class VlmConfig(_Section):
-    """An OpenAI-compatible chat-completions server (vLLM, Ollama, llama.cpp, OpenAI)."""
+    """An OpenAI-compatible chat-completions server (vLLM, Ollama, llama.cpp, OpenAI) for the
+    `vlm` planner and coarse-direction back ends (see [vlm.md](vlm.md))."""
 
     base_url: str = Field(
         "http://127.0.0.1:8000/v1", description="server URL up to /v1 (chat/completions is added)"
@@ -133,17 +156,23 @@ class VlmConfig(_Section):
     )
     timeout_s: float = Field(60.0, gt=0.0, description="seconds per HTTP request")
     retries: int = Field(3, ge=0, description="retries after a 429, a 5xx or a dropped connection")
-    backoff_s: float = Field(1.0, ge=0.0, description="first retry delay, doubled each retry")
+    backoff_s: float = Field(
+        1.0, ge=0.0, description="first retry delay, doubled each retry (a Retry-After header wins)"
+    )
     max_tokens: int = Field(1024, ge=1, description="most tokens an answer may have")
     temperature: float = Field(0.0, ge=0.0, le=2.0, description="sampling temperature")
     prompt: Literal["h-pm", "h-em", "o-em"] = Field(
-        "h-pm", description="planning prompt: H-CoT + annotated map, H-CoT + raw map, ordinary"
+        "h-pm",
+        description="planning prompt: H-CoT + annotated map (h-pm), H-CoT + raw map (h-em), "
+        "ordinary (o-em)",
     )
     plan_tries: int = Field(
         3, ge=1, description="VLM answers per plan (the first, then re-prompts quoting errors)"
     )
     max_detour: float = Field(
-        0.5, ge=0.0, description="a plan longer than the shortest by more than this is an error"
+        0.5,
+        ge=0.0,
+        description="a plan longer than the shortest by more than this is an error (detour)",
     )
     fallback: bool = Field(
         True, description="plan with the graph planner when no VLM answer is valid or it fails"
@@ -156,6 +185,15 @@ class VlmConfig(_Section):
 
 
 class TreeConfig(_Section):
+    """The behaviour tree. The defaults of `planner.max_gap`, `tree.budget_actions`,
+    `tree.budget_path_factor` and `tree.goal_offset` are defined once in the code
+    (`pmnav_bt/planning/plan.py` `MAX_GAP_M`, `pmnav_bt/eval/task.py`), which every command
+    uses: the action budget of an episode is
+    `max(budget_actions, ceil(budget_path_factor * route / 0.25 m))`, the route being the
+    corridor route from the start to the stop point `goal_offset` from the door. Success is
+    stopping within 1 m of the door (`pmnav_bt/eval/task.py` `SUCCESS_RADIUS_M`), so
+    `goal_offset` must stay below 1 m."""
+
     variant: str = Field(
         "pmnav",
         description="the tree, by name (registered in trees/variants.py: the context and "
@@ -197,15 +235,16 @@ class TreeConfig(_Section):
         4,
         ge=1,
         le=100,
-        description="searches for one landmark (the last from level with it: a sign on the "
-        "door's far side is readable only from there)",
+        description="searches for one landmark: at search_range, then every "
+        "research_distance on, up to level with it (a sign on the door's far side is readable "
+        "only from there)",
     )
     research_distance: float | None = Field(
         None,
         gt=0.0,
         le=100.0,
         description="move this far towards a target not found before searching again; "
-        "unset: from the grounder's read range",
+        "unset: half the search range, at most 2 m",
     )
     replans: int = Field(2, ge=0, le=100, description="re-localize-and-replan recoveries")
     goal_offset: float = Field(
@@ -219,6 +258,8 @@ class TreeConfig(_Section):
 
 
 class SimConfig(_Section):
+    """The simulator: its camera, its odometry's noise and where its walls come from."""
+
     width: int = Field(320, ge=16, le=1920, description="camera pixels (60 deg horizontal field)")
     height: int = Field(240, ge=16, le=1080, description="camera pixels")
     reading_width: int = Field(
@@ -227,18 +268,32 @@ class SimConfig(_Section):
         le=1920,
         description="pixels: the camera also offers each view this wide for reading signs "
         "(only the plates' crops are made, when the grounder reads; the tree's other checks "
-        "keep width x height); 0 or at most width: none",
+        "keep width x height; the reader's range follows it, docs/perception.md); 0 or at "
+        "most width: none",
     )
     odometry_noise: float = Field(
         0.02, ge=0.0, le=1.0, description="std of the relative error of each odometry increment"
     )
     walls: Literal["corridors", "grid"] = Field(
         "corridors",
-        description="walls from the annotated corridors, or from the ros_map grid's occupied cells",
+        description="walls from the annotated corridors, or from the ros_map grid's occupied cells "
+        "(grid; docs/real-maps.md)",
     )
 
 
 class Config(_Section):
+    """One typed config chooses the back ends and sets the tree, the grounder and the
+    simulator. Give a YAML file with `--config FILE` (every key optional) and override single
+    values with `--set section.key=value` (the value is read as YAML, e.g.
+    `--set grounder.hidden=[room4]`; `1e-3` is read as a number). Unknown keys and bad values
+    are errors that name the key. Types are strict: `"10"` or `true` is not a number. Every
+    number has a range that keeps a run finite in time and memory (the tables' last column).
+
+        grounder: {miss_rate: 0.2}
+        tree: {variant: coarse_only, replans: 1}
+        sim: {width: 640, height: 480}
+    """
+
     grounder: GrounderConfig = GrounderConfig()
     coarse: CoarseConfig = CoarseConfig()
     refiner: RefinerConfig = RefinerConfig()

@@ -1,4 +1,5 @@
-"""Small planar geometry: headings, compass words, relative actions, point-to-segment projection.
+"""Small planar geometry: headings, compass words, relative actions, point-to-segment
+projection, SE(2) poses, axis-aligned rectangles.
 
 Map frame is REP-103: x east, y north, headings counter-clockwise from +x, radians.
 """
@@ -6,6 +7,7 @@ Map frame is REP-103: x east, y north, headings counter-clockwise from +x, radia
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
@@ -144,3 +146,24 @@ def fit_se2(src: np.ndarray, dst: np.ndarray) -> tuple[tuple[float, float, float
     tf = (float(t[0]), float(t[1]), th)
     res = np.array([se2_apply(tf, p) for p in src]) - dst
     return tf, float(np.sqrt((res**2).sum(axis=1).mean()))
+
+
+@dataclass(frozen=True)
+class Rect:
+    """An axis-aligned rectangle in the map frame (metres): an open area a floor plan's
+    draft flags (``map.draft``), a wall box the simulator builds from a grid
+    (``sim.grid_walls``)."""
+
+    xmin: float
+    ymin: float
+    xmax: float
+    ymax: float
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        return (self.xmin + self.xmax) / 2.0, (self.ymin + self.ymax) / 2.0
+
+    @property
+    def half(self) -> tuple[float, float]:
+        """Half its width and half its height."""
+        return (self.xmax - self.xmin) / 2.0, (self.ymax - self.ymin) / 2.0

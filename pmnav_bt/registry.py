@@ -1,9 +1,12 @@
-"""Back ends by name: one registry per seam, one factory for the simulator and the robot.
+"""Back ends by name: one registry per seam.
 
 Each seam (grounder, coarse direction, refiner, planner) has a registry of named back
 ends. An entry points at its factory as ``"module:function"`` and is imported only when
 chosen, so heavy back ends (OCR models, torch networks, an HTTP client) cost nothing
-unless configured. A factory takes the ``BackendDeps`` and returns the back end.
+unless configured. A factory takes the ``backends.BackendDeps`` and returns the back end;
+``backends.build_backends`` builds a run's back ends from the config, for the simulator
+and the robot alike. The config checks its ``backend`` names here, so this module knows
+nothing of the config.
 
     >>> GROUNDERS.names()
     ['sim_gt', ...]
@@ -20,14 +23,9 @@ from __future__ import annotations
 import difflib
 import importlib
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from pmnav_bt.errors import BackendError, ConfigError
-
-if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.config import Config
-    from pmnav_bt.map.priori_map import PrioriMap
-    from pmnav_bt.seams import CoarseDirection, Grounder, Planner, Refiner
 
 
 @dataclass(frozen=True)
@@ -66,15 +64,11 @@ class GrounderSpec(BackendSpec):
         return super().tags + (["oracle"] if self.oracle else [])
 
 
-@dataclass
-class BackendDeps:
-    """What a factory may use to build its back end."""
+class FactoryDeps(Protocol):
+    """What a registry reads of a factory's inputs (``backends.BackendDeps``) before it
+    builds: whether the run is on a robot."""
 
-    config: Config
-    pm: PrioriMap
-    seed: int = 0
-    on_robot: bool = False
-    grounder: Grounder | None = None  # built first; for back ends that ground (coarse)
+    on_robot: bool
 
 
 class Named:
@@ -121,7 +115,7 @@ class Registry(Named):
         self.seam = seam
         super().__init__(f"{seam}.backend", "back end", specs, kind)
 
-    def build(self, name: str, deps: BackendDeps) -> Any:
+    def build(self, name: str, deps: FactoryDeps) -> Any:
         """Build the back end ``name`` (refusing simulator-only back ends on a robot)."""
         spec = self.spec(name)
         if spec.needs_sim_labels and deps.on_robot:
@@ -221,29 +215,3 @@ PLANNERS = Registry(
     ],
 )
 REGISTRIES = {r.seam: r for r in (GROUNDERS, COARSE, REFINERS, PLANNERS)}
-
-
-@dataclass
-class Backends:
-    """The back ends of one run, built from the config."""
-
-    grounder: Grounder
-    coarse: CoarseDirection
-    refiner: Refiner
-    planner: Planner | None  # None: the map-less baseline plans nothing
-
-
-def build_backends(
-    config: Config, pm: PrioriMap, *, on_robot: bool, seed: int = 0, planner: bool = True
-) -> Backends:
-    """Every seam's back end, as ``config`` names them (the simulator and the robot alike);
-    ``planner=False``: no planner (a tree variant that plans nothing, e.g. the map-less
-    baseline, whose ``pm`` is then its sign vocabulary: ``map.signs_only.SignsOnly``)."""
-    deps = BackendDeps(config=config, pm=pm, seed=seed, on_robot=on_robot)
-    deps.grounder = GROUNDERS.build(config.grounder.backend, deps)
-    return Backends(
-        grounder=deps.grounder,
-        coarse=COARSE.build(config.coarse.backend, deps),
-        refiner=REFINERS.build(config.refiner.backend, deps),
-        planner=PLANNERS.build(config.planner.backend, deps) if planner else None,
-    )

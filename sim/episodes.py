@@ -42,15 +42,15 @@ from pmnav_bt.eval.tiers import (
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, relative_action, wrap_angle
 from pmnav_bt.loading import InputFileError, atomic_write_text, load_json
-from pmnav_bt.map.building import (
-    Building,
+from pmnav_bt.map.building import Building
+from pmnav_bt.map.catalogue import (
     building_sha256,
     builtin_buildings,
+    is_generated_name,
     load_building,
     resolve_building_path,
 )
 from pmnav_bt.map.free_space import free_space_polygon
-from pmnav_bt.map.generate import is_generated_name
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.seams import CREATE3_RADIUS_M, Pose2D

@@ -10,34 +10,17 @@ same columns in consecutive rows, so a straight wall is one box.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import cv2
 import numpy as np
 
+from pmnav_bt.geometry import Rect
 from pmnav_bt.map.floorplan import FREE, FloorPlanError, FloorPlanImage, fill_world_polygons
 from pmnav_bt.map.grid import free_mask
 
 BAND_CELLS = 2  # wall thickness: non-free cells within this many cells of free space
 SMOOTH_M = 0.15  # free-space specks and slivers thinner than this are dropped
-
-
-@dataclass(frozen=True)
-class Box:
-    """An axis-aligned rectangle in the map frame (metres)."""
-
-    xmin: float
-    ymin: float
-    xmax: float
-    ymax: float
-
-    @property
-    def centre(self) -> tuple[float, float]:
-        return (self.xmin + self.xmax) / 2.0, (self.ymin + self.ymax) / 2.0
-
-    @property
-    def half(self) -> tuple[float, float]:
-        return (self.xmax - self.xmin) / 2.0, (self.ymax - self.ymin) / 2.0
 
 
 def sim_free(plan: FloorPlanImage) -> np.ndarray:
@@ -89,7 +72,7 @@ def merge_cells(must: np.ndarray, may: np.ndarray | None = None) -> list[tuple[i
     return rects
 
 
-def grid_wall_boxes(plan: FloorPlanImage, band: int = BAND_CELLS, clear=()) -> list[Box]:
+def grid_wall_boxes(plan: FloorPlanImage, band: int = BAND_CELLS, clear=()) -> list[Rect]:
     """The grid's walls as map-frame boxes (the grid must not be rotated).
 
     ``clear``: convex map-frame polygons whose cells count as free (kept clear of walls).
@@ -110,5 +93,5 @@ def grid_wall_boxes(plan: FloorPlanImage, band: int = BAND_CELLS, clear=()) -> l
     free = sim_free(plan)
     for r0, c0, r1, c1 in merge_cells(wall_cells(free, band), ~free):
         # Image row r covers map y from oy + (h - 1 - r) * res to oy + (h - r) * res.
-        out.append(Box(ox + c0 * res, oy + (h - r1) * res, ox + c1 * res, oy + (h - r0) * res))
+        out.append(Rect(ox + c0 * res, oy + (h - r1) * res, ox + c1 * res, oy + (h - r0) * res))
     return out

@@ -12,11 +12,32 @@ from __future__ import annotations
 import math
 import random
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.seams import Observation, Pose2D
+from pmnav_bt.seams import Base, Observation, Pose2D
 from pmnav_bt.sim.robot import SimBase
 from pmnav_bt.wrapped_base import WrappedBase
+
+if TYPE_CHECKING:  # pragma: no cover
+    from pmnav_bt.config import SimConfig
+    from pmnav_bt.sim.world import SimWorld
+
+
+def simulated_robot(
+    world: SimWorld, sim: SimConfig, pose: Pose2D, seed: int
+) -> tuple[SimBase, Base]:
+    """The robot of a simulated run as the config's ``sim`` section describes it: the body
+    (ground truth: its true pose and its stats) with the camera of ``sim.width`` x
+    ``sim.height`` (and ``sim.reading_width``), and the base the tree drives: the body seen
+    through drifting odometry (``NoisyOdometry``, seeded by ``seed``), or the body itself
+    when ``sim.odometry_noise`` is 0."""
+    body = SimBase(
+        world, pose=pose, width=sim.width, height=sim.height, reading_width=sim.reading_width
+    )
+    if sim.odometry_noise > 0:
+        return body, NoisyOdometry(body, sim.odometry_noise, seed=seed)
+    return body, body
 
 
 class NoisyOdometry(WrappedBase):

@@ -24,7 +24,8 @@ from pmnav_bt.eval.geodesic import GeodesicField
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
 from pmnav_bt.eval.task import SUCCESS_RADIUS_M
 from pmnav_bt.geometry import heading, wrap_angle
-from pmnav_bt.map.building import Building, builtin_buildings, load_building
+from pmnav_bt.map.building import Building
+from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.seams import CREATE3_RADIUS_M, FORWARD_STEP_M, DiscreteAction, MotionStatus
 from pmnav_bt.sim.clock import SimClock

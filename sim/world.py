@@ -26,13 +26,8 @@ import shapely
 from shapely.geometry import MultiPolygon, Polygon
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.map.building import (
-    Building,
-    Landmark,
-    WaypointKind,
-    load_building,
-    resolve_building_path,
-)
+from pmnav_bt.map.building import Building, Landmark, WaypointKind
+from pmnav_bt.map.catalogue import load_building, resolve_building_path
 from pmnav_bt.map.free_space import free_space_polygon
 from pmnav_bt.seams import (
     CAMERA_HEIGHT_M,

@@ -7,7 +7,7 @@ import pytest
 from blackboard_kit import cleared
 from rig import BODIES, Rig, build_rig
 
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.seams import Pose2D
 

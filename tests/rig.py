@@ -27,11 +27,11 @@ import py_trees
 from blackboard_kit import BlackboardAccess, writer
 from py_trees.common import Status
 
+from pmnav_bt.backends import Backends
 from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.config import load_config
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.registry import Backends
 from pmnav_bt.seams import CameraIntrinsics, MotionStatus, Pose2D
 from pmnav_bt.testing.doubles import (
     FakeBase,

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.map.building import building_from_data, load_building
+from pmnav_bt.map.building import building_from_data
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.floorplan import FloorPlanImage, rasterize_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.render.annotate import (

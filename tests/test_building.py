@@ -11,14 +11,8 @@ import pytest
 import yaml
 
 from pmnav_bt.errors import BuildingFileError
-from pmnav_bt.map.building import (
-    Building,
-    building_from_data,
-    builtin_buildings,
-    dump_building,
-    load_building,
-    save_building,
-)
+from pmnav_bt.map.building import Building, building_from_data, dump_building, save_building
+from pmnav_bt.map.catalogue import builtin_buildings, load_building
 
 GOOD = {
     "schema_version": 1,

@@ -5,7 +5,8 @@ from __future__ import annotations
 import yaml
 
 from pmnav_bt.cli import app
-from pmnav_bt.map.building import building_from_data, load_building, resolve_building_path
+from pmnav_bt.map.building import building_from_data
+from pmnav_bt.map.catalogue import load_building, resolve_building_path
 from pmnav_bt.map.checks import (
     building_warnings,
     door_warnings,

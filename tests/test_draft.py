@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pmnav_bt.map.building import builtin_buildings, load_building
+from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.map.draft import DraftError, draft_building
 from pmnav_bt.map.floorplan import FloorPlanImage, rasterize_building, save_ros_map
 

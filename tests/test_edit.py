@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from pmnav_bt.map.building import load_building, resolve_building_path
+from pmnav_bt.map.catalogue import load_building, resolve_building_path
 from pmnav_bt.map.edit import BuildingEditor, EditError
 
 

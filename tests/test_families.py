@@ -8,8 +8,8 @@ import dataclasses
 import pytest
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.experiments.sim_cli import _buildings
-from pmnav_bt.map.generate import family_members, generated_family
+from pmnav_bt.experiments.options import building_names
+from pmnav_bt.map.catalogue import family_members, generated_family
 from pmnav_bt.sim.episodes import episode_building_file, generate_episodes
 
 
@@ -23,13 +23,13 @@ def test_family_specs_name_the_first_members():
 
 
 def test_the_building_option_mixes_families_and_names():
-    assert _buildings("straight_office,sign_sparse:2") == [
+    assert building_names("straight_office,sign_sparse:2") == [
         "straight_office",
         "sign_sparse_0",
         "sign_sparse_1",
     ]
     with pytest.raises(PmNavError, match="--building"):
-        _buildings("gen_small:x")
+        building_names("gen_small:x")
 
 
 def test_small_family_members_are_seeded_and_pose_easy_episodes(tmp_path, monkeypatch):

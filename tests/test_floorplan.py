@@ -10,7 +10,8 @@ import pytest
 import yaml
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.map.building import building_from_data, load_building
+from pmnav_bt.map.building import building_from_data
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.floorplan import (
     FREE,
     OCCUPIED,

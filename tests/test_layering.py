@@ -1,6 +1,7 @@
 """Layering, by import analysis of every module (imports inside functions included):
 the core imports none of the layers built on it; ``experiments`` is the one layer that
-joins simulator, tree and metrics. And every third-party import is a declared dependency."""
+joins simulator, tree and metrics; no layer's modules import each other in a circle. And
+every third-party import is a declared dependency."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import re
 import sys
 from pathlib import Path
 
+import networkx as nx
 import pytest
 
 tomllib = pytest.importorskip("tomllib")  # Python 3.11+
@@ -39,15 +41,23 @@ def layer_of_module(name: str) -> str | None:
     return "core"
 
 
+def modules_under(package: str, folder: Path) -> dict[str, Path]:
+    """The modules of ``package``, whose files are in ``folder``: import name -> file."""
+    out = {}
+    for path in folder.rglob("*.py"):
+        rel = path.relative_to(folder).with_suffix("").parts
+        out[".".join([package, *(p for p in rel if p != "__init__")])] = path
+    return out
+
+
 def shipped_modules() -> dict[str, Path]:
     """Every module of the wheel: import name -> file."""
     out = {}
     for package, folder in PYPROJECT["tool"]["setuptools"]["package-dir"].items():
-        for path in (ROOT / folder).rglob("*.py"):
-            rel = path.relative_to(ROOT / folder).with_suffix("").parts
-            if package == "pmnav_bt" and rel and rel[0] in SUBLAYERS and rel[0] != "experiments":
+        for name, path in modules_under(package, ROOT / folder).items():
+            top = name.split(".")[1] if package == "pmnav_bt" and "." in name else None
+            if top in SUBLAYERS and top != "experiments":
                 continue  # installed from its own folder
-            name = ".".join([package, *(p for p in rel if p != "__init__")])
             out[name] = path
     return out
 
@@ -84,6 +94,32 @@ def imports(path: Path, module: str, fallbacks: bool = True) -> list[tuple[int, 
     return out
 
 
+def import_graph(modules: dict[str, Path]) -> nx.DiGraph:
+    """module -> each module of ``modules`` it imports, from any line of its file (the
+    module's top, a function's body, an ``if TYPE_CHECKING:`` block): what ``imports``
+    finds by walking the file's syntax tree. ``from pmnav_bt.map.building import Building``
+    is an edge to ``pmnav_bt.map.building``, the longest module name the import starts with."""
+    graph = nx.DiGraph()
+    graph.add_nodes_from(modules)
+    for name, path in modules.items():
+        for _, target in imports(path, name):
+            while target and target not in modules:
+                target = target.rpartition(".")[0]
+            if target and target != name:
+                graph.add_edge(name, target)
+    return graph
+
+
+def import_cycles(modules: dict[str, Path]) -> list[list[str]]:
+    """Every circle of imports among ``modules`` (networkx ``simple_cycles``), each one
+    starting at its first module in alphabetical order; sorted."""
+    out = []
+    for cycle in nx.simple_cycles(import_graph(modules)):
+        k = cycle.index(min(cycle))
+        out.append(cycle[k:] + cycle[:k])
+    return sorted(out)
+
+
 MODULES = shipped_modules()
 
 
@@ -104,6 +140,34 @@ def test_each_layer_imports_only_what_it_may(layer):
             if other not in (None, "core", layer) and other not in ALLOWED[layer]:
                 bad.append(f"{path.relative_to(ROOT)}:{line} imports {target}")
     assert not bad, f"the {layer} layer may not import these:\n" + "\n".join(bad)
+
+
+@pytest.mark.parametrize("layer", sorted(ALLOWED))
+def test_no_layer_imports_itself_in_a_circle(layer):
+    """A circle (``config`` imports ``registry``, which imports ``config``) leaves no module
+    below the other: neither can be read, tested or reused alone, and a lazy import that
+    hides one from Python at import time still counts here."""
+    modules = {n: p for n, p in MODULES.items() if layer_of_module(n) == layer}
+    cycles = import_cycles(modules)
+    assert not cycles, f"import circles in the {layer} layer:\n" + "\n".join(
+        " -> ".join([*c, c[0]]) for c in cycles
+    )
+
+
+def test_a_circle_through_a_lazy_import_is_found(tmp_path):
+    """The analysis itself: a planted circle, closed by a relative import inside a function."""
+    pkg = tmp_path / "pkg"
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "sub" / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("from pkg.sub.b import helper\n")
+    (pkg / "sub" / "b.py").write_text("def helper():\n    from .. import a\n\n    return a\n")
+    (pkg / "c.py").write_text("from pkg.a import helper\nfrom pkg.sub import b\n")
+    modules = modules_under("pkg", pkg)
+    assert set(modules) == {"pkg", "pkg.sub", "pkg.a", "pkg.sub.b", "pkg.c"}
+    assert import_cycles(modules) == [["pkg.a", "pkg.sub.b"]]
+    (pkg / "sub" / "b.py").write_text("def helper():\n    return 1\n")
+    assert import_cycles(modules) == []
 
 
 def _declared() -> set[str]:

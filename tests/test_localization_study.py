@@ -14,7 +14,7 @@ from pmnav_bt.experiments.localization_study import (
     classified_starts,
     table,
 )
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.perception.read_range import entity_plate_kind, landmark_ranges
 from pmnav_bt.pose.visibility import (

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+from pmnav_bt.backends import build_backends
 from pmnav_bt.cli import main
 from pmnav_bt.config import load_config
 from pmnav_bt.errors import BackendError, ConfigError
@@ -18,7 +19,6 @@ from pmnav_bt.registry import (
     REGISTRIES,
     BackendSpec,
     GrounderSpec,
-    build_backends,
     grounder_label,
 )
 from pmnav_bt.seams import CoarseDirection, Grounder, Planner, Refiner

@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
-from pmnav_bt.map.building import load_building, resolve_building_path
+from pmnav_bt.map.catalogue import load_building, resolve_building_path
 from pmnav_bt.map.edit import BuildingEditor
 from pmnav_bt.map.floorplan import rasterize_building, save_ros_map
 

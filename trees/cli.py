@@ -45,7 +45,7 @@ def _build_tree(variant: str):
     import py_trees
 
     from pmnav_bt.config import load_config
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.testing.doubles import FakeBase
     from pmnav_bt.trees.runner import build_tree, make_context

@@ -15,13 +15,13 @@ from typing import TextIO
 
 import py_trees
 
+from pmnav_bt.backends import Backends, build_backends
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.config import Config
 from pmnav_bt.eval.task import action_budget as task_action_budget
 from pmnav_bt.failures import Failure, FailureCode, failure_from, root_cause
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.registry import Backends, build_backends
 from pmnav_bt.seams import Base
 from pmnav_bt.trees.snapshots import SnapshotLogger
 from pmnav_bt.trees.variants import TREE_VARIANTS

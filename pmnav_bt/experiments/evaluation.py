@@ -38,7 +38,7 @@ def custom_episode(building: str, goal: str, start: str | None = None, seed: int
     start waypoint (facing along its corridor)."""
     from pmnav_bt.eval.task import action_budget
     from pmnav_bt.eval.tiers import classify
-    from pmnav_bt.map.building import building_sha256, load_building, resolve_building_path
+    from pmnav_bt.map.catalogue import building_sha256, load_building, resolve_building_path
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.planning.resolve import resolve_room, resolve_start
     from pmnav_bt.seams import Pose2D
@@ -94,11 +94,11 @@ def run_episode(
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     """
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.episodes import episode_building_file, goal_geodesic, score_episode
-    from pmnav_bt.sim.odometry import NoisyOdometry
-    from pmnav_bt.sim.robot import COLLISION_HEIGHT, SimBase
+    from pmnav_bt.sim.odometry import simulated_robot
+    from pmnav_bt.sim.robot import COLLISION_HEIGHT
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
 
@@ -114,18 +114,7 @@ def run_episode(
         geodesic = goal_geodesic(pm, episode.goal, footprints, floor=world.floor_space())
         if setup_world is not None:
             setup_world(world)
-        inner = SimBase(
-            world,
-            pose=episode.start_pose,
-            width=sim.width,
-            height=sim.height,
-            reading_width=sim.reading_width,
-        )
-        base = (
-            NoisyOdometry(inner, sim.odometry_noise, seed=episode.seed)
-            if sim.odometry_noise > 0
-            else inner
-        )
+        inner, base = simulated_robot(world, sim, episode.start_pose, episode.seed)
         budget = action_budget(config, episode.route_length)
         ctx = make_context(base, pm, config, seed=episode.seed, budget=budget, deferred_work=True)
         truth: list[tuple[float, float, float]] = []

@@ -76,7 +76,7 @@ def classified_starts(
     """Up to ``n`` start poses of each landmark-density class in ``building`` (seeded),
     counting the landmarks readable within ``ranges`` (m per plate kind, as
     ``read_range.landmark_ranges``; None: ``READ_RANGE_M`` for every plate)."""
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
 
     b = load_building(building)
@@ -120,11 +120,10 @@ def run_localization(
     import py_trees
 
     from pmnav_bt.behaviours.common import NAMESPACE
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.seams import Pose2D
-    from pmnav_bt.sim.odometry import NoisyOdometry
-    from pmnav_bt.sim.robot import SimBase
+    from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.localize import active_localize_subtree
     from pmnav_bt.trees.runner import make_context
@@ -132,20 +131,9 @@ def run_localization(
     t0 = time.perf_counter()
     b = load_building(start.building)
     pm = parse_building(b)
-    sim = config.sim
+    pose = Pose2D(start.x, start.y, start.yaw)
     with SimWorld(b) as world:
-        inner = SimBase(
-            world,
-            pose=Pose2D(start.x, start.y, start.yaw),
-            width=sim.width,
-            height=sim.height,
-            reading_width=sim.reading_width,
-        )
-        base = (
-            NoisyOdometry(inner, sim.odometry_noise, seed=start.seed)
-            if sim.odometry_noise > 0
-            else inner
-        )
+        inner, base = simulated_robot(world, config.sim, pose, start.seed)
         ctx = make_context(base, pm, config, seed=start.seed, deferred_work=True)
         py_trees.blackboard.Blackboard.clear()
         tree = py_trees.trees.BehaviourTree(active_localize_subtree(ctx))

@@ -73,7 +73,8 @@ def route(
             pm, start, goal
         )
     else:
-        from pmnav_bt.registry import PLANNERS, BackendDeps
+        from pmnav_bt.backends import BackendDeps
+        from pmnav_bt.registry import PLANNERS
 
         gap = [] if max_gap is None else [f"planner.max_gap={max_gap}"]
         cfg = load_config(config, [*(overrides or []), *gap])
@@ -108,6 +109,7 @@ def eval_(
 ) -> None:
     """Planning SR per input and tier (paper Table 2), against an OpenAI-compatible server."""
     from pmnav_bt import cli_values
+    from pmnav_bt.experiments.options import building_names, tier_names
     from pmnav_bt.experiments.plan_eval import (
         correct_rule,
         plan_tasks,
@@ -116,7 +118,6 @@ def eval_(
         save_results,
         table_markdown,
     )
-    from pmnav_bt.experiments.sim_cli import _buildings, _tiers
     from pmnav_bt.loading import check_output_dir
     from pmnav_bt.sim.episodes import tier_definition
 
@@ -146,7 +147,7 @@ def eval_(
     cfg = load_config(config, sets)
     client = VlmClient.from_config(cfg.vlm)
     names = [i.strip() for i in inputs.split(",") if i.strip()]
-    tasks, notes = plan_tasks(_buildings(building), _tiers(tier), n, seed)
+    tasks, notes = plan_tasks(building_names(building), tier_names(tier), n, seed)
     for note in notes:
         typer.echo(f"note: {note}", err=True)
     if not tasks:

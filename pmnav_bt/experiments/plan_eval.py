@@ -24,7 +24,7 @@ import cv2
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.loading import load_json
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.planning.graph_planner import shortest_route
 from pmnav_bt.planning.resolve import StartPoint

@@ -289,19 +289,11 @@ def report(
     """Run (or resume) the evaluation and the Table 3 study, then write report.md with
     Tables 1, 3 and 4 beside the paper's, plots, trajectories, config and commit."""
     from pmnav_bt import cli_values
+    from pmnav_bt.experiments import options
     from pmnav_bt.experiments.evaluation import episodes_for
     from pmnav_bt.experiments.localization_study import classified_starts
-    from pmnav_bt.experiments.sim_cli import (
-        _buildings,
-        _class_ranges,
-        _config,
-        _jobs,
-        _ranges_text,
-        _tiers,
-    )
     from pmnav_bt.experiments.stored_run import StoredRun, run_stored_evaluation, run_stored_study
     from pmnav_bt.experiments.variants import VARIANTS, variant_configs
-    from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
 
     if from_dir is not None:
         md = render_report(from_dir)
@@ -309,12 +301,12 @@ def report(
         return
     cli_values.count(n, "-n")
     cli_values.seed(seed)
-    jobs = _jobs(jobs)
-    base = _config(config, overrides)
+    jobs = options.job_count(jobs)
+    base = options.run_config(config, overrides)
     check_output_dir(out)
     names = [v.strip() for v in variants.split(",") if v.strip()] or list(VARIANTS)
     configs = variant_configs(base, names)
-    eps, notes = episodes_for(_buildings(building), _tiers(tier), n, seed)
+    eps, notes = episodes_for(options.building_names(building), options.tier_names(tier), n, seed)
     for note in notes:
         typer.echo(f"note: {note}", err=True)
     if not eps:
@@ -322,19 +314,14 @@ def report(
     starts: list = []
     t3 = None
     if not no_table3:
-        t3_names: list[str] = []
-        for part in (p.strip() for p in table3_building.split(",") if p.strip()):
-            if part == SIGN_SPARSE_FAMILY:
-                t3_names += [f"{SIGN_SPARSE_FAMILY}_{k}" for k in range(family_size)]
-            else:
-                t3_names += _buildings(part)
-        ranges = _class_ranges("stack", base)
+        t3_names = options.table3_building_names(table3_building, family_size)
+        ranges = options.class_ranges("stack", base)
         starts = [s for b in t3_names for s in classified_starts(b, table3_n, seed, ranges)]
         t3 = {
             "building": ", ".join(t3_names),
             "n": table3_n,
             "grounder": base.grounder.backend,
-            "class_range": _ranges_text(ranges),
+            "class_range": options.ranges_text(ranges),
         }
     ev = {"building": building, "tier": tier, "n": n, "seed": seed}
     out.mkdir(parents=True, exist_ok=True)

@@ -14,6 +14,15 @@ import typer
 
 from pmnav_bt import cli_values
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.experiments.options import (
+    building_names,
+    class_ranges,
+    job_count,
+    ranges_text,
+    run_config,
+    table3_building_names,
+    tier_names,
+)
 from pmnav_bt.loading import check_output_dir, check_output_file, safe_filename
 from pmnav_bt.registry import grounder_label
 from pmnav_bt.sim.poses import PoseError, parse_pose  # noqa: F401 - PoseError: part of this CLI
@@ -93,36 +102,6 @@ def _hold_gui(world) -> None:  # pragma: no cover - needs a display
         pass
 
 
-def _tiers(tier: str) -> list[str]:
-    from pmnav_bt.eval.tiers import parse_tiers
-
-    try:
-        return parse_tiers(tier)
-    except ValueError as err:
-        raise PmNavError(f"--tier: {err}") from None
-
-
-def _buildings(building: str) -> list[str]:
-    """Comma-separated files, built-in names, 'all' (every built-in) and FAMILY:N."""
-    from pmnav_bt.map.building import builtin_buildings
-    from pmnav_bt.map.generate import family_members
-
-    out: list[str] = []
-    for part in (b.strip() for b in building.split(",") if b.strip()):
-        try:
-            members = family_members(part)
-        except ValueError as err:
-            raise PmNavError(f"--building {err}") from None
-        out += builtin_buildings() if part == "all" else members or [part]
-    return out
-
-
-def _config(config: Path | None, overrides: list[str] | None):
-    from pmnav_bt.config import load_config
-
-    return load_config(config, overrides or [])
-
-
 CONFIG_OPT = typer.Option(None, "--config", help="A run config YAML (see docs/config.md).")
 SET_OPT = typer.Option(None, "--set", help="Override a config value: section.key=value.")
 
@@ -151,7 +130,7 @@ def episodes(
     if out is not None:
         check_output_file(out, "--out", (".json",))
     eps = []
-    for t in _tiers(tier):
+    for t in tier_names(tier):
         eps += generate_episodes(building, t, n, seed=seed)
     text = episodes_json(eps)
     typer.echo(tier_definition(), err=True)
@@ -187,7 +166,7 @@ def run(
 
     cli_values.seed(seed)
     cli_values.index(index)
-    cfg = _config(config, overrides)
+    cfg = run_config(config, overrides)
     check_output_dir(out)
     if episode_file is not None:
         from pmnav_bt.sim.episodes import episode_building_file, load_episodes
@@ -246,10 +225,6 @@ RESUME_OPT = typer.Option(
     help="Keep the results.jsonl in --out and run only what it lacks (refused if it was "
     "made under another config).",
 )
-
-
-def _jobs(jobs: int | None) -> int:
-    return cli_values.jobs(jobs) if jobs is not None else min(2, cli_values.cpu_count())
 
 
 def reading_note(cfg) -> str:
@@ -324,12 +299,12 @@ def eval_(
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
-    jobs = _jobs(jobs)
-    cfg = _config(config, overrides)
+    jobs = job_count(jobs)
+    cfg = run_config(config, overrides)
     check_output_dir(out)
     names = [v.strip() for v in variants.split(",") if v.strip()]
     configs = variant_configs(cfg, names)
-    eps, notes = episodes_for(_buildings(building), _tiers(tier), n, seed)
+    eps, notes = episodes_for(building_names(building), tier_names(tier), n, seed)
     for note in notes:
         typer.echo(f"note: {note}", err=True)
     if not eps:
@@ -377,26 +352,6 @@ def _stopped(run, out: Path, done: int, unit: str, keep_partial) -> NoReturn:
     raise typer.Exit(run.exit_code)
 
 
-def _class_ranges(class_range: str, cfg) -> dict[str, float] | None:
-    """The read range per plate kind Table 3's classes count landmarks within (None: the
-    map's ``READ_RANGE_M``)."""
-    from pmnav_bt.perception.read_range import landmark_ranges
-
-    if class_range not in ("stack", "map"):
-        raise PmNavError(f"--class-range must be 'stack' or 'map', not {class_range!r}")
-    return landmark_ranges(cfg) if class_range == "stack" else None
-
-
-def _ranges_text(ranges: dict[str, float] | None) -> str:
-    from pmnav_bt.pose.visibility import READ_RANGE_M
-
-    if ranges is None:
-        return f"<= {READ_RANGE_M:g} m"
-    return "the grounder's reliable read range: " + ", ".join(
-        f"{k} plates <= {r:g} m" for k, r in ranges.items()
-    )
-
-
 @app.command("table3")
 def table3(
     building: str = typer.Option(
@@ -431,17 +386,11 @@ def table3(
         table,
     )
     from pmnav_bt.experiments.stored_run import StoredRun, run_stored_study
-    from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
 
     check_output_dir(out)
-    cfg = _config(config, overrides)
-    ranges = _class_ranges(class_range, cfg)
-    names: list[str] = []
-    for part in (p.strip() for p in building.split(",") if p.strip()):
-        if part == SIGN_SPARSE_FAMILY:
-            names += [f"{SIGN_SPARSE_FAMILY}_{k}" for k in range(family_size)]
-        else:
-            names += _buildings(part)
+    cfg = run_config(config, overrides)
+    ranges = class_ranges(class_range, cfg)
+    names = table3_building_names(building, family_size)
     starts = [s for b in names for s in classified_starts(b, n, seed, ranges)]
     if not starts:
         raise PmNavError("no start poses to run")
@@ -454,7 +403,7 @@ def table3(
         f"{grounder_label(cfg.grounder.backend)} "
         f"(miss {cfg.grounder.miss_rate:.0%}); odometry noise {cfg.sim.odometry_noise:.0%}.\n"
         f"Class: signs the priori-map says are readable from the start (line of sight, "
-        f"{_ranges_text(ranges)}): redundant > 2, minimal = 2, scarce 0-1. Success: the "
+        f"{ranges_text(ranges)}): redundant > 2, minimal = 2, scarce 0-1. Success: the "
         f"localization subtree succeeds within {SUCCESS_POS_M:g} m and {SUCCESS_YAW_DEG:g} deg "
         "of the truth. SDF = S * 2 / max(2, d), d = panoramas taken."
     )

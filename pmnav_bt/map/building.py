@@ -11,9 +11,7 @@ Coordinates are metres in the map frame (x east, y north).
 
 from __future__ import annotations
 
-import hashlib
 import math
-import os
 from enum import Enum
 from functools import cached_property
 from pathlib import Path
@@ -43,7 +41,10 @@ MAX_WIDTH_M = 50.0  # corridor width
 MAX_WALL_HEIGHT_M = 20.0
 MAX_WAYPOINTS = 2000
 MAX_EDGES = 4000
-MAX_ROOMS = 5000
+# Rooms: the planner's scale target (benchmarks/bench_plan.py plans on 10,000 rooms). A real
+# building has that many: the largest hospital, Zhengzhou University's First Affiliated
+# Hospital, reports over 10,000 beds (2022), with its wards, offices and labs besides.
+MAX_ROOMS = 10_000
 MAX_LANDMARKS = 5000
 MAX_ALIASES = 32
 MAX_ID_CHARS = 64
@@ -396,10 +397,9 @@ def building_from_data(data: Any, source: str = "<data>", base_dir: Path | None 
     return b
 
 
-def load_building(path: str | Path) -> Building:
-    """Read and validate a building file (or a built-in building's name, or a generated
-    family's: "sign_sparse_<seed>")."""
-    path = resolve_building_path(path)
+def read_building_file(path: str | Path) -> Building:
+    """Read and validate a building file (a name is looked up by ``catalogue.load_building``)."""
+    path = Path(path)
     try:
         data = load_yaml(path, "building")
     except InputFileError as err:
@@ -416,52 +416,3 @@ def dump_building(b: Building) -> str:
     """The building as YAML text."""
     dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
     return yaml.dump(b.to_dict(), Dumper=dumper, sort_keys=False, allow_unicode=True, width=100)
-
-
-# -- built-in buildings ---------------------------------------------------------------
-
-BUILTIN_DIR = Path(__file__).parent.parent / "data" / "buildings"
-
-
-def builtin_buildings() -> list[str]:
-    """Names of the buildings shipped with the package."""
-    return sorted(p.stem for p in BUILTIN_DIR.glob("*.yaml"))
-
-
-def building_sha256(name_or_path: str | Path) -> str:
-    """The sha256 (hex) of a building file's bytes (a path or a built-in name)."""
-    path = resolve_building_path(name_or_path)
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError as err:
-        raise BuildingFileError(
-            str(path), [Problem("", f"cannot read file: {err.strerror}")]
-        ) from None
-
-
-def resolve_building_path(name_or_path: str | Path) -> Path:
-    """A path as given, or the file of a built-in building of that name."""
-    p = Path(name_or_path)
-    text = str(name_or_path)
-    if len(text) > 255 or "\0" in text or p.suffix in (".yaml", ".yml") or len(p.parts) > 1:
-        return p
-    if os.path.lexists(p):
-        return p
-    from pmnav_bt.map.generate import generated_file  # generate imports this module
-
-    generated = generated_file(text)  # "sign_sparse_3": written once to the cache folder
-    if generated is not None:
-        return generated
-    builtin = BUILTIN_DIR / f"{name_or_path}.yaml"
-    if builtin.is_file():
-        return builtin
-    raise BuildingFileError(
-        str(name_or_path),
-        [
-            Problem(
-                "",
-                f"no such file, and no built-in building of that name "
-                f"(built-in: {', '.join(builtin_buildings()) or 'none'})",
-            )
-        ],
-    )

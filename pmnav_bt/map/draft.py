@@ -35,6 +35,7 @@ import networkx as nx
 import numpy as np
 
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.geometry import Rect
 from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
 from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map
 from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask, largest_component
@@ -60,27 +61,13 @@ class DraftParams:
 
 
 @dataclass
-class OpenArea:
-    """A free area too wide to be a corridor: its bounding box in the map frame."""
-
-    xmin: float
-    ymin: float
-    xmax: float
-    ymax: float
-
-    @property
-    def centre(self) -> tuple[float, float]:
-        return (self.xmin + self.xmax) / 2.0, (self.ymin + self.ymax) / 2.0
-
-
-@dataclass
 class Draft:
     """The result: plain building data plus what the person must look at."""
 
     waypoints: list[dict]
     edges: list[dict]
     rooms: list[dict]
-    open_areas: list[OpenArea] = field(default_factory=list)
+    open_areas: list[Rect] = field(default_factory=list)  # free areas too wide for a corridor
     notes: list[str] = field(default_factory=list)
     # Stages, for pictures (pixel masks and the skeleton graph).
     free: np.ndarray | None = None
@@ -253,14 +240,14 @@ def open_area_mask(corridor: np.ndarray, dist_px: np.ndarray, res: float, params
     return cv2.dilate(core.astype(np.uint8), disc).astype(bool) & corridor
 
 
-def _boxes(mask: np.ndarray, plan: FloorPlanImage) -> list[OpenArea]:
+def _boxes(mask: np.ndarray, plan: FloorPlanImage) -> list[Rect]:
     n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
     out = []
     for i in range(1, n):
         x, y, w, h = (int(v) for v in stats[i, :4])
         corners = plan.pixel_to_world([[x - 0.5, y - 0.5], [x + w - 0.5, y + h - 0.5]])
         lo, hi = corners.min(axis=0), corners.max(axis=0)
-        out.append(OpenArea(*(round(float(v), 2) for v in (lo[0], lo[1], hi[0], hi[1]))))
+        out.append(Rect(*(round(float(v), 2) for v in (lo[0], lo[1], hi[0], hi[1]))))
     out.sort(key=lambda a: -(a.xmax - a.xmin) * (a.ymax - a.ymin))
     return out
 
@@ -518,7 +505,7 @@ def _beside(p: np.ndarray, a: np.ndarray, b: np.ndarray, width: float) -> bool:
     return t > -0.05 and perp < width / 2.0 + 0.2
 
 
-def _name_nodes(h: nx.Graph, pos: dict, open_areas: list[OpenArea]) -> dict:
+def _name_nodes(h: nx.Graph, pos: dict, open_areas: list[Rect]) -> dict:
     """start, endN, turnN, branchN; numbered top to bottom, left to right."""
     order = sorted(h.nodes, key=lambda n: (-round(pos[n][1], 1), round(pos[n][0], 1)))
     ends = [n for n in order if h.degree(n) == 1]

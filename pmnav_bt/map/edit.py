@@ -16,7 +16,8 @@ from typing import Any
 import yaml
 
 from pmnav_bt.errors import BuildingFileError, PmNavError
-from pmnav_bt.map.building import Building, building_from_data, dump_building, load_building
+from pmnav_bt.map.building import Building, building_from_data, dump_building
+from pmnav_bt.map.catalogue import load_building
 
 GROUPS = ("waypoints", "rooms", "landmarks")
 POS_KEY = {"waypoints": "pos", "rooms": "door", "landmarks": "pos"}

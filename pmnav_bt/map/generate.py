@@ -10,13 +10,11 @@ doors; a few elevators and stairs are spread over the floor.
 from __future__ import annotations
 
 import math
-import os
 import random
-from pathlib import Path
 
 import networkx as nx
 
-from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data, dump_building
+from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
 
 ROOM_PITCH = 3.0  # metres between door centres along a corridor (alternating walls)
 JUNCTION_CLEARANCE = 2.5  # no door closer than this to a junction
@@ -175,59 +173,6 @@ def generate_small(seed: int = 0) -> Building:
         name=f"{SMALL_FAMILY}_{seed}",
         n_landmarks=2,
     )
-
-
-FAMILIES = {SIGN_SPARSE_FAMILY: generate_sign_sparse, SMALL_FAMILY: generate_small}
-
-
-def is_generated_name(name: str) -> bool:
-    """True for a generated family's building name, such as "sign_sparse_3"."""
-    stem, _, seed = name.rpartition("_")
-    return stem in FAMILIES and seed.isdigit() and len(seed) < 10
-
-
-def family_members(spec: str) -> list[str] | None:
-    """ "FAMILY:N" -> the family's first N building names ("gen_small:3" -> gen_small_0,
-    gen_small_1, gen_small_2); None when ``spec`` is not of that form; ValueError for an
-    unknown family or a bad N."""
-    family, sep, count = spec.partition(":")
-    if not sep:
-        return None
-    if family not in FAMILIES:
-        raise ValueError(
-            f"{spec!r}: unknown building family {family!r}; choose {', '.join(FAMILIES)}"
-        )
-    if not count.isdigit() or not 1 <= int(count) <= 100_000:
-        raise ValueError(f"{spec!r}: expected {family}:N with N from 1 to 100000")
-    return [f"{family}_{k}" for k in range(int(count))]
-
-
-def generated_family(name: str) -> Building | None:
-    """The generated building a name such as "sign_sparse_3" denotes, or None."""
-    if not is_generated_name(name):
-        return None
-    stem, _, seed = name.rpartition("_")
-    return FAMILIES[stem](int(seed))
-
-
-def generated_file(name: str) -> Path | None:
-    """The building file of a generated family's name, written once to the cache folder
-    (``$PMNAV_CACHE`` or ``$XDG_CACHE_HOME/pmnav``, default ``~/.cache/pmnav``), so that a
-    generated building has a file like any other (episodes record its path and hash)."""
-    b = generated_family(name)
-    if b is None:
-        return None
-    root = os.environ.get("PMNAV_CACHE") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "pmnav"
-    )
-    path = Path(root) / "buildings" / f"{name}.yaml"
-    text = dump_building(b)
-    if not path.is_file() or path.read_text(encoding="utf-8") != text:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(text, encoding="utf-8")
-        tmp.replace(path)  # atomic: parallel runs never read half a file
-    return path
 
 
 def _merge_straight_runs(g: nx.Graph) -> nx.Graph:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from pmnav_bt.seams import CoarseChoice, Entity, Grounder, View
 
 if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.registry import BackendDeps
+    from pmnav_bt.backends import BackendDeps
 
 
 @dataclass

@@ -41,7 +41,7 @@ from pmnav_bt.pixelnav.frames import scale_pixel, shrink
 from pmnav_bt.seams import Detection, Observation, PolicyStep, Refinement
 
 if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.registry import BackendDeps
+    from pmnav_bt.backends import BackendDeps
 
 SHIPPED = "pixelnav_small"
 

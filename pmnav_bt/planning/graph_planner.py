@@ -20,16 +20,13 @@ import numpy as np
 from pmnav_bt.errors import PlanningError
 from pmnav_bt.geometry import Action, heading, relative_action, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.planning.plan import ForkChoice, Plan, PlanStart, PlanStep
+from pmnav_bt.planning.plan import MAX_GAP_M, ForkChoice, Plan, PlanStart, PlanStep
 from pmnav_bt.planning.resolve import StartPoint, resolve_room, resolve_start
 from pmnav_bt.seams import PlanConstraints
 from pmnav_bt.seams import PlanStart as SeamStart
 
 if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.registry import BackendDeps
-
-MAX_GAP_M = 8.0  # default: most metres between consecutive plan steps (config planner.max_gap)
-
+    from pmnav_bt.backends import BackendDeps
 
 @dataclass(frozen=True)
 class GraphPlanner:

@@ -14,6 +14,10 @@ from dataclasses import asdict, dataclass, field
 
 from pmnav_bt.geometry import Action, compass
 
+# Most metres between consecutive plan steps, where landmarks allow: the planners' default
+# and the config's (planner.max_gap).
+MAX_GAP_M = 8.0
+
 
 @dataclass(frozen=True)
 class ForkChoice:

@@ -431,10 +431,7 @@ def render_annotated_map(
     the plan shows. ``path_xy`` (map points) is drawn as a blue polyline; ``grid_m``
     adds a metre grid with lines that many metres apart.
     """
-    canvas = make_canvas(pm, scale_px_per_m)
-    if floor_plan is None:
-        floor_plan = load_floor_plan(pm.building, base_dir)
-    img = np.full((canvas.height, canvas.width, 3), 255, dtype=np.uint8)
+    canvas, floor_plan, img = _blank_page(pm, scale_px_per_m, floor_plan, base_dir)
     if floor_plan is not None:
         _draw_plan_background(img, floor_plan, canvas)
         _draw_annotation_over_plan(img, pm, canvas)
@@ -456,6 +453,20 @@ def render_annotated_map(
     return img
 
 
+def _blank_page(
+    pm: PrioriMap,
+    scale_px_per_m: float | None,
+    floor_plan: FloorPlanImage | None,
+    base_dir: str | Path,
+) -> tuple[Canvas, FloorPlanImage | None, np.ndarray]:
+    """The building's canvas, its floor plan (loaded from the building when not given;
+    None when it has none) and a white BGR image the canvas's size."""
+    canvas = make_canvas(pm, scale_px_per_m)
+    if floor_plan is None:
+        floor_plan = load_floor_plan(pm.building, base_dir)
+    return canvas, floor_plan, np.full((canvas.height, canvas.width, 3), 255, dtype=np.uint8)
+
+
 def render_environment_map(
     pm: PrioriMap,
     *,
@@ -466,10 +477,7 @@ def render_environment_map(
     """The raw environmental map (BGR), as the paper's O-EM/H-EM baselines see it: the floor
     plan (or the clean drawing) with only what a printed plan shows, room numbers at their
     rooms, a north arrow and a scale bar; no waypoints, segments or landmark tags."""
-    canvas = make_canvas(pm, scale_px_per_m)
-    if floor_plan is None:
-        floor_plan = load_floor_plan(pm.building, base_dir)
-    img = np.full((canvas.height, canvas.width, 3), 255, dtype=np.uint8)
+    canvas, floor_plan, img = _blank_page(pm, scale_px_per_m, floor_plan, base_dir)
     if floor_plan is not None:
         _draw_plan_background(img, floor_plan, canvas)
     else:

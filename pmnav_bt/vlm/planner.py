@@ -25,8 +25,8 @@ import numpy as np
 
 from pmnav_bt.errors import VlmError
 from pmnav_bt.map.priori_map import PrioriMap
-from pmnav_bt.planning.graph_planner import MAX_GAP_M, GraphPlanner, build_plan
-from pmnav_bt.planning.plan import Plan
+from pmnav_bt.planning.graph_planner import GraphPlanner, build_plan
+from pmnav_bt.planning.plan import MAX_GAP_M, Plan
 from pmnav_bt.planning.resolve import StartPoint, resolve_room, resolve_start
 from pmnav_bt.seams import PlanConstraints, Pose2D
 from pmnav_bt.vlm.client import VlmClient

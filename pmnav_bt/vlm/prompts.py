@@ -111,7 +111,7 @@ def map_image(pm: PrioriMap, inputs: str, long_side: int = 1280) -> np.ndarray:
 
 
 def _render(pm: PrioriMap, annotated: bool) -> np.ndarray:
-    from pmnav_bt.map.building import builtin_buildings, resolve_building_path
+    from pmnav_bt.map.catalogue import builtin_buildings, resolve_building_path
     from pmnav_bt.render.annotate import render_annotated_map, render_environment_map
 
     draw = render_annotated_map if annotated else render_environment_map

@@ -233,7 +233,7 @@ class PlanningResponder:
         return Reply(self.answer(pm, steps, goal, kind, rng))
 
     def _map(self, name: str):
-        from pmnav_bt.map.building import load_building
+        from pmnav_bt.map.catalogue import load_building
         from pmnav_bt.map.priori_map import parse_building
 
         with self._lock:

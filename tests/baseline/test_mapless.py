@@ -10,7 +10,7 @@ import pytest
 
 from pmnav_bt.experiments.evaluation import custom_episode, run_episode
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.map.signs_only import MapAccessError, SignsOnly
 from pmnav_bt.testing.doubles import FakeBase

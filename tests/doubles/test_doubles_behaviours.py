@@ -15,7 +15,7 @@ from pmnav_bt.behaviours.planning import MakePlan
 from pmnav_bt.behaviours.search import CoarseDirection, FineDirection, target_entity
 from pmnav_bt.errors import SensorError, VlmError
 from pmnav_bt.failures import Failure, FailureCode
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.seams import CoarseChoice, Entity, PlanConstraints, Pose2D
 from pmnav_bt.testing.doubles import (
     FakeCoarseDirection,

@@ -15,7 +15,7 @@ from pmnav_bt.behaviours import follow_lead
 from pmnav_bt.behaviours.belief import DriveEnd
 from pmnav_bt.behaviours.follow_lead import BACK_OFF_S, SLIDE_ACROSS_M, WallLook
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M, BACKUP_SPEED, BACKUP_TIME_S, BackUp
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.trees.localize import follow_lead_subtree
 

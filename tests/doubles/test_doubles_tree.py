@@ -9,7 +9,7 @@ import pytest
 
 from pmnav_bt.errors import SensorError
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.testing.doubles import FakePlanner, ScriptedGrounder
 

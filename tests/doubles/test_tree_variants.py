@@ -10,11 +10,11 @@ import dataclasses
 import numpy as np
 import pytest
 
+from pmnav_bt.backends import Backends
 from pmnav_bt.config import load_config
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.priori_map import parse_building
-from pmnav_bt.registry import Backends
 from pmnav_bt.seams import Observation, Pose2D
 from pmnav_bt.testing import doubles
 from pmnav_bt.testing.oracle import ORACLE

@@ -21,7 +21,8 @@ from hypothesis import strategies as st
 
 from pmnav_bt.config import load_config
 from pmnav_bt.errors import BuildingFileError, ConfigError, PmNavError
-from pmnav_bt.map.building import building_from_data, load_building
+from pmnav_bt.map.building import building_from_data
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.floorplan import FloorPlanError, load_ros_map, read_image
 from pmnav_bt.sim.episodes import EPISODES_SCHEMA_VERSION, EpisodeFileError, load_episodes
 from pmnav_bt.treelog import read_tree_log

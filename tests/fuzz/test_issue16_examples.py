@@ -17,7 +17,7 @@ import pytest
 import yaml
 from fuzzkit import TRIED, assert_clean_failure, one_line, pmnav_cli, pmnav_subprocess
 
-from pmnav_bt.map.building import BUILTIN_DIR
+from pmnav_bt.map.catalogue import BUILTIN_DIR
 
 pytestmark = pytest.mark.timeout(120)  # bounded time, whatever regresses
 

@@ -190,7 +190,7 @@ class TestLaunched:
         from std_msgs.msg import Empty
 
         from pmnav_bt.hardware import qos
-        from pmnav_bt.map.building import load_building
+        from pmnav_bt.map.catalogue import load_building
 
         client, state = launched
         probe = state["probe"]
@@ -325,7 +325,7 @@ def test_help_prints_usage_without_starting_a_node(module, ros_required):
 
 def test_room_near_pose():
     from pmnav_bt.hardware.requests import GoalPoseError, goal_from_pose
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
 
     b = load_building("fig2_hospital")
     door = b.room("room17").door

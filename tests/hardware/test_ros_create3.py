@@ -20,7 +20,7 @@ import pytest
 
 from pmnav_bt.eval.metrics import SUCCESS_RADIUS_M, success
 from pmnav_bt.hardware.testing import Proc
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.sim.episodes import generate_episodes
 
 BUILDING = "fig2_hospital"

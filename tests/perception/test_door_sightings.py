@@ -94,7 +94,7 @@ def test_the_ends_of_staggered_wall_boxes_are_not_doors():
     shaded darker; they were found as two doors 6-8 m ahead where there is none."""
     from pathlib import Path
 
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.sim.world import SimWorld
 
     here = Path(__file__).resolve().parents[2] / "examples" / "hospital"

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import pytest
 
+from pmnav_bt.backends import BackendDeps
 from pmnav_bt.config import load_config
 from pmnav_bt.errors import BackendError
-from pmnav_bt.registry import GROUNDERS, BackendDeps
+from pmnav_bt.registry import GROUNDERS
 from pmnav_bt.seams import Grounder
 
 

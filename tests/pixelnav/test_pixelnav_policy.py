@@ -83,10 +83,11 @@ def test_the_answer_depends_on_the_goal_pixel_not_on_earlier_episodes(policy):
 
 
 def test_the_registry_builds_pixelnav_with_the_shipped_weights():
+    from pmnav_bt.backends import BackendDeps
     from pmnav_bt.config import load_config
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
-    from pmnav_bt.registry import REFINERS, BackendDeps
+    from pmnav_bt.registry import REFINERS
 
     assert shipped_weights().is_file() and shipped_weights().with_suffix(".json").is_file()
     cfg = load_config(overrides=["refiner.backend=pixelnav"])

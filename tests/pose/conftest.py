@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.priori_map import parse_building
 
 

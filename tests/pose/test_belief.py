@@ -14,7 +14,7 @@ from belief_kit import (
 )
 
 from pmnav_bt.geometry import se2_apply, se2_compose, se2_inverse, wrap_angle
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.belief import CorridorBelief, Glimpse

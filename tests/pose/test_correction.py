@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pmnav_bt.geometry import se2_apply, se2_inverse
-from pmnav_bt.map.building import load_building
+from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.correction import TOLERANCE_MIN_M, PoseTracker, Verified
 from pmnav_bt.pose.snap import OffMapError, snap_to_corridor

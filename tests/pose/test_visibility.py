@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pmnav_bt.map.building import load_building, resolve_building_path
+from pmnav_bt.map.catalogue import load_building, resolve_building_path
 from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.visibility import (

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from pmnav_bt.geometry import project_points_to_segments
-from pmnav_bt.map.building import WaypointKind, builtin_buildings, load_building
+from pmnav_bt.map.building import WaypointKind
+from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.map.priori_map import parse_building
 
 # name -> (turn waypoints, branch waypoints, corridor loop?) as each file claims.

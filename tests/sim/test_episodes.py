@@ -11,7 +11,7 @@ import pytest
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.map.building import BUILTIN_DIR, builtin_buildings, load_building
+from pmnav_bt.map.catalogue import BUILTIN_DIR, builtin_buildings, load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.sim.episodes import (
     START_CLEARANCE_M,

@@ -7,7 +7,7 @@ import pytest
 import yaml
 
 from pmnav_bt.config import load_config
-from pmnav_bt.map.building import load_building, resolve_building_path
+from pmnav_bt.map.catalogue import load_building, resolve_building_path
 from pmnav_bt.map.floorplan import FREE, rasterize_building, save_ros_map
 from pmnav_bt.sim.grid_walls import grid_wall_boxes, merge_cells
 from pmnav_bt.sim.world import WALL, SimError, SimWorld

@@ -9,7 +9,7 @@ import math
 import pytest
 
 from pmnav_bt.eval.metrics import aggregate_by_tier
-from pmnav_bt.map.building import builtin_buildings, load_building
+from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.episodes import (

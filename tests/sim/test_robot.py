@@ -241,3 +241,23 @@ def test_it_reverses_only_within_the_create3_backup_buffer(base):
     base.set_velocity(-0.2, 0.0)
     base.clock.wait(2.0)
     assert base.pose().y == pytest.approx(y - 0.1, abs=1e-6)
+
+
+def test_the_configs_robot_drives_on_drifting_odometry_unless_the_noise_is_zero(world):
+    from pmnav_bt.config import load_config
+    from pmnav_bt.sim.odometry import NoisyOdometry, simulated_robot
+
+    sim = load_config(None, ["sim.width=64", "sim.height=48", "sim.reading_width=0"]).sim
+    body, base = simulated_robot(world, sim, OPEN, seed=3)
+    try:
+        assert isinstance(base, NoisyOdometry) and base.inner is body
+        assert (body.intrinsics.width, body.intrinsics.height) == (64, 48)
+        assert base.noise == sim.odometry_noise > 0
+    finally:
+        body.close()
+    exact = load_config(None, ["sim.width=64", "sim.height=48", "sim.odometry_noise=0"]).sim
+    body, base = simulated_robot(world, exact, OPEN, seed=3)
+    try:
+        assert base is body
+    finally:
+        body.close()

@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from pmnav_bt.experiments.cli import main
-from pmnav_bt.map.building import BUILTIN_DIR, load_building
+from pmnav_bt.map.catalogue import BUILTIN_DIR, load_building
 from pmnav_bt.map.floorplan import rasterize_building, save_ros_map
 from pmnav_bt.testing.oracle import ORACLE_SET
 
@@ -100,11 +100,11 @@ def test_eval_exits_non_zero_and_counts_errored_episodes(capsys, own_building, m
 
 
 def test_eval_all_means_every_builtin_building(monkeypatch):
-    from pmnav_bt.experiments.sim_cli import _buildings
-    from pmnav_bt.map.building import builtin_buildings
+    from pmnav_bt.experiments.options import building_names
+    from pmnav_bt.map.catalogue import builtin_buildings
 
-    assert _buildings("all") == builtin_buildings()
-    assert _buildings("a.yaml, t_school") == ["a.yaml", "t_school"]
+    assert building_names("all") == builtin_buildings()
+    assert building_names("a.yaml, t_school") == ["a.yaml", "t_school"]
 
 
 def test_a_changed_building_file_is_one_clear_line(capsys, own_building, tmp_path):

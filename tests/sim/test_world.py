@@ -9,7 +9,8 @@ import pytest
 from typer.testing import CliRunner
 
 from pmnav_bt.experiments.sim_cli import PoseError, app
-from pmnav_bt.map.building import WaypointKind, builtin_buildings, load_building
+from pmnav_bt.map.building import WaypointKind
+from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.seams import CameraIntrinsics
 from pmnav_bt.sim.render import draw_top_down, linearise_depth, render_camera
 from pmnav_bt.sim.textures import make_sign, sign_lines

@@ -71,7 +71,7 @@ def test_hidden_goal_sign_re_search_then_replan_then_target_not_found(tmp_path):
 
 def test_hidden_intermediate_landmark_is_avoided_after_a_replan():
     ep = shortest("hard")
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.planning.graph_planner import GraphPlanner
 

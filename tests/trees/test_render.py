@@ -153,7 +153,7 @@ def test_unknown_format(tmp_path):
 
 
 def test_cli_renders_the_real_pmnav_tree(tmp_path):
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.trees.cli import RENDER_BUILDING
 
     res = CliRunner().invoke(app, ["render", "--out", str(tmp_path), "--format", "dot"])

@@ -160,7 +160,7 @@ def episode_log(tmp_path_factory):
     """A real log: 60 ticks of PM-Nav on the test doubles in fig2_hospital's map."""
     from rig import build_rig
 
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.seams import Pose2D
 

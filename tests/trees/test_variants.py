@@ -9,12 +9,12 @@ import dataclasses
 import py_trees
 import pytest
 
+from pmnav_bt.backends import Backends
 from pmnav_bt.behaviours.motion import Approach
 from pmnav_bt.behaviours.policy_approach import PolicyApproach
 from pmnav_bt.config import load_config
 from pmnav_bt.errors import ConfigError
 from pmnav_bt.experiments.variants import VARIANTS, Variant, variant_configs
-from pmnav_bt.registry import Backends
 from pmnav_bt.testing.doubles import (
     FakeBase,
     FakeCoarseDirection,

@@ -47,7 +47,7 @@ def test_parse_angle(text, angle):
 
 
 def coarse(server, **kw) -> VlmCoarseDirection:
-    from pmnav_bt.map.building import load_building
+    from pmnav_bt.map.catalogue import load_building
 
     client = VlmClient(server.base_url, "m", timeout_s=kw.pop("timeout_s", 5.0), retries=0)
     return VlmCoarseDirection(client, load_building("fig2_hospital"), **kw)
@@ -89,8 +89,9 @@ def test_a_hanging_server_is_a_vlm_error_after_the_timeout():
 
 
 def test_both_vlm_back_ends_are_registered_and_built_from_the_config(fig2_map):
+    from pmnav_bt.backends import BackendDeps
     from pmnav_bt.config import load_config
-    from pmnav_bt.registry import COARSE, PLANNERS, BackendDeps
+    from pmnav_bt.registry import COARSE, PLANNERS
     from pmnav_bt.vlm.planner import VlmPlanner
 
     cfg = load_config(

@@ -169,7 +169,7 @@ def test_the_start_may_be_a_pose_a_segment_or_a_room(fig2_map):
 
 @pytest.mark.parametrize("inputs", ["o-em", "h-em", "h-pm"])
 def test_scripted_server_plans_are_valid_in_every_built_in(inputs):
-    from pmnav_bt.map.building import builtin_buildings, load_building
+    from pmnav_bt.map.catalogue import builtin_buildings, load_building
     from pmnav_bt.map.priori_map import parse_building
 
     with ChatServer(PlanningResponder(wrong=0.0)) as s:

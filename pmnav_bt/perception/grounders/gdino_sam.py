@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pmnav_bt.backends import BackendDeps
 from pmnav_bt.errors import BackendError, PmNavError
 from pmnav_bt.loading import weights_file
 from pmnav_bt.map.building import Building
@@ -26,7 +27,6 @@ from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.doors import DoorLayout
 from pmnav_bt.perception.grounders.ocr import OcrGrounder, reader_and_layout
 from pmnav_bt.perception.signs import SignReader
-from pmnav_bt.registry import BackendDeps
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
 
 # Phrases for landmark kinds GroundingDINO knows by another name.

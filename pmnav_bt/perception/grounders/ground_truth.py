@@ -36,7 +36,7 @@ from pmnav_bt.seams import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.registry import BackendDeps
+    from pmnav_bt.backends import BackendDeps
 
 _SIGN_KINDS = {"sign": EntityKind.ROOM, "landmark": EntityKind.LANDMARK}
 

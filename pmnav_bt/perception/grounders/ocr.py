@@ -25,12 +25,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from pmnav_bt.backends import BackendDeps
 from pmnav_bt.map.building import Building
 from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.doors import DoorLayout, door_from_sign
 from pmnav_bt.perception.sign_match import SignMatcher
 from pmnav_bt.perception.signs import MIN_LINE_PX, SignReader, SignText, scale_sign
-from pmnav_bt.registry import BackendDeps
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
 
 

@@ -15,7 +15,7 @@ from pmnav_bt.perception.geometry import target_point
 from pmnav_bt.seams import Detection, Observation, Refinement
 
 if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.registry import BackendDeps
+    from pmnav_bt.backends import BackendDeps
 
 
 @dataclass(frozen=True)
