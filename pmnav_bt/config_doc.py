@@ -5,7 +5,7 @@
 The page is the ``Config`` docstring, then one table per section (the section's docstring
 above it): each key with its default, the values it may take (from the field's type and
 bounds) and its ``Field(description=...)``; last, the back ends each seam's registry
-holds. ``tests/test_config.py`` fails when the committed page differs from this output,
+holds. ``tests/core/test_config.py`` fails when the committed page differs from this output,
 so a key cannot be added, renamed or re-described without the page following.
 """
 

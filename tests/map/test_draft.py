@@ -97,7 +97,7 @@ def test_example_hospital_building_warns_only_about_its_pillar():
 
     from pmnav_bt.map.checks import building_warnings
 
-    f = Path(__file__).resolve().parents[1] / "examples" / "hospital" / "building.yaml"
+    f = Path(__file__).resolve().parents[2] / "examples" / "hospital" / "building.yaml"
     w = building_warnings(load_building(f), f.parent)
     assert len(w) == 1 and "branch4-branch5 runs into an obstacle" in w[0].message
 

@@ -56,7 +56,7 @@ def test_every_key_is_described():
 def test_docs_config_md_is_the_generators_output():
     """docs/config.md is generated; a key added or re-described without regenerating it
     (``python -m pmnav_bt.config_doc > docs/config.md``) fails here."""
-    page = (Path(__file__).resolve().parents[1] / "docs" / "config.md").read_text()
+    page = (Path(__file__).resolve().parents[2] / "docs" / "config.md").read_text()
     assert page == config_doc(), f"docs/config.md is stale: run {COMMAND}"
 
 
