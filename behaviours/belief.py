@@ -23,8 +23,9 @@ from pmnav_bt.perception.door_sightings import find_doors
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_visible_range
 from pmnav_bt.planning.resolve import resolve_room
-from pmnav_bt.pose.belief import CorridorBelief, Glimpse
+from pmnav_bt.pose.belief import CorridorBelief
 from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.landmark_fix import Sighting, fix_pose, sighting
 from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
 from pmnav_bt.pose.visibility import Visibility, entity_xy

@@ -1,5 +1,6 @@
-"""Named evaluation variants: a tree variant plus config overrides, a label, and whether
-it is an oracle (ground-truth perception, labelled so in every table). The tree variant
+"""Named evaluation variants: a tree variant plus config overrides and a label. A variant
+whose grounder is an oracle (its registry spec says ``oracle=True``: ground-truth
+perception) is labelled so in every table. The tree variant
 (``tree.variant``) must be one registered in ``trees/variants.py``: a row naming another
 is refused when its config is made.
 
@@ -19,6 +20,7 @@ from dataclasses import dataclass
 
 from pmnav_bt.config import Config, ConfigError, _set_dotted
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.registry import GROUNDERS
 from pmnav_bt.trees.variants import TREE_VARIANTS
 
 ORACLE_LABEL = "oracle: simulator labels"
@@ -33,8 +35,14 @@ class Variant:
     name: str
     label: str
     overrides: tuple[tuple[str, object], ...]
-    oracle: bool = False
     tables: tuple[str, ...] = ("1", "4")
+
+    @property
+    def oracle(self) -> bool:
+        """Whether the grounder this variant sets declares itself an oracle (a variant that
+        sets none runs the run's grounder, which its report row states)."""
+        backend = dict(self.overrides).get("grounder.backend")
+        return backend is not None and GROUNDERS.spec(str(backend)).oracle
 
     @property
     def title(self) -> str:
@@ -69,7 +77,6 @@ VARIANTS: dict[str, Variant] = {
             "pmnav_oracle",
             "PM-Nav",
             (("tree.variant", "pmnav"), ("grounder.backend", "sim_gt")),
-            oracle=True,
             tables=("4",),
         ),
         # the paper's SG-Nav/InstructNav rows: no priori-map, no plan (docs/baseline.md)

@@ -35,6 +35,7 @@ from pmnav_bt.pose import telling
 from pmnav_bt.pose.evidence import Evidence
 from pmnav_bt.pose.evidence.prior import weigh_prior
 from pmnav_bt.pose.evidence.signs import PLACE_SIGMA_M, SIGHT_SIGMA_M
+from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.hypotheses import FIX_MASS, Hypotheses, Straightened
 from pmnav_bt.pose.landmark_fix import sign_shift
 from pmnav_bt.pose.lead import Lead
@@ -47,26 +48,6 @@ HYPOTHESIS_SIGMA_M = 0.5  # a hypothesis is a lattice point: no surer of the pla
 MIN_BLIND_GLIMPSES = 4  # glimpses before a fix from the corridors' shape alone
 BLIND_SPREAD_M = 0.75  # ... and how tight the belief must be for it
 RESCALE_MIN = 0.002  # a change of the odometry's distance gain smaller than this waits
-
-
-@dataclass(frozen=True)
-class Glimpse:
-    """What one panorama saw: its odometry pose and each sign read, with where (odom)."""
-
-    odom: Pose2D
-    seen: dict[Entity, tuple[float, float]]
-    blocked: float | None = None  # odometry heading of a drive that was just blocked here
-    # Free floor (m) seen in depth straight ahead of each view: (odometry yaw, distance).
-    free: tuple[tuple[float, float], ...] = ()
-    # Signs read whose place is not known (cut by the image border): in sight, not missed.
-    named: frozenset[Entity] = frozenset()
-    # The way (odometry, m) from the robot to the corridor's centre line, seen in depth.
-    to_centre: tuple[float, float] | None = None
-    # Doors seen along the walls (odometry xy of each), and the odometry yaws of the views
-    # that looked for them (none: no door evidence).
-    doors: tuple[tuple[float, float], ...] = ()
-    door_views: tuple[float, ...] = ()
-
 
 
 @dataclass

@@ -15,17 +15,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.pose.belief_view import BeliefView
 from pmnav_bt.pose.hypotheses import apply_many
 from pmnav_bt.pose.telling import WALL_COST_M, telling_lead
 from pmnav_bt.seams import Pose2D
-
-if TYPE_CHECKING:
-    from pmnav_bt.pose.belief import CorridorBelief
 
 BLOCKED_NEAR_M = 1.0  # a drive blocked this close to here: that way is shut from here
 KEEP_WAY_MASS = 0.3  # keep exploring the same way while this much belief says it goes on
@@ -49,7 +46,7 @@ class Lead:
 
 
 def choose_lead(
-    b: CorridorBelief, odom: Pose2D, max_distance: float, last_way: int | None
+    b: BeliefView, odom: Pose2D, max_distance: float, last_way: int | None
 ) -> tuple[Lead | None, int | None]:
     """Where to drive from ``odom`` and the way (0-3) that is, given the way chosen last.
 
@@ -171,7 +168,7 @@ def choose_lead(
     return Lead(heading, go, float(open_mass[k])), k
 
 
-def blocked_ways(b: CorridorBelief, odom: Pose2D) -> set[int]:
+def blocked_ways(b: BeliefView, odom: Pose2D) -> set[int]:
     """The ways (0-3 from the axis) that a drive from within ``BLOCKED_NEAR_M`` of
     ``odom`` met a wall on: whatever the hypotheses say, that way is shut from here (a
     belief that puts the robot at the wrong junction would drive into it again)."""
@@ -184,7 +181,7 @@ def blocked_ways(b: CorridorBelief, odom: Pose2D) -> set[int]:
     }
 
 
-def sign_in_reach(b: CorridorBelief, odom: Pose2D) -> float:
+def sign_in_reach(b: BeliefView, odom: Pose2D) -> float:
     """The share of the belief under which the map puts a sign within reliable reading
     range of ``odom`` (1 with no glimpse yet): near 0 in a bare stretch, where looking
     harder round the same spot reads nothing. A drive just blocked here counts (a

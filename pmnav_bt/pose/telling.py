@@ -13,20 +13,17 @@ free floor round about, a look round costs a full turn and tells nothing
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import networkx as nx
 import numpy as np
 import shapely
 
 from pmnav_bt.geometry import se2_apply, se2_inverse, wrap_angle
+from pmnav_bt.pose.belief_view import BeliefView
 from pmnav_bt.pose.evidence.floor import MAX_RAY_M
 from pmnav_bt.pose.hypotheses import FIX_MASS, apply_many
 from pmnav_bt.pose.lookahead import expected_trip, telling
 from pmnav_bt.seams import Pose2D
-
-if TYPE_CHECKING:
-    from pmnav_bt.pose.belief import CorridorBelief
 
 WALL_COST_M = 100.0  # a way with no signs (or no way on) ever ahead counts as this far
 TELLING_MIN_WEIGHT = 0.05  # hypotheses this likely (of the best) must be told apart ...
@@ -41,7 +38,7 @@ LOOK_ALIKE_M = 1.0
 LOOK_BEARINGS = np.radians(np.arange(0.0, 360.0, 15.0))
 
 
-def likely_modes(b: CorridorBelief) -> tuple[np.ndarray, np.ndarray, list[list[int]]]:
+def likely_modes(b: BeliefView) -> tuple[np.ndarray, np.ndarray, list[list[int]]]:
     """The weights, the hypotheses at least ``TELLING_MIN_WEIGHT`` as likely as the best
     (best first), and their clusters: the places a look must tell apart."""
     w = b.weights()
@@ -51,7 +48,7 @@ def likely_modes(b: CorridorBelief) -> tuple[np.ndarray, np.ndarray, list[list[i
 
 
 def telling_lead(
-    b: CorridorBelief, odom: Pose2D, max_distance: float, junction_reach: float
+    b: BeliefView, odom: Pose2D, max_distance: float, junction_reach: float
 ) -> tuple[float, float, float, int] | None:
     """Towards the nearest place where the few likely hypotheses predict different
     signs (the most information per metre driven; with a ``target``, the place with
@@ -125,7 +122,7 @@ def telling_lead(
 
 
 def leg_towards(
-    b: CorridorBelief, here, path, tf, support: float, max_distance: float, junction_reach: float
+    b: BeliefView, here, path, tf, support: float, max_distance: float, junction_reach: float
 ) -> tuple[float, float, float, int] | None:
     """The first straight leg from ``here`` (map) along a lattice path: the first
     straight run of the path that does not end within a metre of ``here``, driven
@@ -163,7 +160,7 @@ def leg_towards(
     return None
 
 
-def look_tells(b: CorridorBelief, odom: Pose2D) -> bool:
+def look_tells(b: BeliefView, odom: Pose2D) -> bool:
     """Whether a look round from ``odom`` can tell the belief's likely places apart.
 
     False when no place holds ``FIX_MASS`` of the belief, no sign is within sight
@@ -201,7 +198,7 @@ def look_tells(b: CorridorBelief, odom: Pose2D) -> bool:
     return not all(alike)
 
 
-def floor_round(b: CorridorBelief, xy: np.ndarray, heading: float) -> np.ndarray:
+def floor_round(b: BeliefView, xy: np.ndarray, heading: float) -> np.ndarray:
     """The free floor (m, to ``MAX_RAY_M``) the map has round ``xy`` (map) along
     ``LOOK_BEARINGS`` from ``heading``: what a look round from there shows in depth."""
     a = heading + LOOK_BEARINGS

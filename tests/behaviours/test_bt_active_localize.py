@@ -96,7 +96,8 @@ def test_a_look_round_is_skipped_only_where_it_cannot_tell_and_after_a_plain_dri
     from py_trees.common import Status
 
     from pmnav_bt.behaviours.belief import LookTellsNothing
-    from pmnav_bt.pose.belief import CorridorBelief, Glimpse
+    from pmnav_bt.pose.belief import CorridorBelief
+    from pmnav_bt.pose.glimpse import Glimpse
 
     start = Pose2D(60.0, 45.0, math.radians(90.0))
     rig = make_rig(start)

@@ -298,7 +298,7 @@ def test_in_a_bare_stretch_the_belief_skips_the_views_between(make_rig, pm):
     b = CorridorBelief(pm, read_range=2.0)
     views = _panorama(rig)
     assert len(views) == 12  # no belief yet: the views between are taken
-    from pmnav_bt.pose.belief import Glimpse
+    from pmnav_bt.pose.glimpse import Glimpse
 
     b.observe(Glimpse(views[0].observation.pose, {}), axis_odom=start.yaw)  # odom = map
     b.logw[:] = -50.0  # a belief sure of the place: only the truth is live

@@ -15,6 +15,7 @@ from pmnav_bt.experiments.runstore import Expected, ResultStore, ResumeError, re
 from pmnav_bt.experiments.variants import (
     ORACLE_LABEL,
     VARIANTS,
+    Variant,
     config_hash,
     variant_configs,
     variant_title,
@@ -107,6 +108,14 @@ def test_variants_apply_their_overrides_and_the_oracle_says_so():
     assert ORACLE_LABEL in variant_title("pmnav_oracle") and VARIANTS["pmnav_oracle"].oracle
     assert len({config_hash(c) for c in configs.values()}) == 3
     assert config_hash(load_config(None, ["sim.width=160"])) != config_hash(load_config())
+
+
+def test_a_variant_is_an_oracle_exactly_when_its_grounder_declares_itself_one():
+    real = Variant("mine", "mine", (("grounder.backend", "ocr"),))
+    truth = Variant("mine_gt", "mine", (("grounder.backend", "sim_gt"),))
+    assert not real.oracle and ORACLE_LABEL not in real.title
+    assert truth.oracle and ORACLE_LABEL in truth.title
+    assert not VARIANTS["pmnav"].oracle  # no grounder of its own: the run's, stated per row
 
 
 def test_an_unknown_variant_names_the_known_ones():

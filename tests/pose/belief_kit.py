@@ -10,7 +10,8 @@ import shapely
 
 from pmnav_bt.behaviours.belief import FREE_BEARINGS, RAY_HALF_WIDTH_M
 from pmnav_bt.geometry import se2_apply, se2_compose
-from pmnav_bt.pose.belief import CorridorBelief, Glimpse
+from pmnav_bt.pose.belief import CorridorBelief
+from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.seams import Pose2D
 

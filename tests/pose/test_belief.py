@@ -17,7 +17,8 @@ from pmnav_bt.geometry import se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
-from pmnav_bt.pose.belief import CorridorBelief, Glimpse
+from pmnav_bt.pose.belief import CorridorBelief
+from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.landmark_fix import Sighting, fix_pose
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.seams import EntityKind, Pose2D

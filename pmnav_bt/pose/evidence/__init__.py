@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,12 +31,10 @@ from pmnav_bt.pose.evidence.doors import (
 )
 from pmnav_bt.pose.evidence.floor import P_DEPTH, P_DRIVE_RAY, Floor
 from pmnav_bt.pose.evidence.signs import SIGHT_SIGMA_M, Recall, Signs, sight_sigma
+from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.hypotheses import apply_many
 from pmnav_bt.pose.visibility import Visibility
 from pmnav_bt.seams import Pose2D
-
-if TYPE_CHECKING:
-    from pmnav_bt.pose.belief import Glimpse
 
 
 @dataclass(frozen=True)
