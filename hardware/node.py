@@ -210,14 +210,15 @@ class PmNavController:
         from std_msgs.msg import Empty, String
         from visualization_msgs.msg import MarkerArray
 
-        from pmnav_bt.backends import build_backends
         from pmnav_bt.config import load_config
         from pmnav_bt.hardware import qos
         from pmnav_bt.hardware.create3 import Create3Base
         from pmnav_bt.map.catalogue import load_building
         from pmnav_bt.map.priori_map import parse_building
-        from pmnav_bt.trees import runner  # noqa: F401 - import the tree now, not at the first
-        # goal: a long import holds the GIL and would starve the executor (odometry "stale")
+
+        # the tree imported now, not at the first goal: a long import holds the GIL and
+        # would starve the executor (odometry "stale")
+        from pmnav_bt.trees import runner
 
         self.node = node
         self.runtime = runtime
@@ -229,9 +230,11 @@ class PmNavController:
         self.config = load_config(p["config"] or None, overrides, label="parameter 'overrides'")
         self.building = load_building(p["building"])
         self.pm = parse_building(self.building)
-        # The back ends, built once; a back end that reads the simulator's labels is refused
-        # (one line, from the registry) unless the simulated Create 3 publishes them.
-        self.backends = build_backends(
+        # The back ends, built once on what the tree variant may read (an unknown variant
+        # is refused now, not at the first goal); a back end that reads the simulator's
+        # labels is refused (one line, from the registry) unless the simulated Create 3
+        # publishes them.
+        self.backends = runner.variant_backends(
             self.config, self.pm, on_robot=not p["segmentation_topic"], seed=int(p["seed"])
         )
         self.base = Create3Base(node, create3_options(p))

@@ -52,6 +52,16 @@ def action_budget(config: Config, route_m: float | None) -> int:
     return task_action_budget(route_m, config.tree.budget_actions, config.tree.budget_path_factor)
 
 
+def variant_backends(config: Config, pm: PrioriMap, *, on_robot: bool, seed: int = 0) -> Backends:
+    """The back ends the config names, built on what the tree variant ``config.tree.variant``
+    may read of ``pm`` (a planner only for a variant that plans); an unknown variant is
+    refused here, in one line. A long-lived node builds them once with this."""
+    knows = TREE_VARIANTS.spec(config.tree.variant).knows
+    return build_backends(
+        config, knows.known(pm), on_robot=on_robot, seed=seed, planner=knows.plans
+    )
+
+
 def make_context(
     base: Base,
     pm: PrioriMap,
@@ -76,7 +86,7 @@ def make_context(
     knows = TREE_VARIANTS.spec(config.tree.variant).knows
     known = knows.known(pm)
     if backends is None:
-        backends = build_backends(config, known, on_robot=on_robot, seed=seed, planner=knows.plans)
+        backends = variant_backends(config, pm, on_robot=on_robot, seed=seed)
     elif not knows.plans:
         backends = replace(backends, planner=None)
     return Context.wired(

@@ -93,3 +93,15 @@ def test_a_new_variant_registers_by_name_and_gets_its_context_and_tree(fig2_map)
         TREE_VARIANTS._specs.pop("tiny")
     with pytest.raises(TypeError, match="TreeVariant"):
         TREE_VARIANTS.register(object())
+
+
+def test_a_nodes_back_ends_are_built_on_what_its_variant_may_read(fig2_map):
+    from pmnav_bt.trees.runner import variant_backends
+
+    cfg = load_config(overrides=[ORACLE, "tree.variant=mapless"])
+    mapless = variant_backends(cfg, fig2_map, on_robot=False)
+    assert mapless.planner is None and mapless.grounder is not None
+    pmnav = variant_backends(load_config(overrides=[ORACLE]), fig2_map, on_robot=False)
+    assert pmnav.planner is not None
+    with pytest.raises(ConfigError, match="registered: pmnav, coarse_only, mapless"):
+        variant_backends(load_config(overrides=["tree.variant=fancy"]), fig2_map, on_robot=False)
