@@ -10,7 +10,7 @@ busy. Two worker modes are measured:
 
 The sign_sparse_2 case starts with no sign in reach: the corridor belief is built,
 weighed with each look (``UpdateBelief``, in the worker) and with the depth along each
-drive (``FollowLead``), which is where the slowest ticks were.
+drive (``behaviours/follow_lead.py``), which is where the slowest ticks were.
 
     python benchmarks/bench_tree.py [--episodes 4] [--case sign_sparse_2] [--set k=v]
 """
