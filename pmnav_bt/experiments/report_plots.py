@@ -13,21 +13,13 @@ from pmnav_bt.experiments.report_tables import (
     tiers_present,
 )
 from pmnav_bt.experiments.variants import variant_title
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+from pmnav_bt.render import headless_pyplot
 
 
 def plot_sr_spl(results: Results, path: Path) -> Path:
     """Two panels (SR, SPL), bars grouped by tier, one colour per variant, n under each
     tier."""
-    plt = _pyplot()
+    plt = headless_pyplot()
     tiers = [*tiers_present(results), "all"]
     names = list(results)
     stats = {n: tier_stats(results[n]) for n in names}
@@ -66,7 +58,7 @@ def plot_sr_spl(results: Results, path: Path) -> Path:
 
 def plot_failures(results: Results, path: Path) -> Path:
     """Stacked bars: failed runs per variant, by failure code."""
-    plt = _pyplot()
+    plt = headless_pyplot()
     counts = failure_counts(results)
     names = list(results)
     codes = sorted({c for cnt in counts.values() for c in cnt})

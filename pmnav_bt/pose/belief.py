@@ -162,9 +162,9 @@ class CorridorBelief:
             return
         if self.prior is not None:
             weigh_prior(self.logw, self.hyps, self.ref, *self.prior)
+        tfs = self.map_T_odoms()  # the hypotheses and the reference are fixed from here
         for g in self.glimpses:
-            self.evidence.look(self.logw, g, self.map_T_odoms(), self.ref)
-        tfs = self.map_T_odoms()
+            self.evidence.look(self.logw, g, tfs, self.ref)
         for r in self.rays:
             self.evidence.drive_view(self.logw, r, tfs)
 
@@ -332,6 +332,7 @@ class CorridorBelief:
         w = self.weights()[idx]
         i = idx[int(np.argmax(w))]
         tf = tuple(self.map_T_odoms()[i])
+        spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
         src, dst, placed = [], [], []
         for g in self.glimpses:
             for e, oxy in g.seen.items():
@@ -341,7 +342,6 @@ class CorridorBelief:
                     dst.append(m)
                     placed.append(PLACE_SIGMA_M[e.kind])
         if not src:  # nothing read: the hypothesis as it is, if the belief is tight enough
-            spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
             if spread > BLIND_SPREAD_M:
                 return None
             return self.to_odom(tf), spread + 0.5
@@ -351,7 +351,6 @@ class CorridorBelief:
             fitted = self.level_with_walls(fit, tuple(np.mean(dst, axis=0)))
         if fitted is not None:
             tf = fitted
-        spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
         if fitted is None:  # signs close together, or a fit the walls refute: the
             # hypothesis's heading, its position moved towards what the signs say as far
             # as they are surer of it than the belief is (an elevator's plate hangs a

@@ -9,6 +9,7 @@ from typing import Protocol
 import numpy as np
 
 from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.pose.evidence import Evidence
 from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.hypotheses import Hypotheses
 from pmnav_bt.pose.visibility import Visibility
@@ -22,6 +23,7 @@ class BeliefView(Protocol):
     vis: Visibility  # the lattice with the signs readable from each point
     goal: Visibility  # ... read reliably: where to go to read them
     hyps: Hypotheses
+    evidence: Evidence  # (the blocked ways: ``evidence.floor``)
     glimpses: list[Glimpse]
     ref: Pose2D | None
     pending_blocked: float | None

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pmnav_bt.geometry import se2_apply, se2_inverse, wrap_angle
+from pmnav_bt.geometry import se2_inverse, wrap_angle
 from pmnav_bt.map.priori_map import Segment
 from pmnav_bt.pose.visibility import Visibility
 from pmnav_bt.seams import Pose2D
@@ -145,10 +145,6 @@ class Straightened:
         c, s = math.cos(-self.drift), math.sin(-self.drift)
         rx, ry = self.raw.x, self.raw.y
         return (self.corr[0] - (c * rx - s * ry), self.corr[1] - (s * rx + c * ry), -self.drift)
-
-    def apply(self, xy) -> np.ndarray:
-        """An odometry point in the straightened frame."""
-        return se2_apply(self.tf(), xy)
 
     def scaled(self, moved) -> Straightened:
         """With the straightened position moved by ``moved`` (a rescale of distances)."""

@@ -18,7 +18,7 @@ that leaves the likeliest clusters mirror images of each other, such as a dead e
 both dead ends look alike: from a cross junction it drove to one dead end, learnt
 nothing it needed, and drove 60 m back.
 
-Pure numpy on arrays the belief builds (``CorridorBelief._telling_lead``); costs are in
+Pure numpy on arrays the belief builds (``pose.telling.telling_lead``); costs are in
 mass-weighted metres.
 """
 

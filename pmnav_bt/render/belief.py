@@ -23,6 +23,7 @@ from pmnav_bt.geometry import se2_compose
 from pmnav_bt.pose.belief import CorridorBelief
 from pmnav_bt.pose.hypotheses import apply_many
 from pmnav_bt.pose.visibility import entity_xy
+from pmnav_bt.render import headless_pyplot
 from pmnav_bt.seams import Pose2D
 
 SHOWN_WEIGHT = 1e-3  # hypotheses this likely (of the best) are drawn
@@ -44,15 +45,6 @@ class BeliefStep:
     odom: Pose2D
     truth: Pose2D | None = None
     fix: tuple[float, float, float] | None = None
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def hypotheses_now(belief: CorridorBelief, odom: Pose2D) -> tuple[np.ndarray, np.ndarray]:
@@ -164,7 +156,7 @@ def _figsize(b: CorridorBelief, width: float) -> tuple[float, float]:
 
 def render_step(step: BeliefStep, path: str | Path, width: float = 9.0) -> Path:
     """One step as a PNG at ``path``."""
-    plt = _pyplot()
+    plt = headless_pyplot()
     fig, ax = plt.subplots(figsize=_figsize(step.belief, width))
     draw_belief(ax, step)
     fig.savefig(path, dpi=110, bbox_inches="tight")
@@ -174,7 +166,7 @@ def render_step(step: BeliefStep, path: str | Path, width: float = 9.0) -> Path:
 
 def render_sheet(steps: list[BeliefStep], path: str | Path, cols: int = 4) -> Path:
     """Every step small on one contact sheet (row by row, in order) as a PNG at ``path``."""
-    plt = _pyplot()
+    plt = headless_pyplot()
     if not steps:
         raise ValueError("no steps to draw")
     cols = min(cols, len(steps))
