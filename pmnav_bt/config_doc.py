@@ -59,8 +59,9 @@ _BACKENDS_INTRO = inspect.cleandoc(
     `pmnav-ros` counts as a robot unless it subscribes to a segmentation topic (the
     simulated Create 3 publishes one). An unknown name is a config error that lists the
     registered ones. A new back end: `BackendSpec(name, "package.module:factory", summary)`
-    registered on the seam's registry; the factory gets the config, the priori-map, the
-    seed and (for coarse direction) the run's grounder."""
+    registered on the seam's registry (a grounder: `GrounderSpec`, which also declares its
+    reading model and whether it is an oracle); the factory gets the config, the
+    priori-map, the seed and (for coarse direction) the run's grounder."""
 )
 
 

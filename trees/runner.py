@@ -86,7 +86,7 @@ def make_context(
     knows = TREE_VARIANTS.spec(config.tree.variant).knows
     known = knows.known(pm)
     if backends is None:
-        backends = variant_backends(config, pm, on_robot=on_robot, seed=seed)
+        backends = build_backends(config, known, on_robot=on_robot, seed=seed, planner=knows.plans)
     elif not knows.plans:
         backends = replace(backends, planner=None)
     return Context.wired(

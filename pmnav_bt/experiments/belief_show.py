@@ -15,15 +15,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
-from pmnav_bt.config import Config
-from pmnav_bt.experiments.localization_study import LocStart, classified_starts, run_localization
-from pmnav_bt.pose.belief import CorridorBelief
-from pmnav_bt.pose.visibility import LandmarkDensity
-from pmnav_bt.render.belief import BeliefStep, render_sheet, render_step
-from pmnav_bt.seams import Pose2D
+if TYPE_CHECKING:  # the simulator and the drawing are imported when used: `pmnav` starts fast
+    from pmnav_bt.config import Config
+    from pmnav_bt.experiments.localization_study import LocStart
+    from pmnav_bt.render.belief import BeliefStep
 
 DEFAULT_BUILDING = "sign_sparse_2"
 
@@ -43,6 +42,8 @@ class BeliefWatch:
         import py_trees
 
         from pmnav_bt.behaviours.common import NAMESPACE
+        from pmnav_bt.pose.belief import CorridorBelief
+        from pmnav_bt.render.belief import BeliefStep
 
         store = py_trees.blackboard.Blackboard.storage
         belief = store.get(f"{NAMESPACE}/belief")
@@ -72,6 +73,8 @@ class BeliefWatch:
             self._rays = len(belief.rays)
 
     def _flush_drive(self) -> None:
+        from pmnav_bt.render.belief import BeliefStep
+
         if self._drive is None:
             return
         belief, odom, truth, start = self._drive
@@ -105,7 +108,9 @@ def _drive_title(n: int, belief, start: int, driven: float) -> str:
 def default_start(building: str, config: Config, seed: int = 0) -> LocStart:
     """The first scarce start of ``building`` (no sign in reach), as Table 3 draws them;
     else its first start of any class."""
+    from pmnav_bt.experiments.localization_study import classified_starts
     from pmnav_bt.perception.read_range import landmark_ranges
+    from pmnav_bt.pose.visibility import LandmarkDensity
 
     starts = classified_starts(building, 1, seed, landmark_ranges(config))
     scarce = [s for s in starts if s.density == LandmarkDensity.SCARCE.value]
@@ -117,6 +122,9 @@ def default_start(building: str, config: Config, seed: int = 0) -> LocStart:
 def show_belief(start: LocStart, config: Config, out: Path) -> tuple[list[Path], Path, object]:
     """Run the localization from ``start`` and draw each step into ``out``: the step
     pictures, the contact sheet and the run's result."""
+    from pmnav_bt.experiments.localization_study import run_localization
+    from pmnav_bt.render.belief import render_sheet, render_step
+
     watch = BeliefWatch()
     result = run_localization(start, config, watch=watch)
     watch.finish()
@@ -138,6 +146,7 @@ def belief(
 ) -> None:
     """Localize from a start and draw the corridor belief after every look and drive."""
     from pmnav_bt.config import load_config
+    from pmnav_bt.experiments.localization_study import LocStart
     from pmnav_bt.loading import check_output_dir
     from pmnav_bt.sim.poses import parse_pose
 
@@ -146,7 +155,7 @@ def belief(
     if start is None:
         loc = default_start(building, cfg, seed)
     else:
-        p: Pose2D = parse_pose(start)
+        p = parse_pose(start)
         loc = LocStart(building, p.x, p.y, p.yaw, "given", -1, seed)
     typer.echo(f"{building}: from ({loc.x:.1f}, {loc.y:.1f}, {math.degrees(loc.yaw):.0f} deg)")
     paths, sheet, result = show_belief(loc, cfg, out)
