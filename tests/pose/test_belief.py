@@ -25,11 +25,11 @@ from pmnav_bt.seams import EntityKind, Pose2D
 
 
 @pytest.mark.parametrize("n", [1, 2, 3])
-def test_signs_seen_where_the_map_says_fix_the_pose(fig2, n):
-    for p in points_reading(fig2, n)[::9]:
-        true = (*p.xy, fig2.segments[p.segment - 1].heading)
-        b = CorridorBelief(fig2)
-        b.observe(glimpse(fig2, true, p.readable))
+def test_signs_seen_where_the_map_says_fix_the_pose(fig2_map, n):
+    for p in points_reading(fig2_map, n)[::9]:
+        true = (*p.xy, fig2_map.segments[p.segment - 1].heading)
+        b = CorridorBelief(fig2_map)
+        b.observe(glimpse(fig2_map, true, p.readable))
         fix = b.fix()
         if all(e.kind is EntityKind.LANDMARK for e in p.readable):
             # A lone elevator plate hangs beside the elevator: no surer of the place

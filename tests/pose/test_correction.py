@@ -8,8 +8,6 @@ import numpy as np
 import pytest
 
 from pmnav_bt.geometry import se2_apply, se2_inverse
-from pmnav_bt.map.catalogue import load_building
-from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.correction import TOLERANCE_MIN_M, PoseTracker, Verified
 from pmnav_bt.pose.snap import OffMapError, snap_to_corridor
 from pmnav_bt.pose.walls import (
@@ -87,22 +85,17 @@ def test_both_walls_give_the_way_back_to_the_corridors_centre_line(lateral):
     assert corridor_centre(np.vstack([wall(1.2), clutter])) is None
 
 
-@pytest.fixture(scope="module")
-def fig2():
-    return parse_building(load_building("fig2_hospital"))
-
-
-def test_an_estimate_off_the_corridor_is_snapped_onto_it(fig2):
-    seg = fig2.segments[0]
-    a, b = fig2.node_xy(seg.a), fig2.node_xy(seg.b)
+def test_an_estimate_off_the_corridor_is_snapped_onto_it(fig2_map):
+    seg = fig2_map.segments[0]
+    a, b = fig2_map.node_xy(seg.a), fig2_map.node_xy(seg.b)
     mid = (a + b) / 2
     normal = np.array([-math.sin(seg.heading), math.cos(seg.heading)])
     off = mid + normal * (seg.width / 2 + 3.0)  # 3 m into the wall
-    s = snap_to_corridor(fig2, Pose2D(*off, seg.heading), sigma=2.0)
-    loc = fig2.locate(s.pose.x, s.pose.y)
+    s = snap_to_corridor(fig2_map, Pose2D(*off, seg.heading), sigma=2.0)
+    loc = fig2_map.locate(s.pose.x, s.pose.y)
     assert loc.offset < seg.width / 2
     assert s.moved > 3.0
-    inside = snap_to_corridor(fig2, Pose2D(*mid, seg.heading), sigma=1.0)
+    inside = snap_to_corridor(fig2_map, Pose2D(*mid, seg.heading), sigma=1.0)
     assert inside.moved == 0.0
     with pytest.raises(OffMapError, match="uncertainty"):
-        snap_to_corridor(fig2, Pose2D(*(mid + normal * 40.0), seg.heading), sigma=0.5)
+        snap_to_corridor(fig2_map, Pose2D(*(mid + normal * 40.0), seg.heading), sigma=0.5)

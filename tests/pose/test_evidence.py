@@ -81,7 +81,7 @@ def test_views_that_meet_a_side_wall_obliquely_do_not_count_against_the_true_pla
     assert b.logw[i] >= b.logw.max() - 0.5
 
 
-def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_read(fig2):
+def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_read(fig2_map):
     """OCR names a plate 5 m off one time in seven: not reading it there must not count
     against the true place as a sign 2 m off does (the constant P_MISS made a bare
     corridor's mirror image look likelier than the truth beside far signs)."""
@@ -93,11 +93,11 @@ def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_r
     assert ocr_recall(640, 3.0, "name") < ocr_recall(640, 3.0, "number")
     assert ocr_recall(160, 1.5) == ocr_recall(320, 3.0)  # half the pixels: twice as far
     cfg = load_config(None, ["grounder.backend=ocr"])
-    assert sign_recall(load_config(None, ["grounder.backend=sim_gt"]), fig2.building) is None
+    assert sign_recall(load_config(None, ["grounder.backend=sim_gt"]), fig2_map.building) is None
     b = CorridorBelief(
-        fig2, read_range=sign_visible_range(cfg), recall=sign_recall(cfg, fig2.building)
+        fig2_map, read_range=sign_visible_range(cfg), recall=sign_recall(cfg, fig2_map.building)
     )
-    flat = CorridorBelief(fig2, read_range=sign_visible_range(cfg))
+    flat = CorridorBelief(fig2_map, read_range=sign_visible_range(cfg))
     vis, where = b.vis, dict(zip(b.vis.entities, b.vis.sign_xy, strict=True))
     near = far = None
     for p in vis.lattice_points:
@@ -117,7 +117,7 @@ def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_r
         for q in vis.lattice_points
         if q.readable and all(math.dist(q.xy, where[e]) > 4.6 for e in q.readable)
     )
-    g = glimpse(fig2, (*p.xy, fig2.segments[p.segment - 1].heading), ())
+    g = glimpse(fig2_map, (*p.xy, fig2_map.segments[p.segment - 1].heading), ())
     for belief in (b, flat):
         belief.observe(g)
     i = int(np.argmin(np.linalg.norm(b.xy - np.array(p.xy), axis=1)))
@@ -127,7 +127,7 @@ def test_a_sign_the_reader_seldom_reads_from_there_is_little_evidence_when_not_r
     assert lost < 0.5 and lost_flat >= math.log(4.0) - 1e-9
 
 
-def test_a_plate_seen_along_its_wall_is_no_evidence_when_not_read(fig2):
+def test_a_plate_seen_along_its_wall_is_no_evidence_when_not_read(fig2_map):
     """OCR read none of 44 plates seen more than 75 deg off their normal
     (bench_signs.py --angles 0,88): a plate along the wall beside the robot is not missed."""
     from pmnav_bt.config import load_config
@@ -137,7 +137,7 @@ def test_a_plate_seen_along_its_wall_is_no_evidence_when_not_read(fig2):
     assert 0.0 < angle_share(math.radians(72)) < 1.0 == angle_share(math.radians(-40))
     assert angle_share(math.radians(80)) == 0.0
     cfg = load_config(None, ["grounder.backend=ocr"])
-    b = CorridorBelief(fig2, read_range=6.0, recall=sign_recall(cfg, fig2.building))
+    b = CorridorBelief(fig2_map, read_range=6.0, recall=sign_recall(cfg, fig2_map.building))
     vis = b.vis
     head_on = along = None
     for p in vis.lattice_points:
@@ -179,7 +179,7 @@ def test_a_miss_is_judged_from_where_the_hypothesis_puts_the_robot_not_the_centr
     assert b.logw[truth[0]] - b.logw.max() > math.log(0.25)
 
 
-def test_a_sign_read_but_cut_by_the_border_is_in_sight_not_missed(fig2):
+def test_a_sign_read_but_cut_by_the_border_is_in_sight_not_missed(fig2_map):
     """A plate cut by the image border is read but not placed (its centre is biased): it
     says the sign is in sight, so the place where the map puts it in sight is not charged
     a miss, and places where it cannot be seen are charged a spurious reading: places
@@ -187,11 +187,11 @@ def test_a_sign_read_but_cut_by_the_border_is_in_sight_not_missed(fig2):
     door the map places less (the plate hangs a metre beside it: sign_sparse_0 hard #2
     read room14 round the corner of a junction, and the truth lost 200:1 to a place the
     building's shape mirrors)."""
-    p = next(q for q in points_reading(fig2, 1))
+    p = next(q for q in points_reading(fig2_map, 1))
     (e,) = p.readable
-    true = (*p.xy, fig2.segments[p.segment - 1].heading)
-    g = glimpse(fig2, true, ())
-    missed, named = CorridorBelief(fig2), CorridorBelief(fig2)
+    true = (*p.xy, fig2_map.segments[p.segment - 1].heading)
+    g = glimpse(fig2_map, true, ())
+    missed, named = CorridorBelief(fig2_map), CorridorBelief(fig2_map)
     missed.observe(g)
     named.observe(Glimpse(g.odom, {}, named=frozenset({e})))
     vis = named.vis
@@ -199,7 +199,7 @@ def test_a_sign_read_but_cut_by_the_border_is_in_sight_not_missed(fig2):
     elsewhere = [j for j, q in enumerate(named.lattice) if e not in vis.lattice_points[q].readable]
     assert named.logw[i] == 0.0 and missed.logw[i] == pytest.approx(math.log(0.25))
     here = named.xy[elsewhere]  # at the reference glimpse, the lattice points
-    near = np.linalg.norm(here - np.array(entity_xy(fig2, e)), axis=1) <= vis.read_range
+    near = np.linalg.norm(here - np.array(entity_xy(fig2_map, e)), axis=1) <= vis.read_range
     assert near.any() and (~near).any()
     gain = named.logw[elsewhere] - missed.logw[elsewhere]
     np.testing.assert_allclose(gain[~near], math.log(0.005), atol=1e-9)
