@@ -6,7 +6,6 @@ the Context holds the things a behaviour *uses* (injected once, not looked up).
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,13 +17,8 @@ from pmnav_bt.geometry import se2_compose, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose.odometry import CalibratedBase
 from pmnav_bt.seams import Base, CoarseDirection, Grounder, Planner, Pose2D, Refiner
+from pmnav_bt.tree_variants import DetourCheck
 from pmnav_bt.worker import Worker
-
-# Whether a point (x, y) round an obstacle stays ``margin`` m clear of the walls, by what
-# the tree variant knows of them (PM-Nav: the priori-map's corridors); the drive's depth
-# has already shown the floor free up to it. Given to the Context where the variant is
-# built (trees/variants.py); None: the variant knows no walls (the map-less baseline).
-DetourCheck = Callable[[tuple[float, float], float], bool]
 
 
 @dataclass

@@ -16,7 +16,7 @@ import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
-from pmnav_bt.behaviours.context import Context, DetourCheck, heading_error, map_pose, thumbnail
+from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
 from pmnav_bt.behaviours.pose import keep_on_axis, measure_walls
 from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
@@ -24,6 +24,7 @@ from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
 from pmnav_bt.perception.corner import is_corner, is_opening, mask_ratios
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.seams import MotionStatus
+from pmnav_bt.tree_variants import DetourCheck
 
 NO_PROGRESS_S = 10.0  # clock seconds without getting 0.1 m closer -> blocked
 WATCH_PERIOD_S = 1.0  # clock seconds between obstacle checks from depth

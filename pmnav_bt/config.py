@@ -29,17 +29,23 @@ class _Section(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True)
 
 
+def _named(registry, name: str) -> str:
+    """``name`` if ``registry`` (a ``registry.Named``) holds it; else the registry's one-line
+    error (the names it holds, the nearest one) as a validation error of the field."""
+    try:
+        registry.spec(name)
+    except ConfigError as err:
+        raise ValueError(str(err).split(": ", 1)[1]) from None
+    return name
+
+
 def _registered(seam: str):
     """A validator: ``backend`` must name a back end registered for ``seam``."""
 
     def check(cls, name: str) -> str:
         from pmnav_bt.registry import REGISTRIES
 
-        try:
-            REGISTRIES[seam].spec(name)
-        except ConfigError as err:
-            raise ValueError(str(err).split(": ", 1)[1]) from None
-        return name
+        return _named(REGISTRIES[seam], name)
 
     return field_validator("backend")(check)
 
@@ -196,11 +202,19 @@ class TreeConfig(_Section):
 
     variant: str = Field(
         "pmnav",
-        description="the tree, by name (registered in trees/variants.py: the context and "
-        "tree are built, and an unknown name refused, from there): pmnav; coarse_only: no "
+        description="the tree, by name (registered in pmnav_bt/tree_variants.py, where its "
+        "context and tree are built from): pmnav; coarse_only: no "
         "grounding or refinement (paper Table 4); mapless: the map-less frontier-exploring "
         "baseline (docs/baseline.md)",
     )
+
+    @field_validator("variant")
+    @classmethod
+    def _registered_variant(cls, name: str) -> str:
+        from pmnav_bt.tree_variants import TREE_VARIANTS
+
+        return _named(TREE_VARIANTS, name)
+
     tick_hz: float = Field(
         10.0, ge=0.5, le=1000.0, description="tree ticks per second of the clock"
     )
@@ -345,13 +359,18 @@ def load_config(
             value = float(value)  # YAML 1.1 reads 1e3 as text; on the command line it is a number
         _set_dotted(data, key.strip(), value, label)
         set_keys.add(key.strip())
+    return config_from_data(data, source, {k: label for k in set_keys})
+
+
+def config_from_data(data: Any, source: str, sources: dict[str, str] | None = None) -> Config:
+    """``data`` validated as a Config; else a ConfigError of one line naming ``source`` (or,
+    for a key in ``sources``, where that key was set), the key and what is wrong."""
     try:
         return Config.model_validate(data)
     except ValidationError as err:
         e = err.errors()[0]
         where = ".".join(str(p) for p in e["loc"])
-        if where in set_keys:
-            source = label
+        source = (sources or {}).get(where, source)
         more = f" (and {len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
         msg = e["msg"].removeprefix("Value error, ")
         got = e.get("input")

@@ -69,7 +69,7 @@ def _build_tree(variant: str):
 @app.command()
 def render(
     variant: str = typer.Option(
-        "pmnav", "--variant", help="A tree variant by name (registered in trees/variants.py)."
+        "pmnav", "--variant", help="A tree variant (registered in pmnav_bt/tree_variants.py)."
     ),
     out: Path = typer.Option(Path("."), "--out", help="Folder for the pictures."),
     name: str | None = typer.Option(None, "--name", help="File name stem [default: the variant]."),
@@ -118,7 +118,7 @@ def render(
             title=title,
         )
     else:
-        from pmnav_bt.trees.variants import TREE_VARIANTS
+        from pmnav_bt.tree_variants import TREE_VARIANTS
 
         if variant not in TREE_VARIANTS.names():
             choices = ", ".join(TREE_VARIANTS.names())

@@ -7,7 +7,7 @@ looked down, where it has been), reads signs as it looks around and as it drives
 once the goal room's sign and door are seen it places the door by the refiner's range
 and approaches it with PM-Nav's drive and stop. It knows the building's sign vocabulary
 (which sign names which room: ``map.signs_only.SignsOnly``) and nothing of where: it is
-registered so in ``trees/variants.py`` (``SIGN_VOCABULARY``), which builds its context with
+registered so in ``pmnav_bt/tree_variants.py`` (``SIGN_VOCABULARY``), which builds its context with
 no planner, and drives round an obstacle where depth shows the floor free (no walls known).
 
     Mission

@@ -1,7 +1,7 @@
 """The PM-Nav tree: localize, plan, then per step "target determination -> search ->
 verification -> target update", with re-search, replanning and a budget.
 
-Two tree variants (paper, Table 4; registered in ``trees/variants.py``): ``pmnav``
+Two tree variants (paper, Table 4; registered in ``pmnav_bt/tree_variants.py``): ``pmnav``
 (``build_pmnav_tree``) refines the coarse direction with grounding and the refiner back
 end (``refiner.backend``; a refiner that ``drives_approach``, a pixel-goal policy such as
 ``pixelnav``, also drives the approach to the goal door in closed loop); ``coarse_only``

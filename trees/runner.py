@@ -23,8 +23,8 @@ from pmnav_bt.eval.task import action_budget as task_action_budget
 from pmnav_bt.failures import Failure, FailureCode, failure_from, root_cause
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.seams import Base
+from pmnav_bt.tree_variants import TREE_VARIANTS
 from pmnav_bt.trees.snapshots import SnapshotLogger
-from pmnav_bt.trees.variants import TREE_VARIANTS
 
 
 @dataclass
@@ -73,7 +73,7 @@ def make_context(
     on_robot: bool = False,
     backends: Backends | None = None,
 ) -> Context:
-    """The Context of the tree variant ``config.tree.variant`` (``trees.variants``): what
+    """The Context of the tree variant ``config.tree.variant`` (``pmnav_bt.tree_variants``): what
     it may read of ``pm`` (the whole priori-map, or the sign vocabulary only), the back
     ends the config names built on that (``build_backends``; a planner only for a variant
     that plans), and its drives' detour check, wired together.
@@ -97,7 +97,7 @@ def make_context(
 
 def build_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
     """The tree of the variant ``ctx.config.tree.variant`` for ``goal``
-    (``trees.variants.TREE_VARIANTS``), on a context ``make_context`` built for it."""
+    (``pmnav_bt.tree_variants.TREE_VARIANTS``), on a context ``make_context`` built for it."""
     return TREE_VARIANTS.spec(ctx.config.tree.variant).build_tree(ctx, goal)
 
 

@@ -18,7 +18,7 @@ from pmnav_bt.config import Config
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
 from pmnav_bt.loading import atomic_write_text, safe_filename
 from pmnav_bt.registry import grounder_label
-from pmnav_bt.trees.variants import TREE_VARIANTS
+from pmnav_bt.tree_variants import TREE_VARIANTS
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.sim.episodes import Episode

@@ -162,7 +162,7 @@ def run(
 ) -> None:
     """Run one PM-Nav episode and print its result; write the tree log and trajectory plot."""
     from pmnav_bt.experiments.evaluation import custom_episode, run_episode
-    from pmnav_bt.trees.variants import TREE_VARIANTS
+    from pmnav_bt.tree_variants import TREE_VARIANTS
 
     cli_values.seed(seed)
     cli_values.index(index)

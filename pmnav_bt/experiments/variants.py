@@ -1,7 +1,7 @@
 """Named evaluation variants: a tree variant plus config overrides and a label. A variant
 whose grounder is an oracle (its registry spec says ``oracle=True``: ground-truth
 perception) is labelled so in every table. The tree variant
-(``tree.variant``) must be one registered in ``trees/variants.py``: a row naming another
+(``tree.variant``) must be one registered in ``pmnav_bt/tree_variants.py``: a row naming another
 is refused when its config is made.
 
 Adding a variant is one line in ``VARIANTS``, e.g.
@@ -18,10 +18,9 @@ import json
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from pmnav_bt.config import Config, ConfigError, _set_dotted
+from pmnav_bt.config import Config, _set_dotted, config_from_data
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.registry import GROUNDERS
-from pmnav_bt.trees.variants import TREE_VARIANTS
 
 ORACLE_LABEL = "oracle: simulator labels"
 
@@ -50,16 +49,12 @@ class Variant:
         return f"{self.label} ({ORACLE_LABEL})" if self.oracle else self.label
 
     def config(self, base: Config) -> Config:
-        """``base`` with this variant's overrides applied (its tree variant registered)."""
+        """``base`` with this variant's overrides applied (a ConfigError of one line when
+        they make no valid config, e.g. an unregistered tree variant)."""
         data = base.model_dump(mode="json")
         for key, value in self.overrides:
             _set_dotted(data, key, value, label=f"variant {self.name}")
-        try:
-            config = Config.model_validate(data)
-            TREE_VARIANTS.spec(config.tree.variant)
-        except (ValueError, ConfigError) as err:
-            raise ConfigError(f"variant {self.name}: {err}".splitlines()[0]) from None
-        return config
+        return config_from_data(data, f"variant {self.name}")
 
 
 VARIANTS: dict[str, Variant] = {

@@ -24,7 +24,8 @@ def test_defaults_and_overrides(tmp_path):
     "overrides, words",
     [
         (["grounder.miss_rate=2"], "grounder.miss_rate"),
-        (["tree.variant=1"], "tree.variant"),  # a name; unknown names: tests/trees/test_variants.py
+        (["tree.variant=fast"], "tree.variant: unknown tree variant 'fast'"),  # at load
+        (["tree.variant=1"], "tree.variant"),  # a name
         (["grounder.colour=red"], "grounder.colour"),
         (["novalue"], "expected section.key=value"),
     ],

@@ -18,8 +18,8 @@ from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.seams import Observation, Pose2D
 from pmnav_bt.testing import doubles
 from pmnav_bt.testing.oracle import ORACLE
+from pmnav_bt.tree_variants import TREE_VARIANTS
 from pmnav_bt.trees.runner import make_context, run_tree
-from pmnav_bt.trees.variants import TREE_VARIANTS
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""Tree variants by name (trees/variants.py): one registry builds each variant's context
+"""Tree variants by name (pmnav_bt/tree_variants.py): one registry builds each variant's context
 and tree, refuses unknown names in one line that lists the known ones, and the evaluation's
 rows name only registered variants."""
 
@@ -23,8 +23,8 @@ from pmnav_bt.testing.doubles import (
     ScriptedGrounder,
 )
 from pmnav_bt.testing.oracle import ORACLE
+from pmnav_bt.tree_variants import PRIORI_MAP, TREE_VARIANTS, TreeVariant
 from pmnav_bt.trees.runner import build_tree, make_context
-from pmnav_bt.trees.variants import PRIORI_MAP, TREE_VARIANTS, TreeVariant
 
 
 @dataclasses.dataclass

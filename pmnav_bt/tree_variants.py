@@ -2,8 +2,9 @@
 context and tree are built and what of the building it may read.
 
 A variant is a ``TreeVariant``: its tree builder (``"package.module:function"``, imported
-when the tree is built, as back-end factories are: this module imports neither py_trees
-nor a tree) and its ``Knowledge``, what it may read of the building:
+when the tree is built, as back-end factories are: this core module imports neither
+py_trees nor a tree, so the config checks ``tree.variant`` against it when it loads) and
+its ``Knowledge``, what it may read of the building:
 
 - ``PRIORI_MAP``: the whole priori-map; a planner; drives round obstacles only to points
   inside the map's corridors (PM-Nav and its ablations).
@@ -29,10 +30,13 @@ from pmnav_bt.map.signs_only import SignsOnly
 from pmnav_bt.registry import Named, load
 
 if TYPE_CHECKING:  # pragma: no cover
-    import py_trees
-
-    from pmnav_bt.behaviours.context import Context, DetourCheck
     from pmnav_bt.map.priori_map import PrioriMap
+
+# Whether a point (x, y) round an obstacle stays ``margin`` m clear of the walls, by what
+# the tree variant knows of them (PM-Nav: the priori-map's corridors); the drive's depth
+# has already shown the floor free up to it. Given to the Context where the variant is
+# built; None: the variant knows no walls (the map-less baseline).
+DetourCheck = Callable[[tuple[float, float], float], bool]
 
 
 def within_corridors(pm: PrioriMap) -> DetourCheck:
@@ -50,7 +54,7 @@ class Knowledge:
     """What a variant may read of the building, and what follows from it: ``known(pm)``
     is what its Context's ``pm`` is (the back ends are built on it too); ``plans``: it gets
     the configured planner; ``detour_check(known)``: its drives' check of a point round an
-    obstacle (``behaviours.context.DetourCheck``; None: depth only)."""
+    obstacle (``DetourCheck``; None: depth only)."""
 
     name: str
     known: Callable[[PrioriMap], Any]
@@ -76,8 +80,9 @@ class TreeVariant:
     label: str
     summary: str
 
-    def build_tree(self, ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
-        """This variant's tree for ``goal`` on ``ctx`` (a context built for it)."""
+    def build_tree(self, ctx: Any, goal: str) -> Any:
+        """This variant's tree (a py_trees ``BehaviourTree``) for ``goal`` on ``ctx`` (a
+        ``behaviours.context.Context`` built for it)."""
         return load(self.tree)(ctx, goal)
 
 
