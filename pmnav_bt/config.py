@@ -11,7 +11,14 @@ import re
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from pmnav_bt.errors import ConfigError, PmNavError
 from pmnav_bt.eval.task import BUDGET_ACTIONS, BUDGET_PATH_FACTOR, STOP_OFFSET_M
@@ -295,6 +302,116 @@ class SimConfig(_Section):
     )
 
 
+# The [min, max] pairs of the world section, and the limits of their numbers.
+_PAIR_LIMITS = {"people_speed": (0.1, 3.0), "light_level": (0.2, 2.0), "camera_exposure": (0.2, 5.0)}
+
+
+def _pair(name: str, what: str):
+    """A [min, max] field whose numbers lie within ``_PAIR_LIMITS[name]``; default [1, 1]."""
+    lo, hi = _PAIR_LIMITS[name]
+    return Field(
+        [1.0, 1.0],
+        min_length=2,
+        max_length=2,
+        description=f"[min, max] {what}; {lo} <= min <= max <= {hi}",
+    )
+
+
+# The realistic preset: what a weekday corridor of a hospital, school or office looks like.
+# A clutter item every 5-10 m of wall (benches, chairs, carts, beds, plants, notice boards:
+# 1.4 per 10 m, a fifth of them standing in front of a sign); a few people per 100 m of
+# corridor walking at 0.8-1.4 m/s (typical indoor walking speeds), a third of them pausing;
+# a third of the doors open and one in ten glazed; light 25 % dimmer to 20 % brighter than
+# the clean world's, from any side; a consumer camera's noise (2 % of full scale), auto
+# exposure off by up to 20 %, and 20 ms exposure (motion blur while turning); signage and
+# colours drawn per building and seed from the kinds real buildings use.
+WORLD_PRESETS: dict[str, dict[str, Any]] = {
+    "clean": {},
+    "realistic": {
+        "signage": "random",
+        "appearance": "random",
+        "clutter_per_10m": 1.4,
+        "clutter_before_signs": 0.2,
+        "people_per_100m": 3.0,
+        "people_speed": [0.8, 1.4],
+        "people_pausing": 0.33,
+        "doors_open": 0.33,
+        "doors_glass": 0.1,
+        "light_level": [0.75, 1.2],
+        "light_turn_deg": 180.0,
+        "camera_noise": 0.02,
+        "camera_exposure": [0.8, 1.2],
+        "camera_exposure_time": 0.02,
+    },
+}
+
+
+class WorldConfig(_Section):
+    """What fills the simulated world beyond the building file: signage styles, clutter,
+    people, doors, light and the camera's flaws. `preset` chooses every other key's default:
+    `clean` is the world the paper's tables were measured in (one sign style, bare
+    corridors, closed doors, perfect light and camera); `realistic` is a weekday hospital or
+    school corridor (the values and why: `WORLD_PRESETS` in pmnav_bt/config.py,
+    docs/worlds.md). A key set beside the preset overrides it
+    (`--set world.preset=realistic --set world.people_per_100m=0`). Everything random is
+    drawn from the episode's seed, so every episode is reproducible."""
+
+    preset: Literal["clean", "realistic"] = Field(
+        "clean", description="the defaults of every other key of this section"
+    )
+    signage: Literal["file", "random"] = Field(
+        "file",
+        description="sign plates as the building file's signage section says (today's plate "
+        "where it says nothing), or random: what the file leaves unset is drawn per building "
+        "and seed from real practice (sizes, fonts, colours, mountings, layouts)",
+    )
+    appearance: Literal["clean", "random"] = Field(
+        "clean", description="wall, floor and door colours and textures: today's, or drawn per "
+        "building and seed from real palettes",
+    )
+    clutter_per_10m: float = Field(
+        0.0, ge=0.0, le=5.0, description="clutter items along the walls per 10 m of wall"
+    )
+    clutter_before_signs: float = Field(
+        0.0, ge=0.0, le=1.0, description="fraction of the clutter placed in front of a sign"
+    )
+    people_per_100m: float = Field(
+        0.0, ge=0.0, le=50.0, description="walking people per 100 m of corridor"
+    )
+    people_speed: list[float] = _pair("people_speed", "walking speed, m/s")
+    people_pausing: float = Field(
+        0.0, ge=0.0, le=1.0, description="fraction of the people who stop now and then"
+    )
+    doors_open: float = Field(0.0, ge=0.0, le=1.0, description="fraction of doors standing open")
+    doors_glass: float = Field(0.0, ge=0.0, le=1.0, description="fraction of doors glazed")
+    light_level: list[float] = _pair("light_level", "light level, 1 = the clean world's")
+    light_turn_deg: float = Field(
+        0.0, ge=0.0, le=180.0, description="the light's direction turns by up to this (deg)"
+    )
+    camera_noise: float = Field(
+        0.0, ge=0.0, le=0.5, description="std of the camera's pixel noise, fraction of 255"
+    )
+    camera_exposure: list[float] = _pair("camera_exposure", "exposure gain per episode")
+    camera_exposure_time: float = Field(
+        0.0, ge=0.0, le=0.2, description="s the shutter is open (motion blur while turning)"
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _preset_defaults(cls, data: Any) -> Any:
+        if isinstance(data, dict) and data.get("preset", "clean") in WORLD_PRESETS:
+            return {**WORLD_PRESETS[data.get("preset", "clean")], **data}
+        return data
+
+    @field_validator("people_speed", "light_level", "camera_exposure")
+    @classmethod
+    def _ordered(cls, pair: list[float], info) -> list[float]:
+        lo, hi = _PAIR_LIMITS[info.field_name]
+        if not all(lo <= v <= hi for v in pair) or pair[0] > pair[1]:
+            raise ValueError(f"expected [min, max] with {lo} <= min <= max <= {hi}")
+        return pair
+
+
 class Config(_Section):
     """One typed config chooses the back ends and sets the tree, the grounder and the
     simulator. Give a YAML file with `--config FILE` (every key optional) and override single
@@ -315,6 +432,7 @@ class Config(_Section):
     tree: TreeConfig = TreeConfig()
     vlm: VlmConfig = VlmConfig()
     sim: SimConfig = SimConfig()
+    world: WorldConfig = WorldConfig()
 
 
 def _set_dotted(data: dict, key: str, value: Any, label: str = "--set") -> None:

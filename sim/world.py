@@ -25,6 +25,7 @@ import numpy as np
 import shapely
 from shapely.geometry import MultiPolygon, Polygon
 
+from pmnav_bt.config import WorldConfig
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.map.building import Building, Landmark, WaypointKind
 from pmnav_bt.map.catalogue import load_building, resolve_building_path
@@ -40,6 +41,7 @@ from pmnav_bt.seams import (
     sign_label,
 )
 from pmnav_bt.sim._pybullet import p
+from pmnav_bt.sim.scene import scene_rng
 from pmnav_bt.sim.textures import make_sign, write_png
 
 log = logging.getLogger(__name__)
@@ -197,7 +199,9 @@ class SimWorld:
     from the occupied cells of the building's ros_map floor plan (rooms and open areas
     included; doors and signs still stand on the annotated corridor walls);
     ``base_dir`` is the folder the floor plan path is relative to (default: the
-    building file's folder).
+    building file's folder). ``scene`` (the config's ``world`` section; default: the clean
+    preset) says what fills the building beyond its file, drawn from the episode's
+    ``seed`` (``pmnav_bt.sim.scene``).
     """
 
     def __init__(
@@ -208,6 +212,8 @@ class SimWorld:
         ceiling: bool = True,
         walls: str = "corridors",
         base_dir: str | Path | None = None,
+        scene: WorldConfig | None = None,
+        seed: int = 0,
     ) -> None:
         if walls not in WALL_SOURCES:
             raise SimError(f"walls {walls!r}: choose {' or '.join(WALL_SOURCES)}")
@@ -216,6 +222,8 @@ class SimWorld:
             building = load_building(building)
         self.building = building
         self.wall_source = walls
+        self.scene = scene if scene is not None else WorldConfig()
+        self.seed = int(seed)
         self._grid_plan = self._load_grid_plan(base_dir) if walls == "grid" else None
         self.lock = threading.RLock()
         self.labels: dict[int, str] = {}
@@ -255,6 +263,10 @@ class SimWorld:
         except BaseException:
             self.close()
             raise
+
+    def rng(self, part: str) -> np.random.Generator:
+        """The random stream of one part of this world's scene (``scene_rng``)."""
+        return scene_rng(self.seed, self.building.name, part)
 
     # -- lifecycle ------------------------------------------------------------------------
 

@@ -108,7 +108,9 @@ def run_episode(
     pm = parse_building(b)
     sim = config.sim
     t0 = time.perf_counter()
-    with SimWorld(b, walls=sim.walls, base_dir=folder) as world:
+    with SimWorld(
+        b, walls=sim.walls, base_dir=folder, scene=config.world, seed=episode.seed
+    ) as world:
         # SPL's shortest path: in the building as built (landmarks, not added obstacles).
         footprints = world.obstacle_footprints(COLLISION_HEIGHT)
         geodesic = goal_geodesic(pm, episode.goal, footprints, floor=world.floor_space())

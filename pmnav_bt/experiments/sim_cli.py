@@ -40,6 +40,10 @@ def _group() -> None:
     """The pybullet simulator: build a world from a building file and look at it."""
 
 
+CONFIG_OPT = typer.Option(None, "--config", help="A run config YAML (see docs/config.md).")
+SET_OPT = typer.Option(None, "--set", help="Override a config value: section.key=value.")
+
+
 @app.command()
 def show(
     building: str = typer.Argument(..., help="A building file (YAML) or a built-in name."),
@@ -50,8 +54,12 @@ def show(
     width: int = typer.Option(640, "--width", min=16, max=4096, help="Image width, pixels."),
     height: int = typer.Option(480, "--height", min=16, max=4096, help="Image height, pixels."),
     gui: bool = typer.Option(False, "--gui", help="Also open the pybullet GUI (needs a display)."),
+    seed: int = typer.Option(0, "--seed", help="The episode seed the scene is drawn from."),
+    config: Path | None = CONFIG_OPT,
+    overrides: list[str] | None = SET_OPT,
 ) -> None:
-    """Write a top-down plan and the first-person RGB, depth and segmentation views."""
+    """Write a top-down plan and the first-person RGB, depth and segmentation views of the
+    world a run with this config and seed drives in (`--set world.preset=realistic`)."""
     from pmnav_bt.sim.render import (
         annotate_labels,
         colorize_depth,
@@ -62,9 +70,11 @@ def show(
     from pmnav_bt.sim.textures import write_png
     from pmnav_bt.sim.world import SimWorld
 
+    cli_values.seed(seed)
+    cfg = run_config(config, overrides)
     start = parse_pose(pose) if pose is not None else None
     check_output_dir(out)
-    with SimWorld(building, gui=gui) as world:
+    with SimWorld(building, gui=gui, walls=cfg.sim.walls, scene=cfg.world, seed=seed) as world:
         base = SimBase(world, pose=start, width=width, height=height)
         q = base.pose()
         obs = base.observe()
@@ -100,10 +110,6 @@ def _hold_gui(world) -> None:  # pragma: no cover - needs a display
             time.sleep(0.1)
     except KeyboardInterrupt:
         pass
-
-
-CONFIG_OPT = typer.Option(None, "--config", help="A run config YAML (see docs/config.md).")
-SET_OPT = typer.Option(None, "--set", help="Override a config value: section.key=value.")
 
 
 @app.command()
