@@ -303,7 +303,11 @@ class SimConfig(_Section):
 
 
 # The [min, max] pairs of the world section, and the limits of their numbers.
-_PAIR_LIMITS = {"people_speed": (0.1, 3.0), "light_level": (0.2, 2.0), "camera_exposure": (0.2, 5.0)}
+_PAIR_LIMITS = {
+    "people_speed": (0.1, 3.0),
+    "light_level": (0.2, 2.0),
+    "camera_exposure": (0.2, 5.0),
+}
 
 
 def _pair(name: str, what: str):
