@@ -407,6 +407,13 @@ class WorldConfig(_Section):
             return {**WORLD_PRESETS[data.get("preset", "clean")], **data}
         return data
 
+    def with_preset(self, preset: str) -> WorldConfig:
+        """This section in another preset: that preset's defaults, with every key this one
+        changed from its own preset's kept."""
+        own = WorldConfig(preset=self.preset).model_dump()
+        changed = {k: v for k, v in self.model_dump().items() if own[k] != v}
+        return WorldConfig.model_validate({**changed, "preset": preset})
+
     @field_validator("people_speed", "light_level", "camera_exposure")
     @classmethod
     def _ordered(cls, pair: list[float], info) -> list[float]:

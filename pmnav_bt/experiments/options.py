@@ -43,6 +43,23 @@ def building_names(building: str) -> list[str]:
     return out
 
 
+def variant_names(variants: str, worlds: str) -> list[str]:
+    """``--variants`` (comma-separated, at least one) run in each world preset of
+    ``--worlds`` (comma-separated, at least one), as ``VARIANT@WORLD`` names."""
+    from pmnav_bt.experiments.variants import get_variant, in_worlds
+
+    names = [v.strip() for v in variants.split(",") if v.strip()]
+    if not names:
+        raise PmNavError(f"--variants {variants!r}: name at least one variant")
+    try:
+        out = in_worlds(names, [w.strip() for w in worlds.split(",") if w.strip()])
+        for name in out:
+            get_variant(name)
+    except PmNavError as err:
+        raise PmNavError(f"--worlds/--variants: {err}") from None
+    return out
+
+
 def table3_building_names(building: str, family_size: int) -> list[str]:
     """Table 3's ``--building``: as ``building_names``, where the bare family name
     ``sign_sparse`` stands for its first ``--family-size`` members."""

@@ -192,7 +192,7 @@ def render_report(folder: Path) -> Path:
 def _write_meta(out: Path, base: Config, configs: dict, ev: dict, t3: dict | None, total: int):
     from pmnav_bt.eval.task import budget_rule
     from pmnav_bt.eval.tiers import tier_definition
-    from pmnav_bt.experiments.variants import VARIANTS, config_hash
+    from pmnav_bt.experiments.variants import config_hash, find_variant
 
     meta = {
         "commit": git_commit(),
@@ -211,8 +211,8 @@ def _write_meta(out: Path, base: Config, configs: dict, ev: dict, t3: dict | Non
         "base": base.model_dump(mode="json"),
         "variants": {
             n: {
-                "overrides": dict(VARIANTS[n].overrides) if n in VARIANTS else {},
-                "oracle": bool(VARIANTS[n].oracle) if n in VARIANTS else False,
+                "overrides": dict(v.overrides) if (v := find_variant(n)) else {},
+                "oracle": bool(v.oracle) if v else False,
                 "config_hash": config_hash(c),
             }
             for n, c in configs.items()
@@ -226,9 +226,9 @@ def pick_trajectories(results: dict, k: int) -> list[tuple[str, str]]:
     the longest route of its hardest tier, its first failure, then that success's episode
     under the other Table-1 variants."""
     from pmnav_bt.eval.tiers import TIER_NAMES
-    from pmnav_bt.experiments.variants import VARIANTS
+    from pmnav_bt.experiments.variants import find_variant
 
-    t1 = [n for n in results if n in VARIANTS and "1" in VARIANTS[n].tables]
+    t1 = [n for n in results if (v := find_variant(n)) and "1" in v.tables]
     if not t1 or k <= 0:
         return []
     main = results[t1[0]]
@@ -271,6 +271,12 @@ def report(
     variants: str = typer.Option(
         "", "--variants", help="Comma-separated variants [default: every registered one]."
     ),
+    worlds: str = typer.Option(
+        "clean,realistic",
+        "--worlds",
+        help="Run every variant in each of these world presets, side by side "
+        "(docs/worlds.md).",
+    ),
     table3_building: str = typer.Option(
         "all,sign_sparse", "--table3-building", help="Buildings of the Table 3 study."
     ),
@@ -304,7 +310,7 @@ def report(
     jobs = options.job_count(jobs)
     base = options.run_config(config, overrides)
     check_output_dir(out)
-    names = [v.strip() for v in variants.split(",") if v.strip()] or list(VARIANTS)
+    names = options.variant_names(variants or ",".join(VARIANTS), worlds)
     configs = variant_configs(base, names)
     eps, notes = episodes_for(options.building_names(building), options.tier_names(tier), n, seed)
     for note in notes:

@@ -11,7 +11,7 @@ from collections import Counter
 from pmnav_bt.config import Config
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
 from pmnav_bt.eval.tiers import TIER_NAMES
-from pmnav_bt.experiments.variants import VARIANTS, variant_title
+from pmnav_bt.experiments.variants import find_variant, variant_title
 
 # The paper's Table 1 (simulation): method -> tier -> (SR %, SPL %).
 PAPER_TABLE1 = {
@@ -51,7 +51,7 @@ def table1(results: Results) -> str:
     head = "| method | " + " | ".join(f"{t} SR | {t} SPL" for t in tiers) + " | runs |"
     lines = [head, "|---|" + "---|---|" * len(tiers) + "---|"]
     for name, rs in results.items():
-        v = VARIANTS.get(name)
+        v = find_variant(name)
         if v is not None and "1" not in v.tables:
             continue
         st = tier_stats(rs)
@@ -66,7 +66,7 @@ def table1(results: Results) -> str:
 def table4(results: Results) -> str:
     """Rows per tier: the coarse-only and fine variants that ran (and the oracle), SR/SPL,
     beside the paper's coarse and fine columns."""
-    cols = [n for n in results if (v := VARIANTS.get(n)) is not None and "4" in v.tables]
+    cols = [n for n in results if (v := find_variant(n)) is not None and "4" in v.tables]
     if not cols:
         return "(no Table 4 variant in these results)"
     tiers = [t for t in TIER_NAMES if t in tiers_present(results)]
@@ -88,22 +88,25 @@ def table4(results: Results) -> str:
 
 
 def variants_table(results: Results, configs: dict[str, Config]) -> str:
-    """What each variant is: tree, grounder, coarse and refiner back ends, oracle or not."""
+    """What each variant is: tree, grounder, coarse and refiner back ends, world preset,
+    oracle or not."""
     lines = [
-        "| variant | shown as | tree | grounder | coarse | refiner | oracle | runs | errors |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| variant | shown as | tree | grounder | coarse | refiner | world | oracle | runs "
+        "| errors |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, rs in results.items():
         c = configs.get(name)
-        v = VARIANTS.get(name)
-        tree, grounder, coarse, refiner = (
-            (c.tree.variant, c.grounder.backend, c.coarse.backend, c.refiner.backend)
+        v = find_variant(name)
+        what = (
+            [c.tree.variant, c.grounder.backend, c.coarse.backend, c.refiner.backend]
+            + [c.world.preset]
             if c
-            else ("?",) * 4
+            else ["?"] * 5
         )
         errors = sum(r.error is not None for r in rs)
         lines.append(
-            f"| {name} | {variant_title(name)} | {tree} | {grounder} | {coarse} | {refiner} | "
+            f"| {name} | {variant_title(name)} | {' | '.join(what)} | "
             f"{'yes' if v and v.oracle else 'no'} | {len(rs)} | {errors} |"
         )
     return "\n".join(lines)

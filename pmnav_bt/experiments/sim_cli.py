@@ -22,6 +22,7 @@ from pmnav_bt.experiments.options import (
     run_config,
     table3_building_names,
     tier_names,
+    variant_names,
 )
 from pmnav_bt.loading import check_output_dir, check_output_file, safe_filename
 from pmnav_bt.registry import grounder_label
@@ -225,6 +226,13 @@ RAY_OPT = typer.Option(
     "'--ray ADDRESS' joins a cluster (ray://head:10001, head:6379, auto). Needs the "
     "[ray] extra.",
 )
+WORLDS_OPT = typer.Option(
+    "clean,realistic",
+    "--worlds",
+    help="Run every variant in each of these world presets, side by side (clean: the paper's "
+    "worlds; realistic: signage of every kind, clutter, people, doors, light and camera; "
+    "docs/worlds.md); keys of the world section set by --config/--set carry over.",
+)
 RESUME_OPT = typer.Option(
     False,
     "--resume",
@@ -277,8 +285,10 @@ def eval_(
     variants: str = typer.Option(
         "pmnav,coarse_only,pmnav_oracle",
         "--variants",
-        help="Comma-separated evaluation variants (pmnav, coarse_only, pmnav_oracle, mapless).",
+        help="Comma-separated evaluation variants (pmnav, coarse_only, pmnav_oracle, mapless; "
+        "VARIANT@WORLD runs one in a world preset).",
     ),
+    worlds: str = WORLDS_OPT,
     jobs: int | None = typer.Option(
         None, "--jobs", help="Episodes run in parallel [default: 2, at most the CPUs]."
     ),
@@ -308,7 +318,7 @@ def eval_(
     jobs = job_count(jobs)
     cfg = run_config(config, overrides)
     check_output_dir(out)
-    names = [v.strip() for v in variants.split(",") if v.strip()]
+    names = variant_names(variants, worlds)
     configs = variant_configs(cfg, names)
     eps, notes = episodes_for(building_names(building), tier_names(tier), n, seed)
     for note in notes:

@@ -9,6 +9,13 @@ Adding a variant is one line in ``VARIANTS``, e.g.
 A variant's overrides are applied on top of the run's config (``--config``/``--set``),
 so anything it does not set (the grounder, for ``pmnav``) is the run's; the report
 states each variant's grounder from its own config.
+
+A variant runs in the world the run's config describes (its ``world`` section), or in a
+named world preset: ``pmnav@realistic`` is ``pmnav`` with ``world.preset=realistic`` (keys
+of the world section the run's config changed from its own preset carry over), and
+``--worlds clean,realistic`` (the evaluation's default) runs every listed variant in each
+preset, side by side. Results stored under a plain variant name (before worlds were
+named) still load and show.
 """
 
 from __future__ import annotations
@@ -18,7 +25,7 @@ import json
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from pmnav_bt.config import Config, _set_dotted, config_from_data
+from pmnav_bt.config import WORLD_PRESETS, Config, _set_dotted, config_from_data
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.registry import GROUNDERS
 
@@ -53,8 +60,20 @@ class Variant:
         they make no valid config, e.g. an unregistered tree variant)."""
         data = base.model_dump(mode="json")
         for key, value in self.overrides:
+            if key == "world.preset":  # a new preset's defaults, the run's own changes kept
+                data["world"] = base.world.with_preset(str(value)).model_dump(mode="json")
+                continue
             _set_dotted(data, key, value, label=f"variant {self.name}")
         return config_from_data(data, f"variant {self.name}")
+
+    def in_world(self, preset: str) -> Variant:
+        """This variant in the world preset ``preset`` (named ``<name>@<preset>``)."""
+        return Variant(
+            f"{self.name}@{preset}",
+            f"{self.label}, {preset} world",
+            (*self.overrides, ("world.preset", preset)),
+            self.tables,
+        )
 
 
 VARIANTS: dict[str, Variant] = {
@@ -81,16 +100,46 @@ VARIANTS: dict[str, Variant] = {
 
 
 def get_variant(name: str) -> Variant:
-    """The variant called ``name``; PmNavError naming the known ones otherwise."""
-    if name not in VARIANTS:
-        raise PmNavError(f"unknown variant {name!r}; choose from {', '.join(VARIANTS)}")
-    return VARIANTS[name]
+    """The variant called ``name`` (``VARIANT`` or ``VARIANT@WORLD``); PmNavError naming the
+    known ones otherwise."""
+    base, sep, world = name.partition("@")
+    if base not in VARIANTS:
+        raise PmNavError(f"unknown variant {base!r}; choose from {', '.join(VARIANTS)}")
+    if not sep:
+        return VARIANTS[base]
+    if world not in WORLD_PRESETS:
+        raise PmNavError(
+            f"variant {name!r}: unknown world {world!r}; choose from {', '.join(WORLD_PRESETS)}"
+        )
+    return VARIANTS[base].in_world(world)
+
+
+def find_variant(name: str) -> Variant | None:
+    """The variant called ``name``, or None when it is not (or no longer) registered."""
+    try:
+        return get_variant(name)
+    except PmNavError:
+        return None
 
 
 def variant_title(name: str) -> str:
     """A variant's table title, or its name when it is not (or no longer) registered."""
-    v = VARIANTS.get(name)
+    v = find_variant(name)
     return v.title if v else name
+
+
+def in_worlds(names: Iterable[str], worlds: Iterable[str]) -> list[str]:
+    """Every variant of ``names`` in each world preset of ``worlds`` ("pmnav", "realistic"
+    -> "pmnav@realistic"), grouped by world; a name that already says its world is kept
+    once. PmNavError for an unknown preset or no preset at all."""
+    worlds = list(worlds)
+    if not worlds:
+        raise PmNavError(f"name at least one world; choose from {', '.join(WORLD_PRESETS)}")
+    for w in worlds:
+        if w not in WORLD_PRESETS:
+            raise PmNavError(f"unknown world {w!r}; choose from {', '.join(WORLD_PRESETS)}")
+    out = [f"{n}@{w}" for w in worlds for n in names if "@" not in n]
+    return out + [n for n in names if "@" in n and n not in out]
 
 
 def variant_configs(base: Config, names: Iterable[str]) -> dict[str, Config]:

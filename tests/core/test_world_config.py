@@ -44,3 +44,18 @@ def test_scene_streams_are_reproducible_and_independent_per_part():
     assert (a != scene_rng(7, "fig2_hospital", "people").random(4)).all()
     assert (a != scene_rng(8, "fig2_hospital", "clutter").random(4)).all()
     assert (a != scene_rng(7, "school_a", "clutter").random(4)).all()
+
+
+def test_a_variant_in_another_world_keeps_the_runs_own_world_keys():
+    from pmnav_bt.experiments.variants import in_worlds, variant_configs, variant_title
+
+    base = load_config(overrides=["world.people_per_100m=7", "grounder.miss_rate=0.1"])
+    names = in_worlds(["pmnav", "pmnav_oracle@realistic"], ["clean", "realistic"])
+    assert names == ["pmnav@clean", "pmnav@realistic", "pmnav_oracle@realistic"]
+    configs = variant_configs(base, names)
+    clean, real = configs["pmnav@clean"].world, configs["pmnav@realistic"].world
+    assert clean.preset == "clean" and clean.clutter_per_10m == 0
+    assert real.clutter_per_10m == WORLD_PRESETS["realistic"]["clutter_per_10m"]
+    assert clean.people_per_100m == real.people_per_100m == 7  # the run's own change
+    assert configs["pmnav@realistic"].grounder.miss_rate == 0.1
+    assert variant_title("pmnav_oracle@realistic").startswith("PM-Nav, realistic world (oracle")

@@ -60,7 +60,8 @@ def test_ctrl_c_during_a_ray_run_keeps_the_finished_episodes(tmp_path):
     out = tmp_path / "eval"
     cmd = [
         sys.executable, "-m", "pmnav_bt.experiments.cli", "sim", "eval", "--building",
-        "straight_office", "--tier", "easy", "-n", "8", "--variants", "pmnav", "--jobs", "2",
+        "straight_office", "--tier", "easy", "-n", "8", "--variants", "pmnav", "--worlds", "clean",
+        "--jobs", "2",
         "--ray", "--out", str(out), "--set", "grounder.backend=sim_gt",  # the oracle: fast
     ]  # fmt: skip
     proc = subprocess.Popen(

@@ -21,7 +21,7 @@ def eval_argv(out: Path, n: int, jobs: int, *more: str) -> list[str]:
     return [
         sys.executable, "-m", "pmnav_bt.experiments.cli", "sim", "eval",
         "--building", "straight_office", "--tier", "easy", "-n", str(n),
-        "--variants", "pmnav", "--set", "grounder.backend=sim_gt",
+        "--variants", "pmnav", "--worlds", "clean", "--set", "grounder.backend=sim_gt",
         "--jobs", str(jobs), "--out", str(out), *more,
     ]  # fmt: skip
 

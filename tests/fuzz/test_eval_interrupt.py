@@ -56,7 +56,7 @@ def test_eval_interrupted_keeps_finished_episodes(tmp_path, signame, jobs):
     assert 2 <= len(done) < 40 and f"after {len(done)} of 40" in last
     assert len({r["episode_id"] for r in done}) == len(done)
     saved = json.loads((out / "results.json").read_text())  # whole, written atomically
-    assert len(saved["pmnav"]) == len(done)
+    assert len(saved["pmnav@clean"]) == len(done)
     time.sleep(0.5)
     assert _session(proc.pid) == [], "processes left behind"
 

@@ -80,11 +80,23 @@ def test_eval_an_own_building_from_another_directory(capsys, own_building):
         capsys, *argv, "--variants", "pmnav", "--jobs", "1", "--out", "o", *ORACLE_SET
     )
     assert code == 0, out + err
+    # Every variant runs in the clean and the realistic world, side by side.
+    head = out.splitlines()[0]
+    assert head.index("PM-Nav, clean world SR") < head.index("PM-Nav, realistic world SR")
     assert "| easy | 1 | 100.0 |" in out
     # The oracle is labelled as such wherever results print.
-    assert "PM-Nav: grounder sim_gt (oracle)" in Path("o/results.md").read_text()
-    results = json.loads(Path("o/results.json").read_text())["pmnav"]
-    assert results[0]["error"] is None and results[0]["building"] == "my_office"
+    md = Path("o/results.md").read_text()
+    assert "PM-Nav, realistic world: grounder sim_gt (oracle)" in md
+    results = json.loads(Path("o/results.json").read_text())
+    assert list(results) == ["pmnav@clean", "pmnav@realistic"]
+    r = results["pmnav@clean"][0]
+    assert r["error"] is None and r["building"] == "my_office"
+
+
+def test_eval_refuses_an_unknown_world_or_none(capsys):
+    for worlds, says in (("foggy", "unknown world 'foggy'"), (",", "at least one world")):
+        code, out, err = run(capsys, "sim", "eval", "--worlds", worlds, "--out", "o")
+        assert code == 2 and says in err, err
 
 
 def test_eval_exits_non_zero_and_counts_errored_episodes(capsys, own_building, monkeypatch):
@@ -93,10 +105,11 @@ def test_eval_exits_non_zero_and_counts_errored_episodes(capsys, own_building, m
 
     monkeypatch.setattr("pmnav_bt.experiments.evaluation.run_episode", crash)
     argv = ["sim", "eval", "--building", str(own_building), "--tier", "easy", "-n", "2"]
-    code, out, err = run(capsys, *argv, "--variants", "pmnav", "--jobs", "1", "--out", "o")
+    argv += ["--variants", "pmnav", "--worlds", "clean", "--jobs", "1", "--out", "o"]
+    code, out, err = run(capsys, *argv)
     assert code == 1
-    assert "episodes could not be run (pmnav 2 of 2)" in err and "fell over" in err
-    assert "PM-Nav errors" in out  # the table counts them apart from failures
+    assert "episodes could not be run (pmnav@clean 2 of 2)" in err and "fell over" in err
+    assert "PM-Nav, clean world errors" in out  # the table counts them apart from failures
 
 
 def test_eval_all_means_every_builtin_building(monkeypatch):
