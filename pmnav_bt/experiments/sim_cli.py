@@ -439,3 +439,7 @@ def table3(
 from pmnav_bt.experiments.belief_show import belief as _belief  # noqa: E402 - its module's command
 
 app.command("belief")(_belief)
+
+from pmnav_bt.experiments.world_sheet import sheet as _sheet  # noqa: E402 - its module's command
+
+app.command("sheet")(_sheet)
