@@ -141,6 +141,7 @@ class Episode:
     step_budget: int = 0  # actions under the default budget rule; 0: compute it
     building_path: str = ""  # absolute path of the building file ("" : find ``building``)
     building_sha256: str = ""  # of the building file's bytes ("" : not checked)
+    blocked: tuple[str, ...] = ()  # priori-map segments closed by a barrier (scene.blocking)
 
     def __post_init__(self) -> None:
         if self.step_budget <= 0:
@@ -158,6 +159,9 @@ class Episode:
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
         d["route"] = list(self.route)
+        d["blocked"] = list(self.blocked)
+        if not self.blocked:
+            del d["blocked"]  # files of episodes that block nothing stay as they were
         return d
 
 
@@ -178,8 +182,9 @@ _FIELD_TYPES: dict[str, tuple[type, ...]] = {
     "step_budget": (int,),
     "building_path": (str,),
     "building_sha256": (str,),
+    "blocked": (list,),
 }
-_OPTIONAL = {"route", "step_budget", "building_path", "building_sha256"}
+_OPTIONAL = {"route", "step_budget", "building_path", "building_sha256", "blocked"}
 # Plausible magnitudes: a building fits in 1 km; text is short; budgets stay finite.
 _LIMITS: dict[str, tuple[float, float]] = {
     "id": (1, 200),
@@ -196,8 +201,9 @@ _LIMITS: dict[str, tuple[float, float]] = {
     "step_budget": (1, 1_000_000),
     "building_path": (0, 4096),
     "building_sha256": (0, 64),
+    "blocked": (0, 100),
 }
-_LENGTHS = {"id", "building", "goal", "route", "building_path", "building_sha256"}
+_LENGTHS = {"id", "building", "goal", "route", "building_path", "building_sha256", "blocked"}
 MAX_EPISODES = 100_000
 
 
@@ -223,8 +229,8 @@ def _episode_from_dict(d: Any, where: str) -> tuple[Episode | None, list[Problem
         ok = isinstance(v, types) and (bool in types or not isinstance(v, bool))
         if ok and isinstance(v, float) and not math.isfinite(v):
             ok = False
-        if ok and k == "route":
-            ok = all(isinstance(x, str) for x in v)
+        if ok and k in ("route", "blocked"):
+            ok = all(isinstance(x, str) and len(x) <= 200 for x in v)
         if not ok:
             want = " or ".join(t.__name__ for t in types)
             shown = repr(v) if len(repr(v)) <= 60 else repr(v)[:57] + "..."
@@ -245,6 +251,7 @@ def _episode_from_dict(d: Any, where: str) -> tuple[Episode | None, list[Problem
         return None, problems
     kw = dict(d)
     kw["route"] = tuple(kw.get("route", ()))
+    kw["blocked"] = tuple(kw.get("blocked", ()))
     for k in ("start_x", "start_y", "start_yaw", "route_length"):
         kw[k] = float(kw[k])
     return Episode(**kw), []

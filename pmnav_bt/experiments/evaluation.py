@@ -99,6 +99,7 @@ def run_episode(
     from pmnav_bt.sim.episodes import episode_building_file, goal_geodesic, score_episode
     from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.robot import COLLISION_HEIGHT
+    from pmnav_bt.sim.scene.blocking import block_segment
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
 
@@ -111,6 +112,8 @@ def run_episode(
     with SimWorld(
         b, walls=sim.walls, base_dir=folder, scene=config.world, seed=episode.seed
     ) as world:
+        for ref in episode.blocked:  # a way closed on purpose is part of the building as built
+            block_segment(world, pm, ref)
         # SPL's shortest path: in the building as built (landmarks, not added obstacles).
         footprints = world.obstacle_footprints(COLLISION_HEIGHT)
         geodesic = goal_geodesic(pm, episode.goal, footprints, floor=world.floor_space())
