@@ -36,6 +36,7 @@ from pmnav_bt.seams import (
     OBSTACLE_LABEL,
     WALL_LABEL,
     Pose2D,
+    directional_sign_label,
     door_label,
     landmark_label,
     sign_label,
@@ -243,6 +244,7 @@ class SimWorld:
         self.signs: dict[str, WallItem] = {}
         self.landmarks: dict[str, WallItem] = {}
         self.landmark_signs: dict[str, WallItem] = {}
+        self.directional_signs: dict[str, WallItem] = {}  # by index in the file, "0", "1" ...
         self.obstacles: dict[int, tuple[float, float, float]] = {}
         if gui:
             if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
@@ -567,8 +569,7 @@ class SimWorld:
             self._build_door(room.id, room.door)
         for lm in b.landmarks:
             self._build_landmark(lm)
-        for room in b.rooms:
-            self._build_room_sign(room.id, room.sign_text)
+        self._build_signage()
         if self._grid_plan is not None:
             self._build_grid_walls()
 
@@ -774,6 +775,25 @@ class SimWorld:
         self.signs[room_id] = self._build_plate(
             room_id, sign_label(room_id), text, wi, s, z, "sign"
         )
+
+    def _build_signage(self) -> None:
+        """Room signs in the building's style (sim/scene/sign_mounting.py), or today's
+        plates where the file has no signage section and the config draws none."""
+        from pmnav_bt.sim.scene.sign_mounting import mount_directional_sign, mount_room_sign
+        from pmnav_bt.sim.scene.signage import resolve_signage
+
+        b = self.building
+        signage = resolve_signage(b, self.scene.signage, self.rng("signage"))
+        if signage is None:
+            for room in b.rooms:
+                self._build_room_sign(room.id, room.sign_text)
+            return
+        for room in b.rooms:
+            style = signage.rooms[room.id]
+            self.signs[room.id] = mount_room_sign(self, room.id, room.sign_text, style)
+        for i, spec in enumerate(signage.directional):
+            self.label_id(directional_sign_label(i))
+            self.directional_signs[str(i)] = mount_directional_sign(self, i, spec, signage.style)
 
     def _build_landmark(self, lm: Landmark) -> None:
         kind = lm.kind.lower()
