@@ -237,9 +237,11 @@ def _draw_toilet(img: np.ndarray, rgb) -> None:
         top = h / 2.0 - 4.2 * u
         cv2.circle(img, (int(cx), int(top + 0.8 * u)), int(0.8 * u), col, -1)
         body_top, body_bot = top + 1.9 * u, top + 5.2 * u
-        if dress:
-            tri = np.array([[cx, body_top], [cx - 1.6 * u, body_bot], [cx + 1.6 * u, body_bot]])
-            cv2.fillPoly(img, [tri.astype(np.int32)], col)
+        if dress:  # a narrow bodice, then a skirt flaring to the knees
+            bodice = ((int(cx - 0.8 * u), int(body_top)), (int(cx + 0.8 * u), int(top + 3.1 * u)))
+            cv2.rectangle(img, *bodice, col, -1)
+            skirt = np.array([(-0.8, 2.8), (0.8, 2.8), (1.6, 5.4), (-1.6, 5.4)]) * u + (cx, top)
+            cv2.fillPoly(img, [skirt.astype(np.int32)], col)
         else:
             cv2.rectangle(
                 img, (int(cx - 1.0 * u), int(body_top)), (int(cx + 1.0 * u), int(body_bot)), col, -1
@@ -254,11 +256,11 @@ def _draw_toilet(img: np.ndarray, rgb) -> None:
                 -1,
             )
         for side in (-1, 1):  # arms
-            x0 = cx + side * (1.6 * u if dress else 1.35 * u)
+            x0 = cx + side * (1.3 * u if dress else 1.5 * u)
             cv2.rectangle(
                 img,
                 (int(x0 - 0.3 * u), int(body_top + 0.1 * u)),
-                (int(x0 + 0.3 * u), int(body_top + 2.8 * u)),
+                (int(x0 + 0.3 * u), int(body_top + (1.4 if dress else 2.8) * u)),
                 col,
                 -1,
             )
