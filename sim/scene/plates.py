@@ -36,7 +36,9 @@ MARGIN_CAPS = 0.8  # blank border around the text, in capital heights
 MIN_SHRINK = 0.45  # a long word shrinks its line's text down to this fraction, then wraps
 MAX_LINES = 3
 PICTOGRAM_ASPECT = 0.5  # a toilet plate's height over its width (three figures side by side)
-DIRECTIONAL_CAP_M = (0.045, 0.09)  # capitals of a wayfinding sign (read from farther away)
+# Capitals of one-line plates (wayfinding signs, landmark names): 1.5 times the room
+# plates', within these limits, since they are read from farther away.
+LINE_PLATE_CAP_M = (0.045, 0.09)
 _SUPERSAMPLE = 3  # draw large, then shrink with area averaging (anti-aliased edges)
 _HERSHEY = cv2.FONT_HERSHEY_DUPLEX
 FONT_DIR = Path(matplotlib.get_data_path()) / "fonts" / "ttf"
@@ -168,10 +170,11 @@ def make_plate(text: str, style: PlateStyle) -> SignTexture:
     return _texture(" ".join(lines), tuple(lines), big, w_px, h_px, tpm)
 
 
-def make_directional(text: str, style: PlateStyle) -> SignTexture:
-    """A wayfinding sign: one line, ``->`` or ``<-`` drawn as an arrow at that end, the plate
-    as wide as the text needs, capitals larger than a room plate's."""
-    lo, hi = DIRECTIONAL_CAP_M
+def make_line_plate(text: str, style: PlateStyle) -> SignTexture:
+    """A one-line plate as wide as its text needs, with capitals larger than a room
+    plate's: a wayfinding sign (``->`` at the end or ``<-`` at the start is drawn as an
+    arrow there) or a landmark's name plate."""
+    lo, hi = LINE_PLATE_CAP_M
     cap_m = float(np.clip(1.5 * style.cap_height, lo, hi))
     tpm = texels_per_m(cap_m)
     s = _SUPERSAMPLE

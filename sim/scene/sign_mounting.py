@@ -30,7 +30,7 @@ import numpy as np
 
 from pmnav_bt.map.signage import DirectionalSignSpec, PlateStyle
 from pmnav_bt.seams import directional_sign_label, sign_label
-from pmnav_bt.sim.scene.plates import make_directional, make_plate
+from pmnav_bt.sim.scene.plates import make_line_plate, make_plate
 from pmnav_bt.sim.textures import SignTexture
 from pmnav_bt.sim.world import (
     DOOR_HEIGHT,
@@ -90,7 +90,7 @@ def mount_directional_sign(
 ) -> WallItem:
     """Build directional sign ``index`` on the wall nearest ``spec.at``, in the building's
     colours and font."""
-    tex = make_directional(spec.text, style)
+    tex = make_line_plate(spec.text, style)
     w = tex.width_m + 2 * EDGE_M
     wi, s = world._snap(f"directional sign {spec.text!r}", spec.at, w / 2)
     label = directional_sign_label(index)

@@ -12,7 +12,7 @@ import pytest
 from pmnav_bt.map.signage import CLEAN_STYLE, SIGN_FONTS
 from pmnav_bt.sim.scene.plates import (
     TEXELS_PER_M_LIMITS,
-    make_directional,
+    make_line_plate,
     make_plate,
     plate_lines,
     texels_per_m,
@@ -115,7 +115,7 @@ def test_toilet_pictogram_has_three_figures_and_no_text():
 
 @pytest.mark.parametrize("text, side", [("Radiology ->", "right"), ("<- 101-120", "left")])
 def test_directional_signs_draw_the_arrow_at_its_end(text, side):
-    t = make_directional(text, NAVY)
+    t = make_line_plate(text, NAVY)
     m = ink(t.image, NAVY)
     h, w = m.shape
     row = np.concatenate([[0], m[h // 2].astype(int), [0]])

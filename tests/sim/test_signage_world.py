@@ -19,6 +19,7 @@ from pmnav_bt.seams import CameraIntrinsics, directional_sign_label, sign_label
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.render import render_camera
 from pmnav_bt.sim.scene import scene_rng
+from pmnav_bt.sim.scene.plates import make_line_plate
 from pmnav_bt.sim.scene.sign_mounting import FLAG_MIN_BOTTOM_M
 from pmnav_bt.sim.scene.signage import COLOUR_SCHEMES, draw_style, resolve_signage
 from pmnav_bt.sim.textures import make_sign
@@ -254,7 +255,14 @@ def test_random_signage_keeps_what_the_file_sets():
 
 def test_realistic_world_builds_styled_signs():
     with SimWorld("fig2_hospital", scene=WorldConfig(preset="realistic"), seed=2) as world:
+        style = resolve_signage(world.building, "random", world.rng("signage")).style
         widths = {round(it.width, 3) for it in world.signs.values()}
-        assert len(widths) == 1 and widths.pop() != pytest.approx(0.82)
+        assert widths == {round(style.plate_width + 0.02, 3)}
         for rid, item in world.signs.items():
             assert item.label == sign_label(rid)
+        # Landmark plates too are in the building's style: one line, as wide as the name.
+        for lid, item in world.landmark_signs.items():
+            text = world.building.landmark(lid).sign_text
+            assert item.width == pytest.approx(make_line_plate(text, style).width_m + 0.02)
+            hit = _ray_to(world, item, 1.0)
+            assert hit is not None and hit.label == item.label
