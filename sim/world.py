@@ -36,7 +36,6 @@ from pmnav_bt.seams import (
     OBSTACLE_LABEL,
     WALL_LABEL,
     Pose2D,
-    directional_sign_label,
     door_label,
     landmark_label,
     sign_label,
@@ -792,20 +791,13 @@ class SimWorld:
     def _build_signage(self) -> None:
         """Room signs in the building's style (sim/scene/sign_mounting.py), or today's
         plates where the file has no signage section and the config draws none."""
-        from pmnav_bt.sim.scene.sign_mounting import mount_directional_sign, mount_room_sign
+        from pmnav_bt.sim.scene.sign_mounting import mount_signage
 
-        b = self.building
-        signage = self._signage
-        if signage is None:
-            for room in b.rooms:
+        if self._signage is None:
+            for room in self.building.rooms:
                 self._build_room_sign(room.id, room.sign_text)
-            return
-        for room in b.rooms:
-            style = signage.rooms[room.id]
-            self.signs[room.id] = mount_room_sign(self, room.id, room.sign_text, style)
-        for i, spec in enumerate(signage.directional):
-            self.label_id(directional_sign_label(i))
-            self.directional_signs[str(i)] = mount_directional_sign(self, i, spec, signage.style)
+        else:
+            mount_signage(self, self._signage)
 
     def _build_landmark(self, lm: Landmark) -> None:
         kind = lm.kind.lower()

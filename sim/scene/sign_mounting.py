@@ -31,6 +31,8 @@ import numpy as np
 from pmnav_bt.map.signage import DirectionalSignSpec, PlateStyle
 from pmnav_bt.seams import directional_sign_label, sign_label
 from pmnav_bt.sim.scene.plates import make_line_plate, make_plate
+from pmnav_bt.sim.scene.signage import BuildingSignage
+from pmnav_bt.sim.scene.wayfinding import junction_signs
 from pmnav_bt.sim.textures import SignTexture
 from pmnav_bt.sim.world import (
     DOOR_HEIGHT,
@@ -53,6 +55,20 @@ DIRECTIONAL_Z_M = 1.9  # centre height of a directional sign on the wall
 def _shade(rgb: tuple[int, int, int], k: float) -> tuple[float, float, float, float]:
     """The backing's colour: the plate's, darkened by ``k``."""
     return (*(k * c / 255.0 for c in rgb), 1.0)
+
+
+def mount_signage(world: SimWorld, signage: BuildingSignage) -> None:
+    """Build every room sign of ``world`` in its style, and the directional signs: the
+    file's, or with random signage and none in the file, the junctions' (wayfinding.py)."""
+    for room in world.building.rooms:
+        style = signage.rooms[room.id]
+        world.signs[room.id] = mount_room_sign(world, room.id, room.sign_text, style)
+    directional = signage.directional
+    if not directional and signage.wayfinding:
+        directional = junction_signs(world.building, world.walls, world.rng("wayfinding"))
+    for i, spec in enumerate(directional):
+        world.label_id(directional_sign_label(i))
+        world.directional_signs[str(i)] = mount_directional_sign(world, i, spec, signage.style)
 
 
 def mount_room_sign(world: SimWorld, room_id: str, text: str, style: PlateStyle) -> WallItem:

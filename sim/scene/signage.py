@@ -63,7 +63,8 @@ class BuildingSignage:
 
     style: PlateStyle  # the building's system
     rooms: dict[str, PlateStyle]
-    directional: tuple[DirectionalSignSpec, ...]
+    directional: tuple[DirectionalSignSpec, ...]  # the file's
+    wayfinding: bool  # draw signs at the junctions where the file lists none (random)
 
 
 def draw_style(rng: np.random.Generator) -> PlateStyle:
@@ -114,4 +115,4 @@ def resolve_signage(b: Building, mode: str, rng: np.random.Generator) -> Buildin
             style = style.merged(override)
         rooms[room.id] = style
     directional = section.directional if section is not None else ()
-    return BuildingSignage(base, rooms, directional)
+    return BuildingSignage(base, rooms, directional, mode == "random")

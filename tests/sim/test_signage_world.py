@@ -22,6 +22,7 @@ from pmnav_bt.sim.scene import scene_rng
 from pmnav_bt.sim.scene.plates import make_line_plate
 from pmnav_bt.sim.scene.sign_mounting import FLAG_MIN_BOTTOM_M
 from pmnav_bt.sim.scene.signage import COLOUR_SCHEMES, draw_style, resolve_signage
+from pmnav_bt.sim.scene.wayfinding import junction_signs
 from pmnav_bt.sim.textures import make_sign
 from pmnav_bt.sim.world import SIGN_CENTRE_Z, SimWorld
 
@@ -266,3 +267,41 @@ def test_realistic_world_builds_styled_signs():
             assert item.width == pytest.approx(make_line_plate(text, style).width_m + 0.02)
             hit = _ray_to(world, item, 1.0)
             assert hit is not None and hit.label == item.label
+
+
+@pytest.mark.parametrize("name", ["fig2_hospital", "t_school"])
+def test_junction_signs_point_the_right_way(name):
+    """Each wayfinding sign hangs on a wall facing the arrival at a junction, and the rooms
+    it names lie on the side its arrow points to (left: counter-clockwise of walking)."""
+    with SimWorld(name, scene=WorldConfig(signage="random"), seed=0) as world:
+        b = world.building
+        signs = []
+        for seed in range(6):
+            signs += junction_signs(b, world.walls, scene_rng(seed, b.name, "wayfinding"))
+        assert len(signs) >= 4
+        junctions = np.array([w.pos for w in b.waypoints])
+        for spec in signs:
+            wi, _ = world._nearest_wall(spec.at)
+            d = -np.asarray(world.walls[wi].normal)  # the reader walks towards the wall
+            here = junctions[np.argmin(np.linalg.norm(junctions - spec.at, axis=1))]
+            left = spec.text.startswith("<- ")
+            assert left != spec.text.endswith(" ->")
+            body = spec.text.removeprefix("<- ").removesuffix(" ->")
+            named = [r for r in b.rooms if r.display_name == body]  # or the range's ends:
+            named = named or [r for r in b.rooms if r.sign_text.split()[0] in body.split("-")]
+            assert named, spec.text
+            for r in named:
+                v = np.subtract(r.door, here)
+                side = d[0] * v[1] - d[1] * v[0]
+                assert (side > 0) == left, (spec.text, r.id)
+
+
+def test_realistic_worlds_hang_junction_signs():
+    with SimWorld("t_school", scene=WorldConfig(preset="realistic"), seed=6) as world:
+        assert world.directional_signs
+        for i, item in world.directional_signs.items():
+            assert item.label == directional_sign_label(int(i))
+            hit = _ray_to(world, item, 1.0)
+            assert hit is not None and hit.label == item.label
+    with SimWorld("t_school") as clean:
+        assert not clean.directional_signs
