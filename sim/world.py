@@ -43,6 +43,7 @@ from pmnav_bt.seams import (
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.scene import scene_rng
 from pmnav_bt.sim.scene.plates import make_line_plate
+from pmnav_bt.sim.scene.sign_mounting import SIGN_DEPTH, SIGN_GAP, mount_signage
 from pmnav_bt.sim.scene.signage import resolve_signage
 from pmnav_bt.sim.textures import SignTexture, make_sign, write_png
 
@@ -100,8 +101,6 @@ FRAME_WIDTH = 0.08
 FRAME_DEPTH = 0.04  # how far door frames stand out of the wall
 PANEL_DEPTH = 0.02
 SIGN_CENTRE_Z = CAMERA_HEIGHT_M  # sign plates are centred at camera height
-SIGN_DEPTH = 0.015
-SIGN_GAP = 0.15  # between a door frame and its sign plate
 ELEVATOR_WIDTH = 1.6
 ELEVATOR_HEIGHT = 2.2
 STAIRS_STEPS = 6
@@ -791,13 +790,11 @@ class SimWorld:
     def _build_signage(self) -> None:
         """Room signs in the building's style (sim/scene/sign_mounting.py), or today's
         plates where the file has no signage section and the config draws none."""
-        from pmnav_bt.sim.scene.sign_mounting import mount_signage
-
         if self._signage is None:
             for room in self.building.rooms:
                 self._build_room_sign(room.id, room.sign_text)
         else:
-            mount_signage(self, self._signage)
+            mount_signage(self, self._signage, WallItem)
 
     def _build_landmark(self, lm: Landmark) -> None:
         kind = lm.kind.lower()

@@ -4,7 +4,8 @@ A real building has one signage system: every room plate the same size, font, co
 and mounting, with a few exceptions (toilets as pictograms, a flag sign at a busy
 door). The section models that as a building-wide ``style``, per-room overrides in
 ``rooms``, and ``directional`` signs at junctions ("Radiology ->"). Every field is
-optional; what the file leaves unset is today's plate (``CLEAN_STYLE``) with
+optional; what the file leaves unset is today's plate (``CLEAN_STYLE`` in
+``pmnav_bt.sim.scene.signage``) with
 ``world.signage=file``, or drawn per building and seed with ``world.signage=random``
 (``pmnav_bt.sim.scene.signage``).
 
@@ -18,13 +19,12 @@ as a style. Documented field by field in docs/building-format.md ("signage").
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 from typing import Annotated, Any, Literal, get_args
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
 
 from pmnav_bt.errors import Problem
-from pmnav_bt.seams import CAMERA_HEIGHT_M
 
 # Fonts by name: a TrueType file that matplotlib ships (mpl-data/fonts/ttf), or None for
 # OpenCV's Hershey font (the simulator's historical plates). Nothing is downloaded.
@@ -150,20 +150,6 @@ def spec_fields(spec: SignStyleSpec) -> dict[str, Any]:
     return {k: v for k, v in spec.model_dump().items() if v is not None}
 
 
-# Today's plate as a style: 0.8 m wide, black Hershey text on white beside the door at the
-# camera's height; capitals 72 % of the 0.12 m line pitch.
-CLEAN_STYLE = PlateStyle(
-    plate_width=0.8,
-    cap_height=0.72 * 0.12,
-    font="hershey",
-    text_rgb=(0, 0, 0),
-    plate_rgb=(255, 255, 255),
-    mounting="beside",
-    layout="number_and_name",
-    height=CAMERA_HEIGHT_M,
-)
-
-STYLE_FIELDS = tuple(f.name for f in fields(PlateStyle) if f.name != "pictogram")
 
 
 def split_number(text: str) -> tuple[str, str]:

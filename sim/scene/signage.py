@@ -17,11 +17,20 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from pmnav_bt.map.building import Building
-from pmnav_bt.map.signage import (
-    CLEAN_STYLE,
-    SIGN_FONTS,
-    DirectionalSignSpec,
-    PlateStyle,
+from pmnav_bt.map.signage import SIGN_FONTS, DirectionalSignSpec, PlateStyle
+from pmnav_bt.seams import CAMERA_HEIGHT_M
+
+# Today's plate as a style: 0.8 m wide, black Hershey text on white beside the door at the
+# camera's height; capitals 72 % of the 0.12 m line pitch.
+CLEAN_STYLE = PlateStyle(
+    plate_width=0.8,
+    cap_height=0.72 * 0.12,
+    font="hershey",
+    text_rgb=(0, 0, 0),
+    plate_rgb=(255, 255, 255),
+    mounting="beside",
+    layout="number_and_name",
+    height=CAMERA_HEIGHT_M,
 )
 
 # Colour schemes of real room signage as (text, plate) RGB: light-on-dark (the common

@@ -10,7 +10,8 @@ import yaml
 
 from pmnav_bt.errors import BuildingFileError
 from pmnav_bt.map.building import building_from_data, dump_building
-from pmnav_bt.map.signage import CLEAN_STYLE, split_number
+from pmnav_bt.map.signage import split_number
+from pmnav_bt.sim.scene.signage import CLEAN_STYLE
 
 GOOD = {  # a corridor with two rooms: room2 is the toilet
     "schema_version": 1,

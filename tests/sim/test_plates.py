@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 import pytest
 
-from pmnav_bt.map.signage import CLEAN_STYLE, SIGN_FONTS
+from pmnav_bt.map.signage import SIGN_FONTS
 from pmnav_bt.sim.scene.plates import (
     TEXELS_PER_M_LIMITS,
     make_line_plate,
@@ -17,6 +17,7 @@ from pmnav_bt.sim.scene.plates import (
     plate_lines,
     texels_per_m,
 )
+from pmnav_bt.sim.scene.signage import CLEAN_STYLE
 
 NAVY = replace(
     CLEAN_STYLE,

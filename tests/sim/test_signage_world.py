@@ -14,14 +14,19 @@ import yaml
 from pmnav_bt.config import WorldConfig
 from pmnav_bt.map.building import building_from_data
 from pmnav_bt.map.catalogue import resolve_building_path
-from pmnav_bt.map.signage import CLEAN_STYLE, LAYOUTS, MOUNTINGS, SIGN_FONTS
+from pmnav_bt.map.signage import LAYOUTS, MOUNTINGS, SIGN_FONTS
 from pmnav_bt.seams import CameraIntrinsics, directional_sign_label, sign_label
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.render import render_camera
 from pmnav_bt.sim.scene import scene_rng
 from pmnav_bt.sim.scene.plates import make_line_plate
 from pmnav_bt.sim.scene.sign_mounting import FLAG_MIN_BOTTOM_M
-from pmnav_bt.sim.scene.signage import COLOUR_SCHEMES, draw_style, resolve_signage
+from pmnav_bt.sim.scene.signage import (
+    CLEAN_STYLE,
+    COLOUR_SCHEMES,
+    draw_style,
+    resolve_signage,
+)
 from pmnav_bt.sim.scene.wayfinding import junction_signs
 from pmnav_bt.sim.textures import make_sign
 from pmnav_bt.sim.world import SIGN_CENTRE_Z, SimWorld
