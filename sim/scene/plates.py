@@ -39,7 +39,13 @@ PICTOGRAM_ASPECT = 0.5  # a toilet plate's height over its width (three figures 
 # Capitals of one-line plates (wayfinding signs, landmark names): 1.5 times the room
 # plates', within these limits, since they are read from farther away.
 LINE_PLATE_CAP_M = (0.045, 0.09)
-_SUPERSAMPLE = 3  # draw large, then shrink with area averaging (anti-aliased edges)
+# OpenCV's strokes and shapes are drawn this much larger, then shrunk with area averaging
+# (anti-aliased edges); FreeType anti-aliases TrueType text itself, at the final size.
+_SUPERSAMPLE = 3
+
+
+def _supersample(style: PlateStyle) -> int:
+    return _SUPERSAMPLE if style.pictogram or SIGN_FONTS[style.font] is None else 1
 _HERSHEY = cv2.FONT_HERSHEY_DUPLEX
 FONT_DIR = Path(matplotlib.get_data_path()) / "fonts" / "ttf"
 
@@ -150,7 +156,7 @@ def make_plate(text: str, style: PlateStyle) -> SignTexture:
     """A room plate of ``style`` for a sign reading ``text``; ``SignTexture.text`` is what
     the plate shows (empty for a pictogram)."""
     tpm = texels_per_m(style.cap_height)
-    s = _SUPERSAMPLE
+    s = _supersample(style)
     w_px = int(round(style.plate_width * tpm))
     if style.pictogram:
         h_px = int(round(style.plate_width * PICTOGRAM_ASPECT * tpm))
@@ -177,7 +183,7 @@ def make_line_plate(text: str, style: PlateStyle) -> SignTexture:
     lo, hi = LINE_PLATE_CAP_M
     cap_m = float(np.clip(1.5 * style.cap_height, lo, hi))
     tpm = texels_per_m(cap_m)
-    s = _SUPERSAMPLE
+    s = _supersample(style)
     cap_px = cap_m * tpm * s
     right, left = text.rstrip().endswith("->"), text.lstrip().startswith("<-")
     words = text.replace("->", " ").replace("<-", " ").split()
