@@ -52,7 +52,6 @@ Layout = Literal["number_and_name", "number_only", "name_only"]
 Pictogram = Literal["toilet"]
 MOUNTINGS: tuple[str, ...] = get_args(Mounting)
 LAYOUTS: tuple[str, ...] = get_args(Layout)
-PICTOGRAMS: tuple[str, ...] = get_args(Pictogram)
 
 
 def _font(v: Any) -> Any:
@@ -79,8 +78,13 @@ def _colour(v: Any) -> Any:
 Colour = Annotated[tuple[int, int, int], BeforeValidator(_colour)]
 
 
-def _range(limits: tuple[float, float]) -> Any:
-    return Annotated[float, Field(allow_inf_nan=False, strict=True, ge=limits[0], le=limits[1])]
+def _metres(lo: float, hi: float) -> Any:
+    return Field(allow_inf_nan=False, strict=True, ge=lo, le=hi)
+
+
+PlateWidth = Annotated[float, _metres(*PLATE_WIDTH_LIMITS_M)]
+CapHeight = Annotated[float, _metres(*CAP_HEIGHT_LIMITS_M)]
+Height = Annotated[float, _metres(*HEIGHT_LIMITS_M)]
 
 
 class _Strict(BaseModel):
@@ -90,14 +94,14 @@ class _Strict(BaseModel):
 class SignStyleSpec(_Strict):
     """How plates look and hang; every field optional (unset: the building's, or today's)."""
 
-    plate_width: _range(PLATE_WIDTH_LIMITS_M) | None = None  # type: ignore[valid-type]
-    cap_height: _range(CAP_HEIGHT_LIMITS_M) | None = None  # type: ignore[valid-type]
+    plate_width: PlateWidth | None = None
+    cap_height: CapHeight | None = None
     font: FontName | None = None
     text_rgb: Colour | None = None
     plate_rgb: Colour | None = None
     mounting: Mounting | None = None
     layout: Layout | None = None
-    height: _range(HEIGHT_LIMITS_M) | None = None  # type: ignore[valid-type]
+    height: Height | None = None
 
 
 class RoomSignSpec(SignStyleSpec):
@@ -109,10 +113,8 @@ class RoomSignSpec(SignStyleSpec):
 class DirectionalSignSpec(_Strict):
     """A wayfinding sign on the wall nearest ``at``; ``->`` / ``<-`` in the text draw arrows."""
 
-    at: tuple[
-        Annotated[float, Field(allow_inf_nan=False, strict=True, ge=-1000, le=1000)],
-        Annotated[float, Field(allow_inf_nan=False, strict=True, ge=-1000, le=1000)],
-    ]
+    # a map point within the building file's coordinate limits (building.MAX_COORD_M)
+    at: tuple[Annotated[float, _metres(-1000, 1000)], Annotated[float, _metres(-1000, 1000)]]
     text: Annotated[str, Field(min_length=1, max_length=60, strict=True)]
 
 
@@ -141,13 +143,8 @@ class PlateStyle:
     pictogram: str | None = None
 
     def merged(self, spec: SignStyleSpec) -> PlateStyle:
-        """This style with the fields ``spec`` sets replaced."""
-        return replace(self, **spec_fields(spec))
-
-
-def spec_fields(spec: SignStyleSpec) -> dict[str, Any]:
-    """The fields a spec sets (not None)."""
-    return {k: v for k, v in spec.model_dump().items() if v is not None}
+        """This style with the fields ``spec`` sets (not None) replaced."""
+        return replace(self, **{k: v for k, v in spec.model_dump().items() if v is not None})
 
 
 
