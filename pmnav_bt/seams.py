@@ -90,6 +90,11 @@ def landmark_label(landmark_id: str) -> str:
     return f"landmark:{landmark_id}"
 
 
+def directional_sign_label(index: int) -> str:
+    """A wayfinding sign ("Radiology ->"), numbered in the building file's order."""
+    return f"direction:{index}"
+
+
 def parse_label(label: str) -> tuple[str, str]:
     """``"door:room17"`` -> ``("door", "room17")``; ``"floor"`` -> ``("floor", "")``."""
     kind, _, ident = label.partition(":")

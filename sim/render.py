@@ -235,6 +235,8 @@ def draw_top_down(
         text(f"{lid} [{lm.kind}]", (q[0] - 3 * len(lid), q[1] + 4), (170, 20, 20))
     for sign in world.landmark_signs.values():
         mark(sign, (0, 170, 60), 0.15)
+    for sign in world.directional_signs.values():  # wayfinding signs, blue
+        mark(sign, (30, 110, 230), 0.15)
     for ox, oy, size in world.obstacles.values():
         cv2.rectangle(
             img,

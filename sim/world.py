@@ -42,7 +42,10 @@ from pmnav_bt.seams import (
 )
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.scene import scene_rng
-from pmnav_bt.sim.textures import make_sign, write_png
+from pmnav_bt.sim.scene.plates import make_line_plate
+from pmnav_bt.sim.scene.sign_mounting import SIGN_DEPTH, SIGN_GAP, mount_signage
+from pmnav_bt.sim.scene.signage import resolve_signage
+from pmnav_bt.sim.textures import SignTexture, make_sign, write_png
 
 log = logging.getLogger(__name__)
 
@@ -98,8 +101,6 @@ FRAME_WIDTH = 0.08
 FRAME_DEPTH = 0.04  # how far door frames stand out of the wall
 PANEL_DEPTH = 0.02
 SIGN_CENTRE_Z = CAMERA_HEIGHT_M  # sign plates are centred at camera height
-SIGN_DEPTH = 0.015
-SIGN_GAP = 0.15  # between a door frame and its sign plate
 ELEVATOR_WIDTH = 1.6
 ELEVATOR_HEIGHT = 2.2
 STAIRS_STEPS = 6
@@ -243,6 +244,7 @@ class SimWorld:
         self.signs: dict[str, WallItem] = {}
         self.landmarks: dict[str, WallItem] = {}
         self.landmark_signs: dict[str, WallItem] = {}
+        self.directional_signs: dict[str, WallItem] = {}  # by index in the file, "0", "1" ...
         self.obstacles: dict[int, tuple[float, float, float]] = {}
         if gui:
             if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
@@ -563,12 +565,12 @@ class SimWorld:
             self.label_id(sign_label(room.id))
         for lm in b.landmarks:
             self.label_id(landmark_label(lm.id))
+        self._signage = resolve_signage(b, self.scene.signage, self.rng("signage"))
         for room in b.rooms:
             self._build_door(room.id, room.door)
         for lm in b.landmarks:
             self._build_landmark(lm)
-        for room in b.rooms:
-            self._build_room_sign(room.id, room.sign_text)
+        self._build_signage()
         if self._grid_plan is not None:
             self._build_grid_walls()
 
@@ -588,6 +590,7 @@ class SimWorld:
             *self.signs.values(),
             *self.landmarks.values(),
             *self.landmark_signs.values(),
+            *self.directional_signs.values(),
         ):
             c, n = np.asarray(it.centre), np.asarray(it.normal)
             t = np.array([n[1], -n[0]]) * (it.width / 2.0 + 0.05)
@@ -744,7 +747,7 @@ class SimWorld:
         z_centre: float,
         kind: str,
     ) -> WallItem:
-        tex = make_sign(text)
+        tex = self._plate_texture(text)
         w = self.walls[wall]
         n = np.asarray(w.normal)
         z0, z1 = z_centre - tex.height_m / 2.0, z_centre + tex.height_m / 2.0
@@ -756,10 +759,11 @@ class SimWorld:
         return self._item(ident, kind, label, wall, s, tex.width_m + 0.02, (z0, z1), text)
 
     def _plate_beside(
-        self, item: WallItem, wi: int, s_item: float, what: str
+        self, item: WallItem, wi: int, s_item: float, what: str, text: str
     ) -> tuple[int, float, float]:
-        """Wall, position and height for a sign plate beside ``item`` (right, else left)."""
-        half = (make_sign("x").width_m + 0.02) / 2.0
+        """Wall, position and height for the plate of ``text`` beside ``item`` (right, else
+        left)."""
+        half = (self._plate_texture(text).width_m + 0.02) / 2.0
         off = item.width / 2.0 + SIGN_GAP + half
         for s in (s_item - off, s_item + off):  # -s is the viewer's right
             if self._fits(wi, s - half, s + half):
@@ -770,10 +774,27 @@ class SimWorld:
 
     def _build_room_sign(self, room_id: str, text: str) -> None:
         door = self.doors[room_id]
-        wi, s, z = self._plate_beside(door, *self._where[door.label], f"sign of {room_id}")
+        wi, s, z = self._plate_beside(
+            door, *self._where[door.label], f"sign of {room_id}", text
+        )
         self.signs[room_id] = self._build_plate(
             room_id, sign_label(room_id), text, wi, s, z, "sign"
         )
+
+    def _plate_texture(self, text: str) -> SignTexture:
+        """A landmark's plate: today's, or a one-line plate in the building's style."""
+        if self._signage is None:
+            return make_sign(text)
+        return make_line_plate(text, self._signage.style)
+
+    def _build_signage(self) -> None:
+        """Room signs in the building's style (sim/scene/sign_mounting.py), or today's
+        plates where the file has no signage section and the config draws none."""
+        if self._signage is None:
+            for room in self.building.rooms:
+                self._build_room_sign(room.id, room.sign_text)
+        else:
+            mount_signage(self, self._signage, WallItem)
 
     def _build_landmark(self, lm: Landmark) -> None:
         kind = lm.kind.lower()
@@ -786,7 +807,7 @@ class SimWorld:
         elif kind in _DESK_KINDS:
             item = self._build_desk(lm, label)
         else:
-            half = (make_sign(text).width_m + 0.02) / 2.0
+            half = (self._plate_texture(text).width_m + 0.02) / 2.0
             wi, s = self._snap(f"landmark {lm.id}", lm.pos, half)
             item = self._build_plate(lm.id, label, text, wi, s, SIGN_CENTRE_Z, lm.kind)
             self.landmarks[lm.id] = item
@@ -794,7 +815,7 @@ class SimWorld:
         self.landmarks[lm.id] = item
         wi, s = self._where[label]
         if kind in _ELEVATOR_KINDS:
-            wi, s, z = self._plate_beside(item, wi, s, f"sign of {lm.id}")
+            wi, s, z = self._plate_beside(item, wi, s, f"sign of {lm.id}", text)
         else:  # above the steps or the desk, on the wall at camera height
             z = SIGN_CENTRE_Z
         self.landmark_signs[lm.id] = self._build_plate(lm.id, label, text, wi, s, z, "lmsign")

@@ -31,6 +31,7 @@ from pmnav_bt.loading import (
     is_regular_file,
     load_yaml,
 )
+from pmnav_bt.map.signage import Signage, signage_problems
 
 SCHEMA_VERSION = 1
 
@@ -173,6 +174,7 @@ class Building(_Strict):
     edges: tuple[Edge, ...] = Field(max_length=MAX_EDGES)
     rooms: tuple[Room, ...] = Field(default=(), max_length=MAX_ROOMS)
     landmarks: tuple[Landmark, ...] = Field(default=(), max_length=MAX_LANDMARKS)
+    signage: Signage | None = None  # how the signs look (pmnav_bt.map.signage)
 
     @field_validator("schema_version")
     @classmethod
@@ -348,7 +350,12 @@ def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem
         seg_a = np.array([wps[e.a].pos for e in valid_edges])
         seg_b = np.array([wps[e.b].pos for e in valid_edges])
         half = np.array([b.edge_width(e) / 2.0 for e in valid_edges])
-        for group, items, attr in (("rooms", b.rooms, "door"), ("landmarks", b.landmarks, "pos")):
+        directional = b.signage.directional if b.signage is not None else ()
+        for group, items, attr in (
+            ("rooms", b.rooms, "door"),
+            ("landmarks", b.landmarks, "pos"),
+            ("signage.directional", directional, "at"),
+        ):
             if not items:
                 continue
             pts = np.array([getattr(it, attr) for it in items])
@@ -356,14 +363,18 @@ def semantic_problems(b: Building, base_dir: Path | None = None) -> list[Problem
             for i, it in enumerate(items):
                 limit = half[j[i]] + DOOR_REACH_SLACK
                 if dist[i] > limit:
+                    what = repr(it.id) if hasattr(it, "id") else f"sign {it.text!r}"
                     problems.append(
                         Problem(
                             f"{group}[{i}].{attr}",
-                            f"{it.id!r} is {dist[i]:.2f} m from the nearest corridor centre line "
+                            f"{what} is {dist[i]:.2f} m from the nearest corridor centre line "
                             f"({valid_edges[j[i]].a}-{valid_edges[j[i]].b}); at most {limit:.2f} m "
                             "is reachable: move it next to a corridor or add a corridor edge",
                         )
                     )
+
+    if b.signage is not None:
+        problems.extend(signage_problems(b.signage, set(b._room_index)))
 
     if b.floor_plan is not None and base_dir is not None:
         for field in ("image", "ros_map"):
