@@ -94,18 +94,15 @@ def run_episode(
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     """
-    from pmnav_bt.map.catalogue import load_building
-    from pmnav_bt.map.priori_map import parse_building
-    from pmnav_bt.sim.episodes import episode_building_file, goal_geodesic, score_episode
+    from pmnav_bt.sim.episodes import episode_map, goal_geodesic, score_episode
     from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.robot import COLLISION_HEIGHT
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
 
-    file = episode_building_file(episode)
-    b = load_building(file)
+    file, pm = episode_map(episode)
+    b = pm.building
     folder = file.parent
-    pm = parse_building(b)
     sim = config.sim
     t0 = time.perf_counter()
     with SimWorld(

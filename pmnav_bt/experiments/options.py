@@ -18,6 +18,15 @@ if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.config import Config
 
 
+def name_list(text: str, option: str) -> list[str]:
+    """A comma-separated option (``--variants a,b``) as its names; a list that names
+    nothing (``,`` or spaces) is refused: it would run nothing and write an empty table."""
+    names = [part.strip() for part in text.split(",") if part.strip()]
+    if not names:
+        raise PmNavError(f"{option} {text!r}: names nothing; give one or more, comma-separated")
+    return names
+
+
 def tier_names(tier: str) -> list[str]:
     """``--tier``: easy, medium, hard, a comma-separated list of them, or all."""
     from pmnav_bt.eval.tiers import parse_tiers
@@ -34,7 +43,7 @@ def building_names(building: str) -> list[str]:
     from pmnav_bt.map.catalogue import builtin_buildings, family_members
 
     out: list[str] = []
-    for part in (b.strip() for b in building.split(",") if b.strip()):
+    for part in name_list(building, "--building"):
         try:
             members = family_members(part)
         except ValueError as err:
@@ -49,7 +58,7 @@ def table3_building_names(building: str, family_size: int) -> list[str]:
     from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
 
     names: list[str] = []
-    for part in (p.strip() for p in building.split(",") if p.strip()):
+    for part in name_list(building, "--building"):
         if part == SIGN_SPARSE_FAMILY:
             names += [f"{SIGN_SPARSE_FAMILY}_{k}" for k in range(family_size)]
         else:

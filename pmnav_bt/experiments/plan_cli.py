@@ -109,7 +109,7 @@ def eval_(
 ) -> None:
     """Planning SR per input and tier (paper Table 2), against an OpenAI-compatible server."""
     from pmnav_bt import cli_values
-    from pmnav_bt.experiments.options import building_names, tier_names
+    from pmnav_bt.experiments.options import building_names, name_list, tier_names
     from pmnav_bt.experiments.plan_eval import (
         correct_rule,
         plan_tasks,
@@ -138,6 +138,7 @@ def eval_(
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
+    names = name_list(inputs, "--inputs")
     check_output_dir(out)
     sets = list(overrides or [])
     if endpoint:
@@ -146,7 +147,6 @@ def eval_(
         sets.append(f"vlm.model={model}")
     cfg = load_config(config, sets)
     client = VlmClient.from_config(cfg.vlm)
-    names = [i.strip() for i in inputs.split(",") if i.strip()]
     tasks, notes = plan_tasks(building_names(building), tier_names(tier), n, seed)
     for note in notes:
         typer.echo(f"note: {note}", err=True)

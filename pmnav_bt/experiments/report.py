@@ -304,7 +304,7 @@ def report(
     jobs = options.job_count(jobs)
     base = options.run_config(config, overrides)
     check_output_dir(out)
-    names = [v.strip() for v in variants.split(",") if v.strip()] or list(VARIANTS)
+    names = options.name_list(variants, "--variants") if variants else list(VARIANTS)
     configs = variant_configs(base, names)
     eps, notes = episodes_for(options.building_names(building), options.tier_names(tier), n, seed)
     for note in notes:

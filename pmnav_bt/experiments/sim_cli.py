@@ -18,6 +18,7 @@ from pmnav_bt.experiments.options import (
     building_names,
     class_ranges,
     job_count,
+    name_list,
     ranges_text,
     run_config,
     table3_building_names,
@@ -175,7 +176,7 @@ def run(
     cfg = run_config(config, overrides)
     check_output_dir(out)
     if episode_file is not None:
-        from pmnav_bt.sim.episodes import episode_building_file, load_episodes
+        from pmnav_bt.sim.episodes import episode_map, load_episodes
 
         if goal is not None or start is not None:
             raise PmNavError("--episodes runs a stored episode: drop --goal and --start")
@@ -183,7 +184,7 @@ def run(
         if not 0 <= index < len(eps):
             raise PmNavError(f"--index {index}: {episode_file} has {len(eps)} episodes")
         ep = eps[index]
-        episode_building_file(ep)  # a missing or changed building: one clear line, now
+        episode_map(ep)  # a missing, changed or other building, a start outside: now
     elif goal is None:
         raise PmNavError("give --goal ROOM (or --episodes FILE --index N)")
     else:
@@ -308,7 +309,7 @@ def eval_(
     jobs = job_count(jobs)
     cfg = run_config(config, overrides)
     check_output_dir(out)
-    names = [v.strip() for v in variants.split(",") if v.strip()]
+    names = name_list(variants, "--variants")
     configs = variant_configs(cfg, names)
     eps, notes = episodes_for(building_names(building), tier_names(tier), n, seed)
     for note in notes:
