@@ -37,32 +37,34 @@ def tier_names(tier: str) -> list[str]:
         raise PmNavError(f"--tier: {err}") from None
 
 
-def building_names(building: str) -> list[str]:
+def building_names(building: str, option: str = "--building") -> list[str]:
     """``--building``: comma-separated files, built-in names, 'all' (every built-in) and
     FAMILY:N."""
     from pmnav_bt.map.catalogue import builtin_buildings, family_members
 
     out: list[str] = []
-    for part in name_list(building, "--building"):
+    for part in name_list(building, option):
         try:
             members = family_members(part)
         except ValueError as err:
-            raise PmNavError(f"--building {err}") from None
+            raise PmNavError(f"{option} {err}") from None
         out += builtin_buildings() if part == "all" else members or [part]
     return out
 
 
-def table3_building_names(building: str, family_size: int) -> list[str]:
+def table3_building_names(
+    building: str, family_size: int, option: str = "--building"
+) -> list[str]:
     """Table 3's ``--building``: as ``building_names``, where the bare family name
     ``sign_sparse`` stands for its first ``--family-size`` members."""
     from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
 
     names: list[str] = []
-    for part in name_list(building, "--building"):
+    for part in name_list(building, option):
         if part == SIGN_SPARSE_FAMILY:
             names += [f"{SIGN_SPARSE_FAMILY}_{k}" for k in range(family_size)]
         else:
-            names += building_names(part)
+            names += building_names(part, option)
     return names
 
 

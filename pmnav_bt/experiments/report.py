@@ -311,7 +311,11 @@ def report(
     work = results_folder.claim(out, resume, overwrite, REPORT_FILES)
     names = options.name_list(variants, "--variants") if variants else list(VARIANTS)
     configs = variant_configs(base, names)
-    eps, notes = episodes_for(options.building_names(building), options.tier_names(tier), n, seed)
+    buildings, tiers = options.building_names(building), options.tier_names(tier)
+    t3_names = [] if no_table3 else options.table3_building_names(
+        table3_building, family_size, "--table3-building"
+    )
+    eps, notes = episodes_for(buildings, tiers, n, seed)  # every option read first: now work
     for note in notes:
         typer.echo(f"note: {note}", err=True)
     if not eps:
@@ -319,7 +323,6 @@ def report(
     starts: list = []
     t3 = None
     if not no_table3:
-        t3_names = options.table3_building_names(table3_building, family_size)
         ranges = options.class_ranges("stack", base)
         starts = [s for b in t3_names for s in classified_starts(b, table3_n, seed, ranges)]
         t3 = {

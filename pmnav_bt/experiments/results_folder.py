@@ -58,13 +58,15 @@ def claim(out: Path, resume: bool, overwrite: bool, files: tuple[str, ...] = RES
         )
     held = held_results(out, files)
     if resume:
-        if (staged / store).exists():
+        held_there = held_results(staged, files)
+        if store in held_there:
             return staged
-        if held and store not in held:
-            raise ResultsFolderError(
-                f"--resume: {out} holds {', '.join(held)} but no {store} to go on "
-                "from; choose another --out, or replace them with --overwrite"
-            )
+        for folder, names in ((out, held), (staged, held_there)):
+            if names and store not in names:
+                raise ResultsFolderError(
+                    f"--resume: {folder} holds {', '.join(names)} but no {store} to go on "
+                    "from; choose another --out, or replace them with --overwrite"
+                )
         return out
     if overwrite and (held or staged.exists()):
         if staged.exists():
