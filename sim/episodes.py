@@ -48,6 +48,7 @@ from pmnav_bt.map.catalogue import (
     builtin_buildings,
     is_generated_name,
     load_building,
+    open_building,
     resolve_building_path,
 )
 from pmnav_bt.map.free_space import free_space_polygon
@@ -519,7 +520,7 @@ def _as_map(b: Building | PrioriMap | str | Path) -> tuple[PrioriMap, str, str]:
     if isinstance(b, Building):
         return parse_building(b), "", ""
     path = resolve_building_path(b).resolve()
-    return parse_building(load_building(path)), str(path), building_sha256(path)
+    return parse_building(open_building(path)), str(path), building_sha256(path)
 
 
 def _candidates(pm: PrioriMap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -38,14 +38,14 @@ def custom_episode(building: str, goal: str, start: str | None = None, seed: int
     start waypoint (facing along its corridor)."""
     from pmnav_bt.eval.task import action_budget
     from pmnav_bt.eval.tiers import classify
-    from pmnav_bt.map.catalogue import building_sha256, load_building, resolve_building_path
+    from pmnav_bt.map.catalogue import building_sha256, open_building, resolve_building_path
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.planning.resolve import resolve_room, resolve_start
     from pmnav_bt.seams import Pose2D
     from pmnav_bt.sim.episodes import Episode, path_facts
 
     path = resolve_building_path(building).resolve()
-    b = load_building(path)
+    b = open_building(path)
     pm = parse_building(b)
     room = resolve_room(pm, goal)
     if start is None:

@@ -68,7 +68,12 @@ def test_segment_numbers_of_5000_digits(capsys, tmp_path, argv):
 def test_plan_refuses_the_floor_plan_validate_refuses(capsys, tmp_path):
     (tmp_path / "m.yaml").write_text("image: nope.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n")
     f = building_file(tmp_path, floor_plan={"ros_map": "m.yaml"})
-    for argv in (["map", f], ["plan", f, "--from", "seg1", "--to", "room1"]):
+    for argv in (
+        ["map", f],
+        ["plan", f, "--from", "seg1", "--to", "room1"],
+        ["sim", "episodes", f, "-n", "1"],
+        ["sim", "run", "--building", f, "--goal", "room1", "--out", tmp_path / "o"],
+    ):
         refused(capsys, argv, "b.yaml", "floor_plan.ros_map", "nope.pgm")
     code, _, err = pmnav_cli(capsys, "validate", f)
     assert code == 1 and "floor_plan.ros_map" in err and "nope.pgm" in err
