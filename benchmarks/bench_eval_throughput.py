@@ -55,6 +55,7 @@ def main() -> None:
     base = [
         PMNAV, "sim", "eval", "--building", f"gen_small:{a.buildings}", "--tier", "easy",
         "-n", str(a.n), "--variants", "pmnav", "--set", "grounder.backend=sim_gt",
+        "--overwrite",  # each run of the benchmark replaces the last one's results
     ]  # fmt: skip
     total = a.buildings * a.n
     print(f"{total} episodes (gen_small:{a.buildings}, easy, sim_gt, 320x240) per mode; "

@@ -32,10 +32,10 @@ FILE_HELP = "A building file (YAML) or the name of a built-in building (see 'pmn
 
 
 def _priori_map(file: str):
-    from pmnav_bt.map.catalogue import load_building
+    from pmnav_bt.map.catalogue import open_building
     from pmnav_bt.map.priori_map import parse_building
 
-    return parse_building(load_building(file))
+    return parse_building(open_building(file))
 
 
 def _folder(file: str) -> Path:
@@ -77,18 +77,17 @@ def validate(
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as problems (exit 1)."),
 ) -> None:
     """Check a building file: list every problem (exit 1), then warnings about runs."""
-    from pmnav_bt.map.catalogue import load_building
+    from pmnav_bt.map.catalogue import open_building
     from pmnav_bt.map.checks import building_warnings
     from pmnav_bt.map.priori_map import parse_building
 
     try:
-        b = load_building(file)
+        b = open_building(file)
     except BuildingFileError as err:
         for line in err.lines():
             typer.echo(line, err=True)
         typer.echo(f"{len(err.problems)} problem(s)", err=True)
         raise typer.Exit(1) from None
-    _check_floor_plan(file, b)
     pm = parse_building(b)
     typer.echo(
         f"{file}: OK: {b.name}: {len(b.rooms)} rooms, {len(b.landmarks)} landmarks, "
@@ -101,21 +100,6 @@ def validate(
         typer.echo(f"{len(warnings)} warning(s)", err=True)
         if strict:
             raise typer.Exit(1)
-
-
-def _check_floor_plan(file: str, b) -> None:
-    """Open and decode the floor plan (image or ROS map) so a bad file fails here, not later."""
-    if b.floor_plan is None:
-        return
-    from pmnav_bt.map.floorplan import FloorPlanError, load_floor_plan
-
-    try:
-        load_floor_plan(b, _folder(file))
-    except FloorPlanError as err:
-        field = "floor_plan.ros_map" if b.floor_plan.ros_map else "floor_plan.image"
-        typer.echo(f"{file}: {field}: {err}", err=True)
-        typer.echo("1 problem(s)", err=True)
-        raise typer.Exit(1) from None
 
 
 @app.command("map")

@@ -106,6 +106,25 @@ def index(value: int, option: str = "--index") -> int:
 # -- the entry point ---------------------------------------------------------------------
 
 
+def no_empty_values(args: list[str]) -> None:
+    """No command takes an empty value: ``--out ''`` would silently be the current folder
+    (a path of no characters is "."), ``--variants ''`` no variant at all, ``--building ''``
+    no file. Refused before any command parses, whichever option or argument it is."""
+    for i, arg in enumerate(args):
+        if arg == "--":
+            return
+        if arg == "":
+            before = args[i - 1] if i else ""
+            if before.startswith("-"):
+                raise CliValueError(
+                    f"{_short(before)} '': an empty value; give one, or leave the option out"
+                )
+            raise CliValueError(f"argument {i + 1} is empty ''; give a value")
+        if arg.startswith("--") and arg.endswith("=") and len(arg) > 3:
+            raise CliValueError(f"{_short(arg)}: an empty value; give one, or leave it out")
+
+
+
 def _click_exceptions():
     try:
         from typer._click import exceptions as ce  # typer >= 0.26 vendors click
@@ -121,6 +140,10 @@ def run_cli(app: Callable, argv: list[str] | None, prog: str, format_error: Call
     errors and usage errors, the command's own status otherwise.
     """
     ce = _click_exceptions()
+    try:
+        no_empty_values(argv if argv is not None else sys.argv[1:])
+    except CliValueError as err:
+        _die(prog, str(err), 2)
     # typer >= 0.29 keeps Abort in typer.exceptions, not in its vendored click
     abort = getattr(ce, "Abort", None) or __import__("typer.exceptions").exceptions.Abort
     try:

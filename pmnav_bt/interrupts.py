@@ -2,8 +2,9 @@
 
 ``stop_signals()`` turns SIGINT and SIGTERM in the main process into ``Interrupted``;
 ``quiet_worker()`` (a pool initializer) makes workers ignore both, so only the parent
-decides, terminates the pool and keeps what finished. ``JsonlAppender`` writes one line
-per finished result, flushed and synced, so a kill loses at most the running episodes.
+decides, terminates the pool and keeps what finished, and makes them end with a parent
+that was killed outright. ``JsonlAppender`` writes one line per finished result,
+flushed and synced, so a kill loses at most the running episodes.
 """
 
 from __future__ import annotations
@@ -11,7 +12,9 @@ from __future__ import annotations
 import json
 import os
 import signal
+import sys
 import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -80,11 +83,46 @@ def signals_deferred() -> Iterator[None]:
         raise Interrupted(name)
 
 
-def quiet_worker() -> None:
-    """Pool initializer: a worker ignores SIGINT/SIGTERM from the terminal's process group;
-    the parent stops it with terminate()."""
+def quiet_worker(parent: int) -> None:
+    """Pool initializer: a worker ignores SIGINT/SIGTERM from the terminal's process group
+    (the parent stops it with terminate()), and ends with its ``parent``: a parent killed
+    outright (SIGKILL) can stop nothing, and its workers would run their episode on and
+    die on the broken pipe with a traceback."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    end_with_parent(parent)
+
+
+PARENT_POLL_S = 0.5  # where the kernel cannot tell us, how often a worker looks
+
+
+def end_with_parent(parent: int) -> None:
+    """End this process, quietly (no cleanup, no traceback), as soon as ``parent`` has gone.
+
+    On Linux the kernel sends SIGKILL the moment the parent dies (``PR_SET_PDEATHSIG``);
+    elsewhere a daemon thread compares ``os.getppid()`` with ``parent`` every
+    PARENT_POLL_S. A parent gone before this call (the worker is then the child of
+    init) is caught by the same comparison, made once here."""
+    if not _death_signal(signal.SIGKILL):
+        def watch() -> None:
+            while os.getppid() == parent:
+                time.sleep(PARENT_POLL_S)
+            os._exit(0)
+
+        threading.Thread(target=watch, name="pmnav-parent-watch", daemon=True).start()
+    if os.getppid() != parent:
+        os._exit(0)
+
+
+def _death_signal(sig: int) -> bool:
+    """Ask the kernel for ``sig`` when the parent dies; False where it cannot (not Linux)."""
+    if not sys.platform.startswith("linux"):
+        return False
+    import ctypes
+
+    pr_set_pdeathsig = 1  # <linux/prctl.h>
+    libc = ctypes.CDLL(None, use_errno=True)
+    return libc.prctl(pr_set_pdeathsig, int(sig), 0, 0, 0) == 0
 
 
 class JsonlAppender:

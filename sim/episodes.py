@@ -23,7 +23,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from pmnav_bt.errors import PmNavError, Problem
+from pmnav_bt.errors import PmNavError, Problem, UnknownNameError
 from pmnav_bt.eval.geodesic import GeodesicField
 from pmnav_bt.eval.metrics import EpisodeResult, soft_spl, spl, success
 from pmnav_bt.eval.task import STOP_OFFSET_M, SUCCESS_RADIUS_M, action_budget
@@ -48,11 +48,12 @@ from pmnav_bt.map.catalogue import (
     builtin_buildings,
     is_generated_name,
     load_building,
+    open_building,
     resolve_building_path,
 )
 from pmnav_bt.map.free_space import free_space_polygon
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
-from pmnav_bt.planning.resolve import resolve_room
+from pmnav_bt.planning.resolve import resolve_room, resolve_start
 from pmnav_bt.seams import CREATE3_RADIUS_M, Pose2D
 
 __all__ = [
@@ -73,6 +74,7 @@ __all__ = [
     "classify",
     "episode_building",
     "episode_building_file",
+    "episode_map",
     "episodes_json",
     "generate_episodes",
     "goal_door",
@@ -304,8 +306,38 @@ def episode_building_file(episode: Episode) -> Path:
 
 
 def episode_building(episode: Episode) -> Building:
-    """The building of ``episode`` (see :func:`episode_building_file`)."""
-    return load_building(episode_building_file(episode))
+    """The building of ``episode`` (see :func:`episode_building_file`), checked to be the
+    one the episode names (see :func:`episode_map`)."""
+    return _named_building(episode, episode_building_file(episode))
+
+
+def episode_map(episode: Episode) -> tuple[Path, PrioriMap]:
+    """The building file of ``episode`` and its priori-map, the episode checked against
+    them before anything runs: the file holds the building the episode names, and the
+    start is in one of its corridors, by the rule ``--start`` is held to
+    (``planning.resolve``: within half the corridor's width and 1 m of its centre line).
+    A start outside the building would spend the run's whole budget going nowhere."""
+    file = episode_building_file(episode)
+    pm = parse_building(_named_building(episode, file))
+    try:
+        resolve_start(pm, episode.start_pose)
+    except UnknownNameError as err:
+        raise EpisodeBuildingError(f"episode {episode.id}: start_x, start_y: {err}") from None
+    return file, pm
+
+
+def _named_building(episode: Episode, file: Path) -> Building:
+    """The building in ``file``, which must be the one named by the episode's
+    ``building``: a ``building_path`` to another building is an error naming both (one of
+    the two is wrong, and running either would be a guess)."""
+    b = load_building(file)
+    if episode.building_path and b.name != episode.building:
+        raise EpisodeBuildingError(
+            f"episode {episode.id}: building is {episode.building!r} but building_path "
+            f"{file} holds building {b.name!r}; correct one of them (or regenerate the "
+            "episodes with 'pmnav sim episodes')"
+        )
+    return b
 
 
 def load_episodes(path: str | Path) -> list[Episode]:
@@ -495,7 +527,7 @@ def _as_map(b: Building | PrioriMap | str | Path) -> tuple[PrioriMap, str, str]:
     if isinstance(b, Building):
         return parse_building(b), "", ""
     path = resolve_building_path(b).resolve()
-    return parse_building(load_building(path)), str(path), building_sha256(path)
+    return parse_building(open_building(path)), str(path), building_sha256(path)
 
 
 def _candidates(pm: PrioriMap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -38,14 +38,14 @@ def custom_episode(building: str, goal: str, start: str | None = None, seed: int
     start waypoint (facing along its corridor)."""
     from pmnav_bt.eval.task import action_budget
     from pmnav_bt.eval.tiers import classify
-    from pmnav_bt.map.catalogue import building_sha256, load_building, resolve_building_path
+    from pmnav_bt.map.catalogue import building_sha256, open_building, resolve_building_path
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.planning.resolve import resolve_room, resolve_start
     from pmnav_bt.seams import Pose2D
     from pmnav_bt.sim.episodes import Episode, path_facts
 
     path = resolve_building_path(building).resolve()
-    b = load_building(path)
+    b = open_building(path)
     pm = parse_building(b)
     room = resolve_room(pm, goal)
     if start is None:
@@ -94,19 +94,16 @@ def run_episode(
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     """
-    from pmnav_bt.map.catalogue import load_building
-    from pmnav_bt.map.priori_map import parse_building
-    from pmnav_bt.sim.episodes import episode_building_file, goal_geodesic, score_episode
+    from pmnav_bt.sim.episodes import episode_map, goal_geodesic, score_episode
     from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.robot import COLLISION_HEIGHT
     from pmnav_bt.sim.scene.blocking import block_segment
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
 
-    file = episode_building_file(episode)
-    b = load_building(file)
+    file, pm = episode_map(episode)
+    b = pm.building
     folder = file.parent
-    pm = parse_building(b)
     sim = config.sim
     t0 = time.perf_counter()
     with SimWorld(

@@ -53,7 +53,9 @@ def _pool(fn, tasks, jobs) -> Iterator[tuple[int, Any]]:
 
     from pmnav_bt.interrupts import quiet_worker
 
-    pool = mp.get_context("spawn").Pool(min(jobs, len(tasks)), initializer=quiet_worker)
+    pool = mp.get_context("spawn").Pool(
+        min(jobs, len(tasks)), initializer=quiet_worker, initargs=(os.getpid(),)
+    )
     try:
         yield from pool.imap_unordered(_indexed, [(fn, i, t) for i, t in enumerate(tasks)])
     finally:

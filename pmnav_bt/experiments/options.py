@@ -18,6 +18,15 @@ if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.config import Config
 
 
+def name_list(text: str, option: str) -> list[str]:
+    """A comma-separated option (``--variants a,b``) as its names; a list that names
+    nothing (``,`` or spaces) is refused: it would run nothing and write an empty table."""
+    names = [part.strip() for part in text.split(",") if part.strip()]
+    if not names:
+        raise PmNavError(f"{option} {text!r}: names nothing; give one or more, comma-separated")
+    return names
+
+
 def tier_names(tier: str) -> list[str]:
     """``--tier``: easy, medium, hard, a comma-separated list of them, or all."""
     from pmnav_bt.eval.tiers import parse_tiers
@@ -28,17 +37,17 @@ def tier_names(tier: str) -> list[str]:
         raise PmNavError(f"--tier: {err}") from None
 
 
-def building_names(building: str) -> list[str]:
+def building_names(building: str, option: str = "--building") -> list[str]:
     """``--building``: comma-separated files, built-in names, 'all' (every built-in) and
     FAMILY:N."""
     from pmnav_bt.map.catalogue import builtin_buildings, family_members
 
     out: list[str] = []
-    for part in (b.strip() for b in building.split(",") if b.strip()):
+    for part in name_list(building, option):
         try:
             members = family_members(part)
         except ValueError as err:
-            raise PmNavError(f"--building {err}") from None
+            raise PmNavError(f"{option} {err}") from None
         out += builtin_buildings() if part == "all" else members or [part]
     return out
 
@@ -48,11 +57,9 @@ def variant_names(variants: str, worlds: str) -> list[str]:
     ``--worlds`` (comma-separated, at least one), as ``VARIANT@WORLD`` names."""
     from pmnav_bt.experiments.variants import get_variant, in_worlds
 
-    names = [v.strip() for v in variants.split(",") if v.strip()]
-    if not names:
-        raise PmNavError(f"--variants {variants!r}: name at least one variant")
+    names, presets = name_list(variants, "--variants"), name_list(worlds, "--worlds")
     try:
-        out = in_worlds(names, [w.strip() for w in worlds.split(",") if w.strip()])
+        out = in_worlds(names, presets)
         for name in out:
             get_variant(name)
     except PmNavError as err:
@@ -60,17 +67,19 @@ def variant_names(variants: str, worlds: str) -> list[str]:
     return out
 
 
-def table3_building_names(building: str, family_size: int) -> list[str]:
+def table3_building_names(
+    building: str, family_size: int, option: str = "--building"
+) -> list[str]:
     """Table 3's ``--building``: as ``building_names``, where the bare family name
     ``sign_sparse`` stands for its first ``--family-size`` members."""
     from pmnav_bt.map.generate import SIGN_SPARSE_FAMILY
 
     names: list[str] = []
-    for part in (p.strip() for p in building.split(",") if p.strip()):
+    for part in name_list(building, option):
         if part == SIGN_SPARSE_FAMILY:
             names += [f"{SIGN_SPARSE_FAMILY}_{k}" for k in range(family_size)]
         else:
-            names += building_names(part)
+            names += building_names(part, option)
     return names
 
 

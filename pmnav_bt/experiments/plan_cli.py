@@ -13,6 +13,7 @@ import typer
 from typer.core import TyperGroup
 
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.experiments import results_folder
 
 FILE_HELP = "A building file (YAML) or the name of a built-in building (see 'pmnav buildings')."
 
@@ -101,6 +102,7 @@ def eval_(
     tries: int = typer.Option(1, "--tries", min=1, help="Answers per task (re-prompts + 1)."),
     margin: float = typer.Option(0.1, "--margin", min=0.0, help="Allowed detour (0.1 = 10%)."),
     out: Path = typer.Option(Path("out/plan_eval"), "--out", help="Results and transcripts."),
+    overwrite: bool = results_folder.OVERWRITE_OPT,
     replay_dir: Path | None = typer.Option(
         None, "--replay", help="Re-score the transcripts in this folder (no server)."
     ),
@@ -109,7 +111,7 @@ def eval_(
 ) -> None:
     """Planning SR per input and tier (paper Table 2), against an OpenAI-compatible server."""
     from pmnav_bt import cli_values
-    from pmnav_bt.experiments.options import building_names, tier_names
+    from pmnav_bt.experiments.options import building_names, name_list, tier_names
     from pmnav_bt.experiments.plan_eval import (
         correct_rule,
         plan_tasks,
@@ -138,7 +140,9 @@ def eval_(
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
+    names = name_list(inputs, "--inputs")
     check_output_dir(out)
+    work = results_folder.claim(out, False, overwrite)
     sets = list(overrides or [])
     if endpoint:
         sets.append(f"vlm.base_url={endpoint}")
@@ -146,7 +150,6 @@ def eval_(
         sets.append(f"vlm.model={model}")
     cfg = load_config(config, sets)
     client = VlmClient.from_config(cfg.vlm)
-    names = [i.strip() for i in inputs.split(",") if i.strip()]
     tasks, notes = plan_tasks(building_names(building), tier_names(tier), n, seed)
     for note in notes:
         typer.echo(f"note: {note}", err=True)
@@ -159,7 +162,7 @@ def eval_(
             typer.echo(f"{done}/{total} conversations", err=True)
 
     results = run_plan_eval(
-        client, tasks, names, out, tries, margin, cfg.vlm.image_px, progress=report
+        client, tasks, names, work, tries, margin, cfg.vlm.image_px, progress=report
     )
     totals = client.totals()
     header = (
@@ -170,8 +173,9 @@ def eval_(
         f"{totals['latency_s']:.1f} s.\n\nCorrect: {correct_rule(margin)}\n\nTasks: the episodes "
         f"of 'pmnav sim eval'.\n{tier_definition()}"
     )
-    md = save_results(results, out, header)
+    save_results(results, work, header)
+    results_folder.publish(work, out)
     typer.echo(table_markdown(results))
-    typer.echo(f"wrote {md}, {out / 'results.json'} and {len(results)} transcripts")
+    typer.echo(f"wrote {out / 'results.md'}, {out / 'results.json'} and {len(results)} transcripts")
     if sys.stderr.isatty():
         typer.echo(f"re-score with: pmnav plan eval --replay {out}", err=True)

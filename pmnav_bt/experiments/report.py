@@ -20,9 +20,12 @@ import yaml
 
 from pmnav_bt.config import Config
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.experiments import results_folder
 from pmnav_bt.loading import atomic_write_text, check_output_dir
 
 META = "meta.json"
+# What makes a folder hold a report: its evaluation's store first (what --resume goes on from).
+REPORT_FILES = ("eval/results.jsonl", "table3/results.jsonl", "report.md")
 
 
 def git_commit() -> str:
@@ -286,6 +289,7 @@ def report(
     trajectories: int = typer.Option(3, "--trajectories", min=0, help="Trajectory plots."),
     jobs: int | None = typer.Option(None, "--jobs", help="Runs in parallel [default: 2]."),
     resume: bool = typer.Option(False, "--resume", help="Go on from the results already in --out."),
+    overwrite: bool = results_folder.OVERWRITE_OPT,
     ray: str | None = typer.Option(
         None, "--ray", help="Ray: alone, a local runtime; or a cluster address."
     ),
@@ -310,9 +314,14 @@ def report(
     jobs = options.job_count(jobs)
     base = options.run_config(config, overrides)
     check_output_dir(out)
+    work = results_folder.claim(out, resume, overwrite, REPORT_FILES)
     names = options.variant_names(variants or ",".join(VARIANTS), worlds)
     configs = variant_configs(base, names)
-    eps, notes = episodes_for(options.building_names(building), options.tier_names(tier), n, seed)
+    buildings, tiers = options.building_names(building), options.tier_names(tier)
+    t3_names = [] if no_table3 else options.table3_building_names(
+        table3_building, family_size, "--table3-building"
+    )
+    eps, notes = episodes_for(buildings, tiers, n, seed)  # every option read first: now work
     for note in notes:
         typer.echo(f"note: {note}", err=True)
     if not eps:
@@ -320,7 +329,6 @@ def report(
     starts: list = []
     t3 = None
     if not no_table3:
-        t3_names = options.table3_building_names(table3_building, family_size)
         ranges = options.class_ranges("stack", base)
         starts = [s for b in t3_names for s in classified_starts(b, table3_n, seed, ranges)]
         t3 = {
@@ -330,16 +338,16 @@ def report(
             "class_range": options.ranges_text(ranges),
         }
     ev = {"building": building, "tier": tier, "n": n, "seed": seed}
-    out.mkdir(parents=True, exist_ok=True)
+    work.mkdir(parents=True, exist_ok=True)
     total = len(eps) * len(configs)
-    _write_meta(out, base, configs, ev, t3, total)
+    _write_meta(work, base, configs, ev, t3, total)
     echo = lambda text: typer.echo(text, err=True)  # noqa: E731
     echo(f"evaluation: {total} runs ({len(eps)} episodes x {len(configs)} variants)")
-    run = run_stored_evaluation(eps, configs, StoredRun(out / "eval", jobs, ray, resume, echo))
+    run = run_stored_evaluation(eps, configs, StoredRun(work / "eval", jobs, ray, resume, echo))
     stopped = run.stopped_by
     if not stopped and starts:
         echo(f"Table 3 study: {len(starts)} localization runs")
-        study = run_stored_study(starts, base, StoredRun(out / "table3", jobs, ray, resume, echo))
+        study = run_stored_study(starts, base, StoredRun(work / "table3", jobs, ray, resume, echo))
         stopped = study.stopped_by
     if not stopped and trajectories:
         from pmnav_bt.interrupts import Interrupted, stop_signals
@@ -347,15 +355,18 @@ def report(
         with stop_signals():
             try:
                 picks = pick_trajectories(run.results, trajectories)
-                run_trajectories(out, eps, configs, picks)
+                run_trajectories(work, eps, configs, picks)
             except Interrupted as stop:
                 stopped = stop.signame
-    md = render_report(out)
+    md = render_report(work)
+    if not stopped:
+        results_folder.publish(work, out)
+        md = out / md.name
     typer.echo(f"wrote {md}")
     if stopped:
         typer.echo(
-            f"pmnav: stopped by {stopped}; report.md is partial; go on with the same "
-            "command and --resume",
+            f"pmnav: stopped by {stopped}; {md} is partial; go on with the same "
+            "command and --resume" + results_folder.stopped_note(work, out),
             err=True,
         )
         raise typer.Exit(130 if stopped == "SIGINT" else 143)

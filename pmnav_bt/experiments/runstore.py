@@ -6,11 +6,13 @@ whole config). ``--resume`` reads the rows back, skips the keys already there, a
 in one line, when a row was made under another config or for another episode of the same
 id: results of two configurations never mix silently. A torn last line (the process was
 killed mid-write) is dropped and the file truncated to its last whole line before
-appending; a broken line anywhere else is an error.
+appending; a broken line anywhere else is an error. A row that cannot be written (a
+full disk) is cut off again, so the file never holds half a row of this session.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -25,6 +27,13 @@ from pmnav_bt.interrupts import signals_deferred
 
 class ResumeError(PmNavError):
     """The results on disk cannot be resumed with this run (another config or episode)."""
+
+
+class ResultsWriteError(OSError):
+    """A row could not be written (the disk is full); the file holds every earlier row.
+
+    An OSError, as the failure is the machine's, not the user's: the command line prints
+    ``<file>: <what happened>; it keeps the N runs finished before ...`` and exits 1."""
 
 
 def record_key(variant: str, run_id: str) -> str:
@@ -113,7 +122,8 @@ class ResultStore:
                 with open(self.path, "ab") as f:
                     f.write(b"\n")
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._f = open(self.path, "a" if resume else "w", encoding="utf-8")  # noqa: SIM115
+        mode = os.O_WRONLY | os.O_CREAT | os.O_APPEND | (0 if resume else os.O_TRUNC)
+        self._fd = os.open(self.path, mode, 0o644)
 
     def _check(self, rows: list[dict]) -> None:
         configs = {e.variant: e.config_sha for e in self.expected.values()}
@@ -151,15 +161,34 @@ class ResultStore:
             **row,
         }
         with signals_deferred():  # Ctrl-C between the line and its count would miscount
-            self._f.write(json.dumps(full) + "\n")
-            self._f.flush()
-            os.fsync(self._f.fileno())
+            self._append((json.dumps(full) + "\n").encode())
             self.done[key] = full
             self.count += 1
         return full
 
+    def _append(self, data: bytes) -> None:
+        """Add ``data`` (one row) at the end of the file, synced, whole or not at all: a
+        write that fails midway (a full disk, a file-size limit) is cut off again, so the
+        file keeps exactly the rows finished before it. ResultsWriteError says so."""
+        start = os.fstat(self._fd).st_size
+        try:
+            view = memoryview(data)
+            while view:  # a write may take only part (the last bytes before a limit)
+                view = view[os.write(self._fd, view) :]
+            os.fsync(self._fd)
+        except OSError as err:
+            with contextlib.suppress(OSError):
+                os.ftruncate(self._fd, start)
+            kept = len(self.done)
+            raise ResultsWriteError(
+                err.errno,
+                f"{err.strerror}; it keeps the {kept} run{'' if kept == 1 else 's'} finished "
+                "before (go on with --resume when there is room)",
+                str(self.path),
+            ) from None
+
     def close(self) -> None:
-        self._f.close()
+        os.close(self._fd)
 
     def __enter__(self) -> ResultStore:
         return self

@@ -14,6 +14,7 @@ import typer
 
 from pmnav_bt import cli_values
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.experiments import results_folder
 from pmnav_bt.experiments.options import (
     building_names,
     class_ranges,
@@ -24,6 +25,7 @@ from pmnav_bt.experiments.options import (
     tier_names,
     variant_names,
 )
+from pmnav_bt.experiments.results_folder import OVERWRITE_OPT
 from pmnav_bt.loading import check_output_dir, check_output_file, safe_filename
 from pmnav_bt.registry import grounder_label
 from pmnav_bt.sim.poses import PoseError, parse_pose  # noqa: F401 - PoseError: part of this CLI
@@ -176,7 +178,7 @@ def run(
     cfg = run_config(config, overrides)
     check_output_dir(out)
     if episode_file is not None:
-        from pmnav_bt.sim.episodes import episode_building_file, load_episodes
+        from pmnav_bt.sim.episodes import episode_map, load_episodes
 
         if goal is not None or start is not None:
             raise PmNavError("--episodes runs a stored episode: drop --goal and --start")
@@ -184,7 +186,7 @@ def run(
         if not 0 <= index < len(eps):
             raise PmNavError(f"--index {index}: {episode_file} has {len(eps)} episodes")
         ep = eps[index]
-        episode_building_file(ep)  # a missing or changed building: one clear line, now
+        episode_map(ep)  # a missing, changed or other building, a start outside: now
     elif goal is None:
         raise PmNavError("give --goal ROOM (or --episodes FILE --index N)")
     else:
@@ -294,6 +296,7 @@ def eval_(
     ),
     out: Path = typer.Option(Path("out/eval"), "--out", help="Folder for results.json/.md."),
     resume: bool = RESUME_OPT,
+    overwrite: bool = OVERWRITE_OPT,
     ray: str | None = RAY_OPT,
     config: Path | None = CONFIG_OPT,
     overrides: list[str] | None = SET_OPT,
@@ -318,6 +321,7 @@ def eval_(
     jobs = job_count(jobs)
     cfg = run_config(config, overrides)
     check_output_dir(out)
+    work = results_folder.claim(out, resume, overwrite)
     names = variant_names(variants, worlds)
     configs = variant_configs(cfg, names)
     eps, notes = episodes_for(building_names(building), tier_names(tier), n, seed)
@@ -326,7 +330,7 @@ def eval_(
     if not eps:
         raise PmNavError("no episodes to run")
     echo = lambda text: typer.echo(text, err=True)  # noqa: E731
-    run = run_stored_evaluation(eps, configs, StoredRun(out, jobs, ray, resume, echo))
+    run = run_stored_evaluation(eps, configs, StoredRun(work, jobs, ray, resume, echo))
     header = eval_header(building, tier, n, seed, cfg, configs)
     results = {k: v for k, v in run.results.items() if v}
     if run.stopped_by:
@@ -335,13 +339,15 @@ def eval_(
             done = sum(map(len, results.values()))
             note = f"(partial: stopped by {run.stopped_by}, {done} of {run.total} runs)"
             title = "# PM-Nav evaluation"
-            save_evaluation(results, out, header.replace(title, f"{title} {note}", 1))
+            save_evaluation(results, work, header.replace(title, f"{title} {note}", 1))
             return comparison_markdown(results)
 
-        _stopped(run, out, run.resumed + run.new, "episodes", keep_partial if results else None)
-    md = save_evaluation(results, out, header)
+        partial = keep_partial if results else None
+        _stopped(run, work, out, run.resumed + run.new, "episodes", partial)
+    save_evaluation(results, work, header)
+    results_folder.publish(work, out)
     typer.echo(comparison_markdown(results))
-    typer.echo(f"wrote {md} and {out / 'results.json'}")
+    typer.echo(f"wrote {out / 'results.md'} and {out / 'results.json'}")
     errors = error_counts(results)
     if errors:
         first = next(r.error for rs in results.values() for r in rs if r.error)
@@ -354,15 +360,18 @@ def eval_(
         raise typer.Exit(1)
 
 
-def _stopped(run, out: Path, done: int, unit: str, keep_partial) -> NoReturn:
+def _stopped(run, work: Path, out: Path, done: int, unit: str, keep_partial) -> NoReturn:
     """End a run stopped by a signal: save and show the partial table (``keep_partial``
-    writes it and returns its text; None when nothing finished), say where the finished
-    rows are and how to go on, and exit with the signal's status (130, 143)."""
+    writes it into ``work`` and returns its text; None when nothing finished), say where
+    the finished rows are and how to go on, and exit with the signal's status (130, 143).
+    An ``--overwrite`` run's ``work`` is its staging folder: ``out`` keeps the earlier
+    results."""
     if keep_partial is not None:
         typer.echo(keep_partial(), err=True)
     typer.echo(
         f"pmnav: stopped by {run.stopped_by} after {done} of {run.total} {unit}; finished "
-        f"ones are in {out / 'results.jsonl'} (go on with --resume)",
+        f"ones are in {work / 'results.jsonl'} (go on with --resume)"
+        + results_folder.stopped_note(work, out),
         err=True,
     )
     raise typer.Exit(run.exit_code)
@@ -382,6 +391,7 @@ def table3(
     jobs: int = typer.Option(1, "--jobs", min=1, help="Runs in parallel."),
     out: Path = typer.Option(Path("out/table3"), "--out", help="Folder for results.json/.md."),
     resume: bool = RESUME_OPT,
+    overwrite: bool = OVERWRITE_OPT,
     ray: str | None = RAY_OPT,
     class_range: str = typer.Option(
         "stack",
@@ -404,6 +414,7 @@ def table3(
     from pmnav_bt.experiments.stored_run import StoredRun, run_stored_study
 
     check_output_dir(out)
+    work = results_folder.claim(out, resume, overwrite)
     cfg = run_config(config, overrides)
     ranges = class_ranges(class_range, cfg)
     names = table3_building_names(building, family_size)
@@ -411,7 +422,7 @@ def table3(
     if not starts:
         raise PmNavError("no start poses to run")
     echo = lambda text: typer.echo(text, err=True)  # noqa: E731
-    run = run_stored_study(starts, cfg, StoredRun(out, jobs, ray, resume, echo))
+    run = run_stored_study(starts, cfg, StoredRun(work, jobs, ray, resume, echo))
     results = run.results
     header = (
         f"# Localization by landmark density (paper Table 3)\n\nbuildings: {', '.join(names)}; "
@@ -426,14 +437,15 @@ def table3(
     if run.stopped_by:
 
         def keep_partial() -> str:
-            save(results, out, header + f"\n\nPARTIAL: stopped by {run.stopped_by}.")
+            save(results, work, header + f"\n\nPARTIAL: stopped by {run.stopped_by}.")
             return table(results)
 
-        _stopped(run, out, len(results), "runs", keep_partial if results else None)
-    md = save(results, out, header)
+        _stopped(run, work, out, len(results), "runs", keep_partial if results else None)
+    save(results, work, header)
+    results_folder.publish(work, out)
     typer.echo(header)
     typer.echo(table(results))
-    typer.echo(f"wrote {md} and {out / 'results.json'}")
+    typer.echo(f"wrote {out / 'results.md'} and {out / 'results.json'}")
 
 
 from pmnav_bt.experiments.belief_show import belief as _belief  # noqa: E402 - its module's command

@@ -36,6 +36,24 @@ def load_building(name_or_path: str | Path) -> Building:
     return read_building_file(resolve_building_path(name_or_path))
 
 
+def open_building(name_or_path: str | Path) -> Building:
+    """A building as a command opens it: the file read and validated (``load_building``)
+    and its floor plan, when it has one, opened and decoded. ``validate``, ``map``,
+    ``plan`` and ``sim run`` all judge a building file this way, so a broken image or ROS
+    map is refused by each of them alike, not only by the ones that draw or drive in it."""
+    path = resolve_building_path(name_or_path)
+    b = read_building_file(path)
+    if b.floor_plan is not None:
+        from pmnav_bt.map.floorplan import FloorPlanError, load_floor_plan  # imports cv2
+
+        try:
+            load_floor_plan(b, path.parent)
+        except FloorPlanError as err:
+            field = "floor_plan.ros_map" if b.floor_plan.ros_map else "floor_plan.image"
+            raise BuildingFileError(str(path), [Problem(field, str(err))]) from None
+    return b
+
+
 def builtin_buildings() -> list[str]:
     """Names of the buildings shipped with the package."""
     return sorted(p.stem for p in BUILTIN_DIR.glob("*.yaml"))
@@ -56,6 +74,10 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
     """A path as given, or the file of a built-in building of that name."""
     p = Path(name_or_path)
     text = str(name_or_path)
+    if text.endswith(("/", os.sep)):  # Path() drops the slash; "x.yaml/" names a folder
+        raise BuildingFileError(
+            text, [Problem("", "a path ending in '/' names a folder; give the building file")]
+        )
     if len(text) > 255 or "\0" in text or p.suffix in (".yaml", ".yml") or len(p.parts) > 1:
         return p
     if os.path.lexists(p):

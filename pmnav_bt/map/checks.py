@@ -184,24 +184,31 @@ def grid_warnings(b: Building, plan: FloorPlanImage) -> list[Problem]:
             if (hi - lo) * step >= OFF_FREE_M:
                 mid = xy[(lo + hi) // 2]
                 c = cell[(lo + hi) // 2]
-                what, then = (
-                    (
+                if not inside[(lo + hi) // 2]:  # a grid smaller than the building
+                    what, then = (
+                        f"runs off the floor-plan grid ({plan.width}x{plan.height} cells, "
+                        f"{plan.width * step:g} x {plan.height * step:g} m)",
+                        "the grid does not cover the building; check the map's origin and "
+                        "resolution",
+                    )
+                elif free[c[1], c[0]]:
+                    what, then = (
                         "runs into an obstacle in the corridor",
                         "the robot must leave the centre line to go round it (it does when "
-                        "depth shows open floor beside it)",
+                        "depth shows open floor beside it); move the waypoints if they can "
+                        "avoid it",
                     )
-                    if free[c[1], c[0]]
-                    else (
+                else:
+                    what, then = (
                         "leaves the grid's free space",
-                        "the robot follows the centre line and stops there",
+                        "the robot follows the centre line and stops there; move the "
+                        "waypoints if they can avoid it",
                     )
-                )
                 out.append(
                     Problem(
                         f"edges[{i}]",
                         f"{e.a}-{e.b} {what} for {(hi - lo) * step:.2f} m near "
-                        f"({mid[0]:.2f}, {mid[1]:.2f}): {then}; move the waypoints if they "
-                        "can avoid it",
+                        f"({mid[0]:.2f}, {mid[1]:.2f}): {then}",
                     )
                 )
         measured = centre_line_width(

@@ -31,6 +31,11 @@ MERGE_TOLERANCE = 0.6
 _NATURAL = re.compile(r"(\d+)")
 
 
+def _clipped(text: str, n: int = 40) -> str:
+    """``text`` cut to ``n`` characters for a message (a typed name can be any length)."""
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
 def natural_key(s: str) -> tuple:
     """Sort key that orders room2 before room10."""
     return tuple(int(t) if t.isdigit() else t for t in _NATURAL.split(s))
@@ -142,7 +147,7 @@ class PrioriMap:
         """A segment by index (13), short name ("seg13") or full name ("seg13(room14-room7)")."""
         text = str(ref).strip().lower().replace(" ", "")
         m = re.fullmatch(r"(?:seg)?(\d+)(?:\((.*)\))?", text)
-        if m:
+        if m and len(m.group(1)) <= 9:  # longer: no such segment (and past int()'s limit)
             i = int(m.group(1))
             if 1 <= i <= len(self.segments):
                 seg = self.segments[i - 1]
@@ -153,7 +158,8 @@ class PrioriMap:
                 )
         names = [s.name for s in self.segments]
         raise UnknownNameError(
-            f"unknown segment {ref!r}: this map has seg1 to seg{len(names)}", names[:5]
+            f"unknown segment {_clipped(str(ref))!r}: this map has seg1 to seg{len(names)}",
+            names[:5],
         )
 
     def locate(self, x: float, y: float) -> SegmentPosition:

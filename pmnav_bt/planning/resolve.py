@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pmnav_bt.cli_values import MAX_POSE_COORD_M
 from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.priori_map import PrioriMap, Segment
@@ -95,6 +96,10 @@ def resolve_start(pm: PrioriMap, spec: PlanStart) -> StartPoint:
             raise UnknownNameError(f"bad pose {spec!r}: expected 'x,y' or 'x,y,yaw_deg'") from None
         if not all(map(math.isfinite, (x, y, yaw if yaw is not None else 0.0))):
             raise UnknownNameError(f"bad pose {spec[:60]!r}: the numbers must be finite")
+        if max(abs(x), abs(y)) > MAX_POSE_COORD_M:
+            raise UnknownNameError(
+                f"bad pose {spec[:60]!r}: x and y must be within +-{MAX_POSE_COORD_M:g} m"
+            )
         return _pose_start(pm, x, y, yaw)
     if re.fullmatch(r"(?i)seg\s*\d+.*", spec):
         seg = pm.segment(spec)

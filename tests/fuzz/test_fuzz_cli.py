@@ -90,3 +90,143 @@ def test_table3_class_range_is_stack_or_map(capsys, tmp_path, value):
     assert code != 0
     one_line(err, "pmnav: error:")
     assert "--class-range" in err and not (tmp_path / "t3" / "results.jsonl").exists()
+
+
+# -- issue 42: the generators that would have found its examples -------------------------
+
+DIGITS = st.builds(
+    lambda lead, n: lead + "9" * n, st.sampled_from(["", "1", "-1", "-"]), st.integers(9, 5000)
+)  # from 10 digits (no segment, no building has such a number) past int()'s 4300 digits
+
+
+@FUZZ
+@given(
+    spec=st.one_of(
+        DIGITS.map(lambda d: f"seg{d.lstrip('-')}"),
+        st.tuples(DIGITS, st.sampled_from(["", "(start-end1)", "(a-b)"])).map(
+            lambda t: f"seg{t[0].lstrip('-')}{t[1]}"
+        ),
+        st.tuples(DIGITS, DIGITS).map(",".join),
+        st.tuples(DIGITS, DIGITS, DIGITS).map(",".join),
+    ),
+    command=st.sampled_from(["plan", "sim run"]),
+)
+def test_huge_numbers_inside_pose_and_segment_specs(capsys, tmp_path, spec, command):
+    TRIED["CLI: huge numbers in --from/--start specs"] += 1
+    if spec.startswith("-"):
+        spec = " " + spec
+    if command == "plan":
+        argv = ["plan", "straight_office", "--from", spec, "--to", "room1"]
+    else:
+        argv = ["sim", "run", "--goal", "room1", "--start", spec, "--out", tmp_path / "o"]
+    code, _, err = pmnav_cli(capsys, *argv)
+    assert code == 2  # x and y of 10 digits and more are never in a corridor
+    one_line(err, "pmnav: error:")
+
+
+NOTHING = st.text(alphabet=" ,\t", min_size=1, max_size=8)  # a list that names no item
+
+
+@FUZZ
+@given(
+    where=st.sampled_from(
+        [
+            ("sim", "eval", "--variants"),
+            ("sim", "eval", "--building"),
+            ("sim", "eval", "--tier"),
+            ("sim", "table3", "--building"),
+            ("report", "--variants"),
+            ("report", "--building"),
+            ("report", "--table3-building"),
+            ("plan", "eval", "--inputs"),
+        ]
+    ),
+    text=NOTHING,
+)
+def test_empty_lists_in_options(capsys, tmp_path, where, text):
+    TRIED["CLI: comma lists naming nothing"] += 1
+    *command, option = where
+    out = tmp_path / f"o{TRIED['CLI: comma lists naming nothing']}"
+    code, _, err = pmnav_cli(capsys, *command, option, text, "--out", out)
+    assert code == 2
+    one_line(err, option)
+    assert not [p for p in out.rglob("*") if p.is_file()]  # nothing written
+
+
+def _value_options():
+    """(command words, option) for every option of every pmnav command that takes a value."""
+    import typer
+
+    from pmnav_bt.experiments.cli import app
+
+    found = []
+
+    def walk(cmd, words):
+        for name, sub in sorted(getattr(cmd, "commands", {}).items()):
+            walk(sub, [*words, name])
+        for p in cmd.params:
+            if p.param_type_name == "option" and not p.is_flag and p.nargs == 1:
+                found.append((tuple(words), max(p.opts, key=len)))
+            elif p.param_type_name == "argument":
+                found.append((tuple(words), None))
+
+    walk(typer.main.get_command(app), [])
+    return sorted(set(found), key=str)
+
+
+VALUE_OPTIONS = _value_options()
+
+
+@pytest.mark.parametrize("form", ["separate", "equals"])
+@pytest.mark.parametrize(
+    "words, option", VALUE_OPTIONS, ids=[f"{' '.join(w)} {o or 'ARG'}" for w, o in VALUE_OPTIONS]
+)
+def test_empty_values_everywhere(capsys, tmp_path, monkeypatch, words, option, form):
+    """No option or argument of any command takes an empty value (``--out ''`` was the
+    current folder): one line, and nothing written where the command ran."""
+    if form == "equals" and not (option or "").startswith("--"):
+        pytest.skip("only a long option has a --name= form")
+    TRIED["CLI: empty values, every option"] += 1
+    monkeypatch.chdir(tmp_path)
+    given = [option, ""] if form == "separate" and option else [f"{option}="] if option else [""]
+    code, _, err = pmnav_cli(capsys, *words, *given)
+    assert code == 2
+    one_line(err, "empty")
+    assert list(tmp_path.iterdir()) == []
+
+
+RESULT_MARKS = {
+    "sim eval": ["results.jsonl", "results.json", "results.md", "overwriting/results.jsonl"],
+    "sim table3": ["results.jsonl", "results.json", "results.md", "overwriting/results.md"],
+    "report": ["eval/results.jsonl", "table3/results.jsonl", "report.md",
+               "overwriting/eval/results.jsonl"],
+}  # fmt: skip
+
+
+@FUZZ
+@given(
+    command=st.sampled_from(sorted(RESULT_MARKS)),
+    picks=st.lists(st.integers(0, 3), min_size=1, max_size=4, unique=True),
+    texts=st.lists(st.binary(max_size=40), min_size=4, max_size=4),
+    resume=st.booleans(),
+)
+def test_folders_holding_other_results(capsys, tmp_path, command, picks, texts, resume):
+    """A folder holding results (any of them, any content) is refused whole, before any
+    episode runs: without --resume always; with --resume when there is no store to go on
+    from, or the store's rows are not this run's."""
+    TRIED["CLI: folders holding other results"] += 1
+    out = tmp_path / f"o{TRIED['CLI: folders holding other results']}"
+    files = {RESULT_MARKS[command][i]: texts[i] for i in picks}
+    for name, data in files.items():
+        (out / name).parent.mkdir(parents=True, exist_ok=True)
+        (out / name).write_bytes(data)
+    argv = [*command.split(), "-n", "1", "--building", "straight_office", "--out", out]
+    if command == "report":
+        argv += ["--no-table3", "--trajectories", "0"]
+    store = RESULT_MARKS[command][0]
+    if resume and (store in files or f"overwriting/{store}" in files):
+        return  # --resume goes on from a store: the result store judges its rows
+    code, _, err = pmnav_cli(capsys, *argv, *(["--resume"] if resume else []))
+    assert code == 2
+    one_line(err, "pmnav: error:", "--overwrite")
+    assert {n: (out / n).read_bytes() for n in files} == files  # untouched

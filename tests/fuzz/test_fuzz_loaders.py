@@ -338,3 +338,38 @@ def test_image_headers(tmp_path, w, h, kind):
     with pytest.raises(FloorPlanError) as err:  # truncated bodies never decode
         read_image(f)
     _one_line_naming(err.value, f"i.{kind}")
+
+
+# -- issue 42: grids smaller than (or beside) their building -------------------------------
+
+
+@FUZZ
+@given(
+    w=st.integers(min_value=1, max_value=120),
+    h=st.integers(min_value=1, max_value=120),
+    origin=st.tuples(st.floats(-80, 80), st.floats(-80, 80)),
+    resolution=st.sampled_from([0.05, 0.1, 0.25, 1.0]),
+    seed=st.integers(0, 3),
+)
+def test_grid_smaller_than_its_building(tmp_path, w, h, origin, resolution, seed):
+    """``pmnav validate``'s grid checks on a grid that covers the building only in part,
+    or not at all: warnings, one line each, never an IndexError."""
+    import numpy as np
+    import yaml
+
+    from pmnav_bt.map.checks import building_warnings
+
+    TRIED["ros_map: grid smaller than its building"] += 1
+    cells = np.random.default_rng(seed).choice(np.array([0, 205, 254], np.uint8), size=w * h)
+    (tmp_path / "m.pgm").write_bytes(f"P5\n{w} {h}\n255\n".encode() + cells.tobytes())
+    (tmp_path / "m.yaml").write_text(
+        yaml.safe_dump({"image": "m.pgm", "resolution": resolution, "origin": [*origin, 0]})
+    )
+    warnings = building_warnings(_OFFICE, plan=load_ros_map(tmp_path / "m.yaml"))
+    assert all("\n" not in str(p) for p in warnings)
+    (x0, y0), x1, y1 = origin, origin[0] + w * resolution, origin[1] + h * resolution
+    if x0 > 54.1 or x1 < -0.1 or y0 > 0.1 or y1 < -0.1:  # the corridor (0,0)-(54,0) misses it
+        assert any("runs off the floor-plan grid" in str(p) for p in warnings), warnings
+
+
+_OFFICE = load_building("straight_office")

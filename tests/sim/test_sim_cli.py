@@ -94,7 +94,7 @@ def test_eval_an_own_building_from_another_directory(capsys, own_building):
 
 
 def test_eval_refuses_an_unknown_world_or_none(capsys):
-    for worlds, says in (("foggy", "unknown world 'foggy'"), (",", "at least one world")):
+    for worlds, says in (("foggy", "unknown world 'foggy'"), (",", "--worlds ',': names nothing")):
         code, out, err = run(capsys, "sim", "eval", "--worlds", worlds, "--out", "o")
         assert code == 2 and says in err, err
 
