@@ -12,7 +12,7 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TextIO
 
 from pmnav_bt.config import Config
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
@@ -89,10 +89,12 @@ def run_episode(
     on_tick: Callable | None = None,
     plot: bool = True,
     setup_world: Callable | None = None,
+    also_log: TextIO | None = None,
 ) -> EpisodeRun:
     """Run one episode in a fresh world; write its tree log and trajectory plot to ``out_dir``.
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
+    ``also_log``: a second sink for the tree log's lines (the live web view, ``--view``).
     """
     from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
@@ -101,6 +103,7 @@ def run_episode(
     from pmnav_bt.sim.robot import COLLISION_HEIGHT
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
+    from pmnav_bt.trees.view_record import ViewRecorder
 
     file = episode_building_file(episode)
     b = load_building(file)
@@ -131,8 +134,12 @@ def run_episode(
         if out_dir is not None:
             out_dir.mkdir(parents=True, exist_ok=True)
             log_path = out_dir / f"{safe_filename(episode.id)}.tree.jsonl"
+        view = ViewRecorder(ctx, building=str(file), truth=inner.pose)
         with open(log_path, "w", encoding="utf-8") if log_path else _null() as log:
-            outcome = run_tree(ctx, episode.goal, log=log, on_tick=record)
+            sinks = [s for s in (log, also_log) if s is not None]
+            outcome = run_tree(
+                ctx, episode.goal, log=_Tee(sinks) if sinks else None, on_tick=record, view=view
+            )
         final = inner.pose()
         stats = inner.stats
     wall = time.perf_counter() - t0
@@ -160,6 +167,18 @@ class _null:
 
     def __exit__(self, *exc):
         return False
+
+
+class _Tee:
+    """A text sink writing to several (the log file and the live view)."""
+
+    def __init__(self, sinks: list[TextIO]) -> None:
+        self.sinks = sinks
+
+    def write(self, text: str) -> int:
+        for s in self.sinks:
+            s.write(text)
+        return len(text)
 
 
 def _plot(
