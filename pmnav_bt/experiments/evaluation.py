@@ -134,9 +134,11 @@ def run_episode(
         if out_dir is not None:
             out_dir.mkdir(parents=True, exist_ok=True)
             log_path = out_dir / f"{safe_filename(episode.id)}.tree.jsonl"
-        view = ViewRecorder(ctx, building=str(file), truth=inner.pose)
         with open(log_path, "w", encoding="utf-8") if log_path else _null() as log:
             sinks = [s for s in (log, also_log) if s is not None]
+            view = None  # no log, no view entries (nor frames encoded for them)
+            if sinks:
+                view = ViewRecorder(ctx, building=_building_ref(file, b.name), truth=inner.pose)
             outcome = run_tree(
                 ctx, episode.goal, log=_Tee(sinks) if sinks else None, on_tick=record, view=view
             )
@@ -159,6 +161,16 @@ def run_episode(
         plot_path = out_dir / f"{safe_filename(episode.id)}.trajectory.png"
         _plot(pm, ctx.trace, truth, plot_path, result, config, outcome, folder)
     return EpisodeRun(result, plot_path, log_path)
+
+
+def _building_ref(file: Path, name: str) -> str:
+    """How a tree log names the building: a built-in by its name (the log stays readable
+    on another machine), any other by its file's path."""
+    from pmnav_bt.map.catalogue import builtin_buildings, resolve_building_path
+
+    if name in builtin_buildings() and resolve_building_path(name).resolve() == file.resolve():
+        return name
+    return str(file)
 
 
 class _null:
