@@ -52,7 +52,7 @@ def _pose(p: Pose2D | tuple) -> list[float]:
 
 def failure_record(f: Failure | None) -> dict | None:
     """A Failure as JSON: code, message and the root cause when a recovery came after it."""
-    if not isinstance(f, Failure):
+    if f is None:
         return None
     out: dict[str, Any] = {"code": f.code.value, "message": f.message}
     root = root_cause(f)
@@ -63,7 +63,7 @@ def failure_record(f: Failure | None) -> dict | None:
 
 def plan_record(plan) -> dict | None:
     """A Plan as JSON: its headline, path and steps (None: no plan)."""
-    if plan is None or not hasattr(plan, "steps"):
+    if plan is None:
         return None
     return {
         "text": plan.text().splitlines()[0],
@@ -82,7 +82,7 @@ def plan_record(plan) -> dict | None:
 
 def belief_record(belief, odom: Pose2D) -> dict | None:
     """Where the likeliest hypotheses of a CorridorBelief put the robot at ``odom``."""
-    if belief is None or not hasattr(belief, "weights"):
+    if belief is None:
         return None
     if belief.ref is None:
         return {"xy": [], "w": [], "best": 0.0, "glimpses": 0}
@@ -162,7 +162,7 @@ class ViewRecorder:
 
 
 def _sigma(tracker, distance: float) -> float | None:
-    if tracker is None or not hasattr(tracker, "sigma"):
+    if tracker is None:
         return None
     s = float(tracker.sigma(distance))
     return round(s, 3) if math.isfinite(s) else None

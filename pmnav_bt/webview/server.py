@@ -68,10 +68,13 @@ class ViewServer(ThreadingHTTPServer):
         self._maps: dict[str, object] = {}
         self._map_lock = threading.Lock()
         self._thread: threading.Thread | None = None
+        self.address_family = socket.AF_INET6 if ":" in host else socket.AF_INET
         try:
             super().__init__((host, port), _Handler)
         except OSError as err:
-            raise PmNavError(f"cannot serve on {host}:{port}: {err.strerror}") from None
+            raise PmNavError(
+                f"cannot serve on {host}:{port}: {err.strerror}; choose another port (0: any free)"
+            ) from None
 
     def handle_error(self, request, client_address) -> None:
         """A page that went away (reset, broken pipe) is no error; anything else is."""
@@ -176,8 +179,11 @@ class _Handler(BaseHTTPRequestHandler):
         try:
             run = int(query.get("run", ["0"])[0])
             have = int(query.get("from", ["0"])[0])
+            if have < 0:
+                raise ValueError
         except ValueError:
-            self._send(HTTPStatus.BAD_REQUEST, b"run and from must be integers", "text/plain")
+            why = b"run and from must be integers, from at least 0"
+            self._send(HTTPStatus.BAD_REQUEST, why, "text/plain")
             return
         self.close_connection = True
         self.send_response(HTTPStatus.OK)
