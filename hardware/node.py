@@ -323,7 +323,7 @@ class PmNavController:
         feed = Feed(f"pmnav-ros {self.node.get_fully_qualified_name()}", live=True,
                     building=p["building"])  # fmt: skip
         host = check_host(p["view_host"], p["view_allow_remote"])
-        server = ViewServer(feed, host, int(p["view_port"])).start()
+        server = ViewServer(feed, host, int(p["view_port"]), p["view_allow_remote"]).start()
         self.log.info(f"web view: {server.url}")
         return server, FeedWriter(feed)
 

@@ -27,7 +27,7 @@ def start_server(feed, host: str, port: int, allow_remote: bool):
 
     if not 0 <= port <= 65535:
         raise PmNavError(f"--port {port}: choose 0 (any free port) to 65535")
-    return ViewServer(feed, check_host(host, allow_remote), port).start()
+    return ViewServer(feed, check_host(host, allow_remote), port, allow_remote).start()
 
 
 def view(

@@ -14,7 +14,10 @@ Routes (GET):
 
 Any other path is a 404: the server serves the one page and what the feed holds, and
 never maps a request's path onto files. It listens on 127.0.0.1 unless told otherwise
-(:func:`check_host`). A page that goes away mid-stream ends its own thread quietly.
+(:func:`check_host`), and then answers only requests addressed to a loopback name (the
+``Host`` header), so that a web site whose name was made to point at 127.0.0.1 (DNS
+rebinding) cannot read the run from a visitor's browser. A page that goes away
+mid-stream ends its own thread quietly.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from pmnav_bt.webview.feed import Feed
 
 KEEPALIVE_S = 10.0
 PAGE = "view.html"
+LOOPBACK_NAMES = frozenset({"localhost", "127.0.0.1", "[::1]"})
 
 
 def check_host(host: str, allow_remote: bool) -> str:
@@ -62,8 +66,11 @@ class ViewServer(ThreadingHTTPServer):
     daemon_threads = True
     allow_reuse_address = True
 
-    def __init__(self, feed: Feed, host: str = "127.0.0.1", port: int = 0) -> None:
+    def __init__(
+        self, feed: Feed, host: str = "127.0.0.1", port: int = 0, allow_remote: bool = False
+    ) -> None:
         self.feed = feed
+        self.allow_remote = allow_remote
         self.closing = threading.Event()
         self._maps: dict[str, object] = {}
         self._map_lock = threading.Lock()
@@ -131,7 +138,15 @@ class _Handler(BaseHTTPRequestHandler):
     def log_message(self, format: str, *args) -> None:  # noqa: A002 - the base's name
         """Quiet: a page's requests are no news."""
 
+    def _addressed_to_loopback(self) -> bool:
+        host = (self.headers.get("Host") or "localhost").strip().lower()
+        name = host[: host.find("]") + 1] if host.startswith("[") else host.split(":")[0]
+        return name in LOOPBACK_NAMES
+
     def do_GET(self) -> None:  # noqa: N802 - the base's name
+        if not self.server.allow_remote and not self._addressed_to_loopback():
+            self._send(HTTPStatus.FORBIDDEN, b"not a loopback host name", "text/plain")
+            return
         url = urlsplit(self.path)
         route = url.path
         if route == "/":

@@ -139,7 +139,7 @@ def test_live_ticks_stream_and_a_page_that_goes_away_ends_quietly(serve, capfd):
     writer.write(lines[0])
     _wait(lambda: feed.run == 1)
     sock = socket.create_connection(server.server_address[:2], timeout=10)
-    sock.sendall(b"GET /api/events?run=1&from=0 HTTP/1.1\r\nHost: x\r\n\r\n")
+    sock.sendall(b"GET /api/events?run=1&from=0 HTTP/1.1\r\nHost: localhost\r\n\r\n")
     writer.write("".join(lines[1:4]))
     assert [t["i"] for e in _events(sock, 3) for t in e["ticks"]] == [0, 1, 2]
     sock.close()  # the page goes away mid-stream
@@ -175,6 +175,10 @@ def test_the_page_is_served_and_hosts_beyond_loopback_are_refused(serve):
     server = serve(Feed("x", live=False))
     status, body = get(server, "/")
     assert status == 200 and b"<title>pmnav view</title>" in body
+    conn = http.client.HTTPConnection(*server.server_address[:2], timeout=10)
+    conn.request("GET", "/", headers={"Host": "rebound.example:8765"})  # DNS rebinding
+    assert conn.getresponse().status == 403
+    conn.close()
     assert check_host("localhost", False) == "localhost"
     assert check_host("0.0.0.0", True) == "0.0.0.0"
     with pytest.raises(PmNavError, match="--allow-remote"):
