@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import NoReturn
 
@@ -207,32 +207,34 @@ def run(
         f"start ({ep.start_x:.1f}, {ep.start_y:.1f}, {math.degrees(ep.start_yaw):.0f} deg), "
         f"corridor route {ep.route_length:.1f} m"
     )
-    with _live_view(view, view_port, out) as sink:
+    with _live_view(view, view_port, out) as (sink, hold):
         if live is not None:
             with live:
                 r = run_episode(ep, cfg, out_dir=out, on_tick=live, also_log=sink)
         else:
             r = run_episode(ep, cfg, out_dir=out, also_log=sink)
-    res = r.result
-    typer.echo(
-        f"{'SUCCESS' if res.success else 'FAILURE'}: SPL {res.spl:.3f}, {res.steps} actions, "
-        f"{res.path_length:.1f} m driven (shortest {res.shortest_path_length:.1f} m), "
-        f"{res.collisions} collisions, stopped {res.distance_to_door:.2f} m from the door, "
-        f"{res.wall_time:.1f} s wall"
-    )
-    if res.failure_reason:
-        typer.echo(f"reason: {res.failure_reason}")
-    typer.echo(f"tree log: {r.tree_log}\ntrajectory plot: {r.plot}")
+        res = r.result
+        typer.echo(
+            f"{'SUCCESS' if res.success else 'FAILURE'}: SPL {res.spl:.3f}, {res.steps} actions, "
+            f"{res.path_length:.1f} m driven (shortest {res.shortest_path_length:.1f} m), "
+            f"{res.collisions} collisions, stopped {res.distance_to_door:.2f} m from the door, "
+            f"{res.wall_time:.1f} s wall"
+        )
+        if res.failure_reason:
+            typer.echo(f"reason: {res.failure_reason}")
+        typer.echo(f"tree log: {r.tree_log}\ntrajectory plot: {r.plot}")
+        hold()
     if not res.success:
         raise typer.Exit(1)
 
 
 @contextmanager
 def _live_view(on: bool, port: int, out: Path):
-    """With ``on``: a web view server fed by the run's tree log lines (the sink yielded,
-    else None); after the run, on a terminal, it serves until Ctrl-C."""
+    """With ``on``: a web view server fed by the run's tree log lines. Yields the sink
+    for them (None without ``on``) and ``hold()``: after the run, on a terminal, serve on
+    until Ctrl-C (a run stopped by Ctrl-C, or not on a terminal, closes the view at once)."""
     if not on:
-        yield None
+        yield None, lambda: None
         return
     from pmnav_bt.webview.cli import start_server
     from pmnav_bt.webview.feed import Feed, FeedWriter
@@ -241,17 +243,19 @@ def _live_view(on: bool, port: int, out: Path):
     server = start_server(feed, "127.0.0.1", port, allow_remote=False)
     typer.echo(f"live view: {server.url}")
     writer = FeedWriter(feed)
-    try:
-        yield writer
-    finally:
+
+    def hold() -> None:
         writer.close()
         if sys.stdin.isatty():
             typer.echo(f"the run is over; the view stays at {server.url}: Ctrl-C to stop")
-            try:
+            with suppress(KeyboardInterrupt):
                 while True:
                     time.sleep(1.0)
-            except KeyboardInterrupt:
-                pass
+
+    try:
+        yield writer, hold
+    finally:
+        writer.close()
         server.close()
 
 

@@ -250,9 +250,10 @@ class FeedWriter:
         """Nothing to flush: the lines are queued already."""
 
     def close(self) -> None:
-        """Feed what is queued, then say the run ended."""
-        self._queue.put(None)
-        self._thread.join()
+        """Feed what is queued, then say the run ended (again: nothing more)."""
+        if self._thread.is_alive():
+            self._queue.put(None)
+            self._thread.join()
 
     def _drain(self) -> None:
         lines = _Lines(self.feed)
