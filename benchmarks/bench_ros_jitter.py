@@ -14,7 +14,10 @@ consecutive *motion* commands (both non-zero: the robot moving), three ways:
 - ``callback``: when the (Python, busy) probe's callback ran: adds the probe's own
   scheduling delays, an upper bound.
 
-Run: python benchmarks/bench_ros_jitter.py [--episodes easy:0,medium:1] [--width 320]
+``--view``: the controller serves its live web view (``view_port``) with a page attached
+to its event stream (``bench_tree.attach_page``), to see what a viewer costs cmd_vel.
+
+Run: python benchmarks/bench_ros_jitter.py [--episodes easy:0,medium:1] [--width 320] [--view]
 Target (cmd_rate_hz 20): p99 of the period < 75 ms; no gap over 0.5 s (the Create 3
 stops after 0.5 s without a command).
 """
@@ -24,8 +27,10 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import socket
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -51,6 +56,12 @@ def _row(name: str, per: np.ndarray) -> str:
     )
 
 
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--episodes", default="easy:0,medium:1", help="tier:index,... (seed 0)")
@@ -58,6 +69,7 @@ def main() -> int:
     ap.add_argument("--height", type=int, default=240)
     ap.add_argument("--camera-hz", type=float, default=5.0)
     ap.add_argument("--timeout", type=float, default=180.0, help="seconds per episode")
+    ap.add_argument("--view", action="store_true", help="serve the web view, a page attached")
     args = ap.parse_args()
 
     from pmnav_bt.hardware.env import domain_id_for, rclpy_available
@@ -81,7 +93,8 @@ def main() -> int:
     series: dict[str, list[np.ndarray]] = {"received": [], "source": [], "callback": []}
     print(
         f"cmd_vel period while PM-Nav runs: camera {args.width}x{args.height} at "
-        f"{args.camera_hz} Hz, cmd_rate_hz 20, ROS_DOMAIN_ID {domain}; logs in {logs}"
+        f"{args.camera_hz} Hz, cmd_rate_hz 20, ROS_DOMAIN_ID {domain}; "
+        f"web view: {'on, a page attached' if args.view else 'off'}; logs in {logs}"
     )
     print(f"{'':36s} {'n':>5s} {'median':>7s} {'p90':>6s} {'p99':>6s} {'max':>6s}  (ms)")
     try:
@@ -102,13 +115,18 @@ def main() -> int:
                 domain,
                 logs / f"{ep.id}-sim.log",
             )
-            ctl = Proc(
-                "pmnav_bt.hardware.node",
-                {"building": BUILDING, "seed": ep.seed, "budget": ep.step_budget},
-                domain,
-                logs / f"{ep.id}-controller.log",
-            )
+            params = {"building": BUILDING, "seed": ep.seed, "budget": ep.step_budget}
+            if args.view:
+                params["view_port"] = view_port = _free_port()
+            ctl = Proc("pmnav_bt.hardware.node", params, domain, logs / f"{ep.id}-controller.log")
             procs = (sim, ctl)
+            page_stop = threading.Event()
+            if args.view:
+                from bench_tree import attach_page
+
+                threading.Thread(
+                    target=attach_page, args=(("127.0.0.1", view_port), page_stop), daemon=True
+                ).start()
             try:
                 with probe.lock:
                     probe.status = None
@@ -135,6 +153,7 @@ def main() -> int:
                     dds = list(probe.cmd_dds)
                     probe.results.clear()
             finally:
+                page_stop.set()
                 for p in procs:
                     p.stop()
             moving = [bool(v or w) for _, v, w in cmds]

@@ -12,20 +12,78 @@ The sign_sparse_2 case starts with no sign in reach: the corridor belief is buil
 weighed with each look (``UpdateBelief``, in the worker) and with the depth along each
 drive (``behaviours/follow_lead.py``), which is where the slowest ticks were.
 
+``--log`` says where the tree log goes: nowhere (``none``, the default), a file
+(``file``), or the live web view (``view``: a ``pmnav view`` server fed through its
+queue, with one page attached reading the event stream), to see what writing the log and
+its view entry costs a tick.
+
     python benchmarks/bench_tree.py [--episodes 4] [--case sign_sparse_2] [--set k=v]
+        [--log none|file|view]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import http.client
+import json
 import statistics
+import tempfile
+import threading
 import time
 
 from pmnav_bt.config import load_config
 from pmnav_bt.experiments.evaluation import custom_episode
 
 
-def run(ep, deferred: bool, overrides=()) -> tuple[list[float], float, bool, int]:
+@contextlib.contextmanager
+def tree_log(where: str):
+    """The sink the tree log goes to (None: no log), per ``--log``."""
+    if where == "none":
+        yield None
+    elif where == "file":
+        with tempfile.TemporaryFile("w+", encoding="utf-8") as f:
+            yield f
+    else:
+        from pmnav_bt.webview.feed import Feed, FeedWriter
+        from pmnav_bt.webview.server import ViewServer
+
+        feed = Feed("bench", live=True)
+        server = ViewServer(feed).start()
+        writer = FeedWriter(feed)
+        stop = threading.Event()
+        address = server.server_address[:2]
+        page = threading.Thread(target=attach_page, args=(address, stop), daemon=True)
+        page.start()
+        try:
+            yield writer
+        finally:
+            writer.close()
+            stop.set()
+            server.close()
+            page.join()
+
+
+def attach_page(address, stop: threading.Event) -> None:
+    """A page attached to the view: the run so far, then the event stream, again on a reset."""
+    while not stop.is_set():
+        conn = http.client.HTTPConnection(*address, timeout=5)
+        try:
+            conn.request("GET", "/api/log")
+            log = json.loads(conn.getresponse().read())
+            conn.request("GET", f"/api/events?run={log['run']}&from={len(log['ticks'])}")
+            r = conn.getresponse()
+            while not stop.is_set() and r.read1(65536):
+                pass
+        except (OSError, http.client.HTTPException):
+            time.sleep(0.05)
+        finally:
+            conn.close()
+
+
+def run(
+    ep, deferred: bool, overrides=(), log: str = "none"
+) -> tuple[list[float], float, bool, int]:
     from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.odometry import simulated_robot
@@ -42,7 +100,8 @@ def run(ep, deferred: bool, overrides=()) -> tuple[list[float], float, bool, int
         ctx = make_context(
             base, pm, cfg, seed=ep.seed, budget=ep.step_budget * 2, deferred_work=deferred
         )
-        out = run_tree(ctx, ep.goal, tick_durations=durations)
+        with tree_log(log) as sink:
+            out = run_tree(ctx, ep.goal, log=sink, tick_durations=durations)
     return durations, time.perf_counter() - t0, out.success, out.ticks
 
 
@@ -56,10 +115,15 @@ def main() -> None:
     ap.add_argument("--episodes", type=int, default=4)
     ap.add_argument("--case", default=None, help="only the cases in this building")
     ap.add_argument("--set", action="append", default=[], help="config override key=value")
+    ap.add_argument("--log", choices=("none", "file", "view"), default="none",
+                    help="where the tree log goes: nowhere, a file, the live web view")
     args = ap.parse_args()
     from pmnav_bt.registry import grounder_label
 
-    print(f"grounder: {grounder_label(load_config(None, args.set).grounder.backend)}")
+    print(
+        f"grounder: {grounder_label(load_config(None, args.set).grounder.backend)}; "
+        f"tree log: {args.log}"
+    )
     cases = [
         ("fig2_hospital", "room17", "22,0,0"),
         ("fig2_hospital", "room17", None),
@@ -75,7 +139,7 @@ def main() -> None:
     for building, goal, start in cases:
         ep = custom_episode(building, goal, start)
         for deferred in (True, False):
-            d, wall, ok, ticks = run(ep, deferred, args.set)
+            d, wall, ok, ticks = run(ep, deferred, args.set, args.log)
             ms = [1e3 * x for x in d]
             name = f"{building}:{goal} from {start or 'start'}"
             print(

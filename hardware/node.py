@@ -19,8 +19,11 @@ API (all standard messages; names relative to the node's namespace):
   (std_msgs/String, JSON): ready or the missing inputs, idle/running, the goal,
   sensor ages, the current fault.
 - out ``tree`` (std_msgs/String, JSON): one snapshot per tick (statuses, feedback,
-  blackboard changes; the format of ``pmnav tree replay``); ``tree/structure``
-  (latched) holds the tree's nodes.
+  blackboard changes, the view entry; the format of ``pmnav tree replay``);
+  ``tree/structure`` (latched) holds the tree's nodes.
+- ``view_port``: the live web view of ``pmnav view`` on http://127.0.0.1:PORT/; the
+  snapshots reach it through a queue its own thread reads (``webview/feed.py``), so
+  the tree does not wait for it.
 - out ``plan`` (nav_msgs/Path, latched, frame ``map``), ``trajectory`` (nav_msgs/Path,
   the driven odometry poses put in the map frame with the latest localization),
   ``pose`` (geometry_msgs/PoseStamped, the estimated map pose), ``markers``
@@ -96,6 +99,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "odom_frame": ("odom", ""),
     "publish_tf": (True, "publish map -> odom on /tf (needs tf2_msgs)"),
     "tree_log": ("", "also write the tree snapshots (JSON lines) to this file"),
+    "view_port": (0, "serve the live web view (pmnav view) on this port; 0: none"),
+    "view_host": ("127.0.0.1", "address of the web view; only loopback unless view_allow_remote"),
+    "view_allow_remote": (False, "let view_host be an address other machines reach"),
     "status_hz": (1.0, "status topic rate"),
     "viz_hz": (2.0, "pose, trajectory and map -> odom publish rate"),
 }
@@ -178,17 +184,21 @@ class _Run:
 
 class _SnapshotWriter:
     """A text sink for SnapshotLogger: the structure record goes to ``tree/structure``
-    (latched), tick records to ``tree``; optionally tee'd to a file."""
+    (latched), tick records to ``tree``; optionally tee'd to a file and to the web
+    view's queue (``view``: a FeedWriter)."""
 
-    def __init__(self, tick_pub, structure_pub, tee=None) -> None:
+    def __init__(self, tick_pub, structure_pub, tee=None, view=None) -> None:
         from std_msgs.msg import String
 
         self._String = String
         self._tick, self._structure, self._tee = tick_pub, structure_pub, tee
+        self._view = view
 
     def write(self, text: str) -> int:
         if self._tee is not None:
             self._tee.write(text)
+        if self._view is not None:
+            self._view.write(text)
         line = text.strip()
         if line:
             pub = self._structure if line.startswith('{"type": "tree"') else self._tick
@@ -290,6 +300,7 @@ class PmNavController:
             self.recorder = McapRecorder(node, record, self._recorded_topics())
             self.log.info(f"recording to {record}")
         self._publish_map_markers()
+        self.view_server, self.view_writer = self._start_view(p)
         action = node.resolve_topic_name(action_server.ACTION_NAME) if self.action else None
         self.log.info(
             f"pmnav-ros started: building {self.building.name}, "
@@ -300,6 +311,27 @@ class PmNavController:
 
     def _stamp(self):
         return self.node.get_clock().now().to_msg()
+
+    def _start_view(self, p: dict[str, Any]):
+        """The web view's server and the queue the snapshots reach it by (None, None
+        when ``view_port`` is 0)."""
+        if not p["view_port"]:
+            return None, None
+        from pmnav_bt.webview.feed import Feed, FeedWriter
+        from pmnav_bt.webview.server import ViewServer, check_host
+
+        feed = Feed(f"pmnav-ros {self.node.get_fully_qualified_name()}", live=True,
+                    building=p["building"])  # fmt: skip
+        host = check_host(p["view_host"], p["view_allow_remote"])
+        server = ViewServer(feed, host, int(p["view_port"]), p["view_allow_remote"]).start()
+        self.log.info(f"web view: {server.url}")
+        return server, FeedWriter(feed)
+
+    def close_view(self) -> None:
+        """Stop the web view's server (the node is shutting down)."""
+        if self.view_server is not None:
+            self.view_writer.close()
+            self.view_server.close()
 
     def _recorded_topics(self) -> list[tuple[str, type, object]]:
         from diagnostic_msgs.msg import DiagnosticArray
@@ -460,6 +492,7 @@ class PmNavController:
     def execute(self, req: GoalRequest) -> dict:
         """Run the tree for one goal and publish its result."""
         from pmnav_bt.trees.runner import make_context, run_tree
+        from pmnav_bt.trees.view_record import ViewRecorder
 
         goal = req.goal
         w0 = time.monotonic()
@@ -475,7 +508,7 @@ class PmNavController:
         )
         viz = _Viz(self, ctx)
         tee = open(p["tree_log"], "a", encoding="utf-8") if p["tree_log"] else None  # noqa: SIM115
-        writer = _SnapshotWriter(self.pub_tree, self.pub_structure, tee)
+        writer = _SnapshotWriter(self.pub_tree, self.pub_structure, tee, self.view_writer)
         feedback = self._feedback_fn(req, viz, w0)
 
         def on_tick(tree) -> None:
@@ -489,7 +522,10 @@ class PmNavController:
             self._wait_ready(run, req, w0)
             ctx.config = camera_config(cfg, self.base.camera_width(), self.base.options)
             max_ticks = max(1, int(float(p["max_duration_s"]) * cfg.tree.tick_hz))
-            out = run_tree(ctx, goal, max_ticks, log=writer, on_tick=on_tick, sync_workers=False)
+            view = ViewRecorder(ctx, building=p["building"])
+            out = run_tree(
+                ctx, goal, max_ticks, log=writer, on_tick=on_tick, sync_workers=False, view=view
+            )
             result.update(
                 success=out.success,
                 code=out.failure.code.value if out.failure else None,
@@ -753,9 +789,14 @@ def main(argv: list[str] | None = None) -> None:
         lambda node, runtime: PmNavController(node, runtime, record=record),
         serve=PmNavController.spin,
         on_signal=PmNavController.request_stop,
-        before_shutdown=lambda controller: controller.base.close(),
+        before_shutdown=_before_shutdown,
         after_shutdown=_close_recorder,
     )
+
+
+def _before_shutdown(controller: PmNavController) -> None:
+    controller.base.close()
+    controller.close_view()
 
 
 def _close_recorder(controller: PmNavController) -> None:

@@ -26,6 +26,7 @@ LIMITS: dict[str, tuple[float, float]] = {
     "stall_s": (0.1, 600.0),
     "status_hz": (0.1, 100.0),
     "viz_hz": (0.1, 100.0),
+    "view_port": (0, 65535),
 }
 MAX_TEXT = 4096
 

@@ -18,6 +18,7 @@ import typer
 from pmnav_bt.cli_values import run_cli
 from pmnav_bt.errors import BuildingFileError, PmNavError
 from pmnav_bt.loading import check_output_file
+from pmnav_bt.webview.cli import view
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
@@ -152,6 +153,9 @@ def annotate(file: Path = typer.Argument(..., help="The building file to edit (Y
     from pmnav_bt.render.tk_annotate import run
 
     run(file)
+
+
+app.command("view")(view)
 
 
 def _error_line(err: PmNavError) -> str:

@@ -16,6 +16,11 @@ from typing import Any
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.loading import InputFileError, iter_text_lines, parse_json
 
+# The log's format. 1: no version field (statuses, feedback, blackboard); 2: the tree
+# record names its version and the run (building, goal); tick records may hold a
+# ``view`` entry (trees/view_record.py) for the web view. A reader takes every version up
+# to its own and refuses a newer one in one line.
+SCHEMA_VERSION = 2
 STATUSES = frozenset({"SUCCESS", "FAILURE", "RUNNING", "INVALID"})
 TICK_FIELDS = ("tick", "time", "status", "feedback", "blackboard")
 NODE_FIELDS = ("id", "name", "class", "parent")
@@ -25,19 +30,20 @@ MAX_NODES = 10_000
 
 @dataclass
 class TreeLog:
-    """The checked content of a tree log; ``warning`` says what was dropped, if anything."""
+    """The checked content of a tree log; ``warning`` says what was dropped, if anything;
+    ``header`` is the tree record (its ``version``, and from version 2 its ``run``)."""
 
     nodes: list[dict]
     ticks: list[dict]
     warning: str = ""
     lines: int = field(default=0)
+    header: dict = field(default_factory=dict)
 
 
 def read_tree_log(path: str | Path) -> TreeLog:
     """Read and check a tree log; PmNavError names the file, the line and what is wrong."""
     path = Path(path)
-    nodes: list[dict] | None = None
-    ticks: list[dict] = []
+    lines = TreeLogLines(str(path))
     warning = ""
     pending: tuple[int, str] | None = None  # a line without its newline: maybe cut short
     count = 0
@@ -49,54 +55,73 @@ def read_tree_log(path: str | Path) -> TreeLog:
             if not complete:
                 pending = (i, line)
                 break
-            rec = _record(path, i, line)
-            nodes = _take(path, i, rec, nodes, ticks)
+            lines.add(i, line)
     except InputFileError as err:
         raise PmNavError(str(err)) from None
     if pending is not None:
         i, line = pending
         try:
-            rec = _record(path, i, line)
+            rec = lines.parse(i, line)
         except PmNavError:
             warning = (
                 f"{path}: line {i}: the last line was cut short (the run stopped mid-write); "
-                f"replaying the {len(ticks)} complete tick records before it"
+                f"replaying the {len(lines.ticks)} complete tick records before it"
             )
         else:
-            nodes = _take(path, i, rec, nodes, ticks)
-    if nodes is None:
+            lines.take(i, rec)
+    if lines.nodes is None:
         raise PmNavError(f"{path}: not a tree log (no tree record); write one with --tree-log")
-    return TreeLog(nodes, ticks, warning, count)
+    return TreeLog(lines.nodes, lines.ticks, warning, count, lines.header)
 
 
-def _record(path: Path, i: int, line: str) -> dict:
-    try:
-        rec = parse_json(line, path, f"line {i}", allow_nan=True)
-    except InputFileError as err:
-        raise PmNavError(str(err)) from None
-    if not isinstance(rec, dict):
-        raise PmNavError(f"{path}: line {i}: not a tree log record (not a JSON object)")
-    return rec
+class TreeLogLines:
+    """Checks a tree log line by line: a file read whole, or one followed as it is written.
+
+    ``source`` names it in errors. ``new_runs``: a second tree record starts a new run
+    (a node that appends every goal's tree to one log) instead of being an error; the
+    ticks held are then dropped."""
+
+    def __init__(self, source: str, new_runs: bool = False) -> None:
+        self.source = source
+        self.new_runs = new_runs
+        self.header: dict = {}
+        self.nodes: list[dict] | None = None
+        self.ticks: list[dict] = []
+
+    def parse(self, i: int, line: str) -> dict:
+        """Line ``i`` as a JSON object (PmNavError: not one)."""
+        try:
+            rec = parse_json(line, self.source, f"line {i}", allow_nan=True)
+        except InputFileError as err:
+            raise PmNavError(str(err)) from None
+        if not isinstance(rec, dict):
+            raise PmNavError(f"{self.source}: line {i}: not a tree log record (not a JSON object)")
+        return rec
+
+    def add(self, i: int, line: str) -> dict:
+        """Parse, check and keep line ``i``; returns its record."""
+        return self.take(i, self.parse(i, line))
+
+    def take(self, i: int, rec: dict) -> dict:
+        """Check and keep a record of line ``i``; returns it."""
+        where = f"{self.source}: line {i}"
+        kind = rec.get("type")
+        if kind == "tree":
+            if self.nodes is not None and not self.new_runs:
+                raise PmNavError(f"{where}: a second tree record (one log, one tree)")
+            header = check_header(rec, f"{where}: tree record")
+            self.nodes = _check_nodes(self.source, i, rec.get("nodes"))
+            self.header, self.ticks = header, []
+        elif kind == "tick":
+            if self.nodes is None:
+                raise PmNavError(f"{where}: not a tree log (a tick record before the tree record)")
+            self.ticks.append(check_tick(rec, where))
+        elif not isinstance(kind, str):
+            raise PmNavError(f"{where}: record 'type' must be a string, got {_brief(kind)}")
+        return rec
 
 
-def _take(path: Path, i: int, rec: dict, nodes: list[dict] | None, ticks: list[dict]):
-    kind = rec.get("type")
-    if kind == "tree":
-        if nodes is not None:
-            raise PmNavError(f"{path}: line {i}: a second tree record (one log, one tree)")
-        return _check_nodes(path, i, rec.get("nodes"))
-    if kind == "tick":
-        if nodes is None:
-            raise PmNavError(
-                f"{path}: line {i}: not a tree log (a tick record before the tree record)"
-            )
-        ticks.append(_check_tick(path, i, rec))
-    elif not isinstance(kind, str):
-        raise PmNavError(f"{path}: line {i}: record 'type' must be a string, got {_brief(kind)}")
-    return nodes
-
-
-def _check_nodes(path: Path, i: int, nodes: Any) -> list[dict]:
+def _check_nodes(path: Path | str, i: int, nodes: Any) -> list[dict]:
     where = f"{path}: line {i}: tree record"
     if not isinstance(nodes, list) or not nodes:
         raise PmNavError(f"{where}: 'nodes' must be a non-empty list, got {_brief(nodes)}")
@@ -129,11 +154,32 @@ def _check_nodes(path: Path, i: int, nodes: Any) -> list[dict]:
     return nodes
 
 
-def _check_tick(path: Path, i: int, rec: dict) -> dict:
-    where = f"{path}: line {i}: tick record"
+def check_header(rec: dict, where: str) -> dict:
+    """A tree record's version (1 when it has none: logs written before versions) and
+    ``run`` (building, goal), checked; a newer version than this reader's is refused."""
+    version = rec.get("version", 1)
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise PmNavError(f"{where}: 'version' must be a positive integer, got {_brief(version)}")
+    if version > SCHEMA_VERSION:
+        raise PmNavError(
+            f"{where}: schema version {version} is newer than this pmnav reads "
+            f"(up to {SCHEMA_VERSION}); update pmnav"
+        )
+    run = rec.get("run", {})
+    if not isinstance(run, dict):
+        raise PmNavError(f"{where}: 'run' must be an object, got {_brief(run)}")
+    for f in ("building", "goal"):
+        if run.get(f) is not None and not isinstance(run[f], str):
+            raise PmNavError(f"{where}: run.{f} must be a string, got {_brief(run[f])}")
+    return {"version": version, "run": run}
+
+
+def check_tick(rec: dict, where_line: str) -> dict:
+    """A tick record, checked (``where_line``: the file and line, for the error)."""
+    where = f"{where_line}: tick record"
     missing = sorted(f for f in TICK_FIELDS if f not in rec)
     if missing:
-        raise PmNavError(f"{path}: line {i}: a tick record lacks {', '.join(missing)}")
+        raise PmNavError(f"{where_line}: a tick record lacks {', '.join(missing)}")
     tick, t = rec["tick"], rec["time"]
     if not isinstance(tick, int) or isinstance(tick, bool):
         raise PmNavError(f"{where}: 'tick' must be an integer, got {_brief(tick)}")
@@ -153,7 +199,107 @@ def _check_tick(path: Path, i: int, rec: dict) -> dict:
     for k, v in rec["feedback"].items():
         if not isinstance(v, str):
             raise PmNavError(f"{where}: feedback of {_brief(k)} must be a string, got {_brief(v)}")
+    if "view" in rec:
+        _check_view(rec["view"], f"{where}: view")
     return rec
+
+
+# -- the view entry (version 2): the shape of each key the web view draws -------------------
+
+
+def _num(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _nums(v: Any, n: int | None) -> bool:
+    return isinstance(v, list) and (n is None or len(v) == n) and all(_num(x) for x in v)
+
+
+def _points(v: Any) -> bool:
+    return isinstance(v, list) and all(_nums(p, 2) for p in v)
+
+
+def _strs(v: Any) -> bool:
+    return isinstance(v, list) and all(isinstance(x, str) for x in v)
+
+
+def _failure(v: Any) -> bool:
+    return (
+        isinstance(v, dict)
+        and isinstance(v.get("code"), str)
+        and isinstance(v.get("message"), str)
+        and (v.get("root") is None or _failure(v["root"]))
+    )
+
+
+def _plan(v: Any) -> bool:
+    steps = v.get("steps") if isinstance(v, dict) else None
+    return (
+        isinstance(v, dict)
+        and isinstance(v.get("text"), str)
+        and _points(v.get("path"))
+        and isinstance(steps, list)
+        and all(
+            isinstance(s, dict)
+            and all(isinstance(s.get(f), str) for f in ("landmark", "action", "text"))
+            and _nums(s.get("xy"), 2)
+            for s in steps
+        )
+    )
+
+
+def _belief(v: Any) -> bool:
+    return (
+        isinstance(v, dict)
+        and _points(v.get("xy"))
+        and _nums(v.get("w"), len(v.get("xy") or []))
+        and _num(v.get("best"))
+    )
+
+
+def _found(v: Any) -> bool:
+    return (
+        isinstance(v, dict)
+        and isinstance(v.get("label"), str)
+        and _nums(v.get("box"), 4)
+        and _num(v.get("score"))
+        and (v.get("entity") is None or isinstance(v["entity"], str))
+    )
+
+
+def _frame(v: Any) -> bool:
+    return (
+        isinstance(v, dict)
+        and isinstance(v.get("jpeg"), str)
+        and _nums(v.get("size"), 2)
+        and _strs(v.get("what"))
+        and isinstance(v.get("found"), list)
+        and all(_found(d) for d in v["found"])
+    )
+
+
+# key -> (the check of a non-null value, what it should be)
+VIEW_CHECKS = {
+    "pose": (lambda v: _nums(v, 3), "[x, y, yaw]"),
+    "odom": (lambda v: _nums(v, 3), "[x, y, yaw]"),
+    "truth": (lambda v: _nums(v, 3), "[x, y, yaw]"),
+    "sigma": (lambda v: _num(v) and v >= 0, "a number of metres, at least 0"),
+    "plan": (_plan, "a plan: text, path [[x, y], ...], steps"),
+    "belief": (_belief, "a belief: xy [[x, y], ...], w (one weight each), best"),
+    "failure": (_failure, "a failure: code, message, optional root"),
+    "recovering": (_failure, "a failure: code, message, optional root"),
+    "frame": (_frame, "a frame: jpeg, size [w, h], what, found"),
+    "seen": (_strs, "a list of names"),
+}
+
+
+def _check_view(view: Any, where: str) -> None:
+    """Each key the web view draws has the shape it expects (unknown keys are left)."""
+    if not isinstance(view, dict):
+        raise PmNavError(f"{where}: must be an object, got {_brief(view)}")
+    for key, (ok, what) in VIEW_CHECKS.items():
+        if key in view and view[key] is not None and not ok(view[key]):
+            raise PmNavError(f"{where}.{key}: expected {what}, got {_brief(view[key])}")
 
 
 def _brief(v: Any, n: int = 40) -> str:

@@ -25,6 +25,7 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.seams import Base
 from pmnav_bt.tree_variants import TREE_VARIANTS
 from pmnav_bt.trees.snapshots import SnapshotLogger
+from pmnav_bt.trees.view_record import ViewRecorder
 
 
 @dataclass
@@ -114,15 +115,20 @@ def run_tree(
     on_tick: Callable[[py_trees.trees.BehaviourTree], None] | None = None,
     sync_workers: bool = True,
     tick_durations: list[float] | None = None,
+    view: ViewRecorder | None = None,
 ) -> RunOutcome:
     """Build the tree for ``goal`` and tick it until it succeeds or fails.
 
     ``tick_durations`` (optional) collects the wall time of every tick, in seconds.
+    ``log``: write the tree log here, each tick's ``view`` entry made by ``view`` (default
+    a ViewRecorder that knows the building by the map's name and no true pose).
     """
     py_trees.blackboard.Blackboard.clear()
+    if log is not None and view is None:
+        view = ViewRecorder(ctx)
     tree = build_tree(ctx, goal)
     if log is not None:
-        tree.add_post_tick_handler(SnapshotLogger(tree, log, ctx.now))
+        tree.add_post_tick_handler(SnapshotLogger(tree, log, ctx.now, view=view, goal=goal))
     period = 1.0 / ctx.config.tree.tick_hz
     status = py_trees.common.Status.RUNNING
     crash: Failure | None = None

@@ -1,8 +1,11 @@
 """Tree status for debugging: per-tick JSON snapshots, replay, and unicode rendering.
 
-A log is JSON lines: first the tree's structure, then one record per tick with every
-visited node's status and feedback message and the blackboard keys written in that
-tick. ``pmnav tree replay LOG`` steps through it.
+A log is JSON lines: first the tree's structure (with the schema ``version`` and, from
+version 2, the ``run``: building and goal), then one record per tick with every visited
+node's status and feedback message, the blackboard keys written in that tick and, from
+version 2, the ``view`` entry (``trees/view_record.py``: pose, plan, belief, failure,
+camera frame). ``pmnav tree replay LOG`` steps through it; ``pmnav view LOG`` shows it
+in a browser.
 """
 
 from __future__ import annotations
@@ -16,6 +19,8 @@ from typing import Any, TextIO
 
 import numpy as np
 import py_trees
+
+from pmnav_bt.treelog import SCHEMA_VERSION
 
 STATUS_MARK = {"SUCCESS": "✔", "FAILURE": "✘", "RUNNING": "*", "INVALID": "-"}
 
@@ -62,26 +67,41 @@ def structure(root: py_trees.behaviour.Behaviour) -> list[dict]:
 
 
 class SnapshotLogger:
-    """Writes one JSON record per tick (a post-tick handler of a BehaviourTree)."""
+    """Writes one JSON record per tick (a post-tick handler of a BehaviourTree).
 
-    def __init__(self, tree: py_trees.trees.BehaviourTree, out: TextIO, clock_now=None):
+    ``view``: a ``trees.view_record.ViewRecorder`` adds each tick's ``view`` entry and
+    the tree record's ``run``; ``goal``: the goal named there."""
+
+    def __init__(
+        self,
+        tree: py_trees.trees.BehaviourTree,
+        out: TextIO,
+        clock_now=None,
+        view=None,
+        goal: str | None = None,
+    ):
         self.out = out
         self.now = clock_now
+        self.view = view
         self.visitor = py_trees.visitors.SnapshotVisitor()
         tree.visitors.append(self.visitor)
         py_trees.blackboard.Blackboard.enable_activity_stream(maximum_size=10000)
-        self._write({"type": "tree", "nodes": structure(tree.root)})
+        rec: dict[str, Any] = {"type": "tree", "version": SCHEMA_VERSION}
+        if view is not None:
+            rec["run"] = view.run_fields(goal)
+        rec["nodes"] = structure(tree.root)
+        self._write(rec)
 
     def _write(self, rec: dict) -> None:
         self.out.write(json.dumps(rec) + "\n")
 
     def __call__(self, tree: py_trees.trees.BehaviourTree) -> None:
         stream = py_trees.blackboard.Blackboard.activity_stream
-        changes = {}
+        raw = {}
         if stream is not None:
             for item in stream.data:
                 if item.activity_type in ("WRITE", "INITIALISED"):
-                    changes[item.key] = brief(item.current_value)
+                    raw[item.key] = item.current_value
             stream.clear()
         statuses, feedback = {}, {}
         for node in tree.root.iterate():
@@ -89,16 +109,17 @@ class SnapshotLogger:
                 statuses[str(node.id)] = node.status.name
                 if node.feedback_message:
                     feedback[str(node.id)] = node.feedback_message
-        self._write(
-            {
-                "type": "tick",
-                "tick": tree.count,
-                "time": round(self.now(), 3) if self.now else None,
-                "status": statuses,
-                "feedback": feedback,
-                "blackboard": changes,
-            }
-        )
+        rec = {
+            "type": "tick",
+            "tick": tree.count,
+            "time": round(self.now(), 3) if self.now else None,
+            "status": statuses,
+            "feedback": feedback,
+            "blackboard": {k: brief(v) for k, v in raw.items()},
+        }
+        if self.view is not None:
+            rec["view"] = self.view(raw)
+        self._write(rec)
 
 
 @dataclass

@@ -12,7 +12,7 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TextIO
 
 from pmnav_bt.config import Config
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
@@ -89,10 +89,12 @@ def run_episode(
     on_tick: Callable | None = None,
     plot: bool = True,
     setup_world: Callable | None = None,
+    also_log: TextIO | None = None,
 ) -> EpisodeRun:
     """Run one episode in a fresh world; write its tree log and trajectory plot to ``out_dir``.
 
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
+    ``also_log``: a second sink for the tree log's lines (the live web view, ``--view``).
     """
     from pmnav_bt.sim.episodes import episode_map, goal_geodesic, score_episode
     from pmnav_bt.sim.odometry import simulated_robot
@@ -100,6 +102,7 @@ def run_episode(
     from pmnav_bt.sim.scene.blocking import block_segment
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
+    from pmnav_bt.trees.view_record import ViewRecorder
 
     file, pm = episode_map(episode)
     b = pm.building
@@ -132,7 +135,13 @@ def run_episode(
             out_dir.mkdir(parents=True, exist_ok=True)
             log_path = out_dir / f"{safe_filename(episode.id)}.tree.jsonl"
         with open(log_path, "w", encoding="utf-8") if log_path else _null() as log:
-            outcome = run_tree(ctx, episode.goal, log=log, on_tick=record)
+            sinks = [s for s in (log, also_log) if s is not None]
+            view = None  # no log, no view entries (nor frames encoded for them)
+            if sinks:
+                view = ViewRecorder(ctx, building=_building_ref(file, b.name), truth=inner.pose)
+            outcome = run_tree(
+                ctx, episode.goal, log=_Tee(sinks) if sinks else None, on_tick=record, view=view
+            )
         final = inner.pose()
         stats = inner.stats
     wall = time.perf_counter() - t0
@@ -154,12 +163,34 @@ def run_episode(
     return EpisodeRun(result, plot_path, log_path)
 
 
+def _building_ref(file: Path, name: str) -> str:
+    """How a tree log names the building: a built-in by its name (the log stays readable
+    on another machine), any other by its file's path."""
+    from pmnav_bt.map.catalogue import builtin_buildings, resolve_building_path
+
+    if name in builtin_buildings() and resolve_building_path(name).resolve() == file.resolve():
+        return name
+    return str(file)
+
+
 class _null:
     def __enter__(self):
         return None
 
     def __exit__(self, *exc):
         return False
+
+
+class _Tee:
+    """A text sink writing to several (the log file and the live view)."""
+
+    def __init__(self, sinks: list[TextIO]) -> None:
+        self.sinks = sinks
+
+    def write(self, text: str) -> int:
+        for s in self.sinks:
+            s.write(text)
+        return len(text)
 
 
 def _plot(

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import NoReturn
 
@@ -166,10 +167,17 @@ def run(
     seed: int = typer.Option(0, "--seed"),
     out: Path = typer.Option(Path("out/run"), "--out", help="Folder for the log and the plot."),
     show_tree: bool = typer.Option(False, "--show-tree", help="Show the live tree while it runs."),
+    view: bool = typer.Option(
+        False, "--view", help="Serve the live web view of the run (see 'pmnav view')."
+    ),
+    view_port: int = typer.Option(8765, "--view-port", help="Port of --view (0: any free one)."),
     config: Path | None = CONFIG_OPT,
     overrides: list[str] | None = SET_OPT,
 ) -> None:
-    """Run one PM-Nav episode and print its result; write the tree log and trajectory plot."""
+    """Run one PM-Nav episode and print its result; write the tree log and trajectory plot.
+
+    With --view, a browser page shows the run live; on a terminal it stays up after the
+    run until Ctrl-C."""
     from pmnav_bt.experiments.evaluation import custom_episode, run_episode
     from pmnav_bt.tree_variants import TREE_VARIANTS
 
@@ -202,23 +210,56 @@ def run(
         f"start ({ep.start_x:.1f}, {ep.start_y:.1f}, {math.degrees(ep.start_yaw):.0f} deg), "
         f"corridor route {ep.route_length:.1f} m"
     )
-    if live is not None:
-        with live:
-            r = run_episode(ep, cfg, out_dir=out, on_tick=live)
-    else:
-        r = run_episode(ep, cfg, out_dir=out)
-    res = r.result
-    typer.echo(
-        f"{'SUCCESS' if res.success else 'FAILURE'}: SPL {res.spl:.3f}, {res.steps} actions, "
-        f"{res.path_length:.1f} m driven (shortest {res.shortest_path_length:.1f} m), "
-        f"{res.collisions} collisions, stopped {res.distance_to_door:.2f} m from the door, "
-        f"{res.wall_time:.1f} s wall"
-    )
-    if res.failure_reason:
-        typer.echo(f"reason: {res.failure_reason}")
-    typer.echo(f"tree log: {r.tree_log}\ntrajectory plot: {r.plot}")
+    with _live_view(view, view_port, out) as (sink, hold):
+        if live is not None:
+            with live:
+                r = run_episode(ep, cfg, out_dir=out, on_tick=live, also_log=sink)
+        else:
+            r = run_episode(ep, cfg, out_dir=out, also_log=sink)
+        res = r.result
+        typer.echo(
+            f"{'SUCCESS' if res.success else 'FAILURE'}: SPL {res.spl:.3f}, {res.steps} actions, "
+            f"{res.path_length:.1f} m driven (shortest {res.shortest_path_length:.1f} m), "
+            f"{res.collisions} collisions, stopped {res.distance_to_door:.2f} m from the door, "
+            f"{res.wall_time:.1f} s wall"
+        )
+        if res.failure_reason:
+            typer.echo(f"reason: {res.failure_reason}")
+        typer.echo(f"tree log: {r.tree_log}\ntrajectory plot: {r.plot}")
+        hold()
     if not res.success:
         raise typer.Exit(1)
+
+
+@contextmanager
+def _live_view(on: bool, port: int, out: Path):
+    """With ``on``: a web view server fed by the run's tree log lines. Yields the sink
+    for them (None without ``on``) and ``hold()``: after the run, on a terminal, serve on
+    until Ctrl-C (a run stopped by Ctrl-C, or not on a terminal, closes the view at once)."""
+    if not on:
+        yield None, lambda: None
+        return
+    from pmnav_bt.webview.cli import start_server
+    from pmnav_bt.webview.feed import Feed, FeedWriter
+
+    feed = Feed(f"pmnav sim run --out {out}", live=True)
+    server = start_server(feed, "127.0.0.1", port, allow_remote=False)
+    typer.echo(f"live view: {server.url}")
+    writer = FeedWriter(feed)
+
+    def hold() -> None:
+        writer.close()
+        if sys.stdin.isatty():
+            typer.echo(f"the run is over; the view stays at {server.url}: Ctrl-C to stop")
+            with suppress(KeyboardInterrupt):
+                while True:
+                    time.sleep(1.0)
+
+    try:
+        yield writer, hold
+    finally:
+        writer.close()
+        server.close()
 
 
 RAY_OPT = typer.Option(
