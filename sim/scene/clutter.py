@@ -31,6 +31,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -94,7 +95,7 @@ class ClutterItem:
         """The item's x axis (along the wall) as a heading."""
         return math.atan2(-self.normal[0], self.normal[1])
 
-    @property
+    @cached_property
     def footprint(self) -> Polygon:
         return footprint(*self.centre, self.yaw, self.length / 2.0, self.depth / 2.0)
 

@@ -184,7 +184,8 @@ class Crowd:
             c.index: (c.a[0], c.a[1], float(c.along[0]), float(c.along[1]), c.length)
             for c in ways
         }
-        self._lanes = {c.index: _lanes(c, world) for c in ways}
+        beside = [np.asarray(fp.exterior.coords) for fp in world.obstacle_footprints(HEIGHT_M[1])]
+        self._lanes = {c.index: _lanes(c, beside) for c in ways}
         for q in people:
             self._locate(q)
 
@@ -353,17 +354,18 @@ class Crowd:
                     self._touching.discard((i, k))
 
 
-def _lanes(c: Corridor, world: SimWorld) -> tuple[np.ndarray, np.ndarray]:
+def _lanes(c: Corridor, obstacles: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """The keep-right offsets along ``c`` walking a -> b and b -> a (index: metres walked
-    / ``_GRID_M``): ``LANE_M``, less beside an obstacle on that side (growing back at 1 m
-    per m beyond it), tapering to 0 before a junction end."""
+    / ``_GRID_M``): ``LANE_M``, less beside an obstacle (its outline's points) on that side,
+    growing back at 1 m per m beyond it; tapering to 0 before a junction end."""
     n = int(math.ceil(c.length / _GRID_M)) + 1
     s = np.arange(n) * _GRID_M
     fwd, back = np.full(n, LANE_M), np.full(n, LANE_M)
-    for fp in world.obstacle_footprints(HEIGHT_M[1]):
-        pts = np.array([c.local(xy) for xy in fp.exterior.coords])
-        s0, s1 = pts[:, 0].min(), pts[:, 0].max()
-        l0, l1 = pts[:, 1].min(), pts[:, 1].max()
+    for pts in obstacles:
+        d = pts - np.asarray(c.a)
+        along, lateral = d @ c.along, d @ c.left
+        s0, s1 = along.min(), along.max()
+        l0, l1 = lateral.min(), lateral.max()
         if s1 < -c.half_width or s0 > c.length + c.half_width or l0 * l1 <= 0:
             continue  # elsewhere, or astride the centre line (not clutter beside a lane)
         if min(abs(l0), abs(l1)) > c.half_width + 0.05:
