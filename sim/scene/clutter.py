@@ -61,11 +61,12 @@ SIGN_FRONT_M = 1.0  # how far in front of a sign plate ordinary clutter keeps of
 SIGN_COVER = 0.7  # an item before a sign is shifted by up to this much of the overlap span
 WALL_GAP_M = 0.02  # furniture stands this far off the wall (clear of the skirting)
 TRIES_PER_ITEM = 60
+MIN_CORRIDOR_M = 0.5  # shorter corridors (stubs joining others) carry no clutter
 
 KIND_WEIGHTS: dict[str, dict[str, float]] = {
     "hospital": {"bench": 2, "chair": 3, "cart": 3, "bed": 2, "plant": 1.5, "notice_board": 1},
     "school": {"bench": 3, "chair": 1, "cart": 0.5, "bed": 0, "plant": 1, "notice_board": 3},
-    "office": {"bench": 0.5, "chair": 2, "cart": 0.5, "bed": 0, "plant": 3, "notice_board": 1.5},
+    "office": {"bench": 0.5, "chair": 2, "cart": 0.5, "bed": 0, "plant": 2, "notice_board": 1.5},
 }
 DEFAULT_WEIGHTS = {"bench": 1, "chair": 1, "cart": 1, "bed": 0, "plant": 1, "notice_board": 1}
 
@@ -142,7 +143,7 @@ class ClutterPlan:
     def __init__(self, world: SimWorld) -> None:
         b = world.building
         self.world = world
-        self.corridors = [c for c in corridors(b) if c.length > 0.5]
+        self.corridors = [c for c in corridors(b) if c.length > MIN_CORRIDOR_M]
         self.floor = world.floor_space()
         shapely.prepare(self.floor)
         self.centre_lines = MultiLineString([LineString([c.a, c.b]) for c in self.corridors])
@@ -289,10 +290,10 @@ def place_clutter(world: SimWorld) -> list[ClutterItem]:
     scene = world.scene
     if scene.clutter_per_10m <= 0.0:
         return []
+    if not any(c.length > MIN_CORRIDOR_M for c in corridors(world.building)):
+        return []
     rng = world.rng("clutter")
     plan = ClutterPlan(world)
-    if not plan.corridors:
-        return []
     expected = sum(w.length for w in world.walls) * scene.clutter_per_10m / 10.0
     n = int(expected) + int(rng.random() < expected - int(expected))
     n_before = int(round(n * scene.clutter_before_signs))

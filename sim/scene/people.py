@@ -262,9 +262,10 @@ class Crowd:
 
     def advance(self, h: float) -> None:
         """Clock listener: ``h`` seconds of walking, pausing and yielding."""
-        for q in self.people:
-            self._advance_one(q, h)
-        self._count_contacts()
+        with self.world.lock:  # a camera may be rendering them from a worker thread
+            for q in self.people:
+                self._advance_one(q, h)
+            self._count_contacts()
 
     # -- walking --------------------------------------------------------------------------------
 
