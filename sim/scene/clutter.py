@@ -32,7 +32,6 @@ import logging
 import math
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
@@ -43,9 +42,7 @@ from pmnav_bt.seams import CREATE3_RADIUS_M, OBSTACLE_LABEL
 from pmnav_bt.sim.scene.bodies import Envelope, compound_body, footprint
 from pmnav_bt.sim.scene.corridors import Corridor, corridors, junction_points
 from pmnav_bt.sim.scene.furniture import BUILDERS, ON_WALL, Shape
-
-if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.sim.world import SimWorld, WallItem
+from pmnav_bt.sim.scene.host import Mounted, SceneWorld
 
 log = logging.getLogger(__name__)
 
@@ -129,7 +126,7 @@ class _Site:
         return footprint(c[0], c[1], yaw, self.shape.length / 2.0, self.shape.depth / 2.0)
 
 
-def _front(item: WallItem, margin: float, depth: float) -> Polygon:
+def _front(item: Mounted, margin: float, depth: float) -> Polygon:
     """The floor in front of a wall item: ``margin`` beyond either end, ``depth`` out."""
     c, n = np.asarray(item.centre, float), np.asarray(item.normal, float)
     t = np.array([-n[1], n[0]]) * (item.width / 2.0 + margin)
@@ -140,7 +137,7 @@ def _front(item: WallItem, margin: float, depth: float) -> Polygon:
 class ClutterPlan:
     """Where clutter may stand in ``world`` (its walls, doors, signs and landmarks built)."""
 
-    def __init__(self, world: SimWorld) -> None:
+    def __init__(self, world: SceneWorld) -> None:
         b = world.building
         self.world = world
         self.corridors = [c for c in corridors(b) if c.length > MIN_CORRIDOR_M]
@@ -168,7 +165,7 @@ class ClutterPlan:
         w = np.array([weights[k] for k in self.kinds], float)
         self.weights = w / w.sum()
 
-    def _sign_sites(self) -> dict[str, tuple[WallItem, Corridor, float]]:
+    def _sign_sites(self) -> dict[str, tuple[Mounted, Corridor, float]]:
         """Every sign plate that hangs on a corridor's side wall: label -> (plate, corridor, s)."""
         w = self.world
         plates = [*w.signs.values(), *w.landmark_signs.values()]
@@ -265,7 +262,7 @@ class ClutterPlan:
         return True
 
 
-def add_item(world: SimWorld, kind: str, shape: Shape, centre, normal) -> int:
+def add_item(world: SceneWorld, kind: str, shape: Shape, centre, normal) -> int:
     """Build one item of ``shape`` with its footprint centred at ``centre``, its back to the
     wall whose inward normal is ``normal``: a solid body labelled ``obstacle`` whose
     footprint counts in ``obstacle_footprints``."""
@@ -283,7 +280,7 @@ def add_item(world: SimWorld, kind: str, shape: Shape, centre, normal) -> int:
     return world.register(body, OBSTACLE_LABEL, solid=True, footprint=fp, bottom=shape.bottom)
 
 
-def place_clutter(world: SimWorld) -> list[ClutterItem]:
+def place_clutter(world: SceneWorld) -> list[ClutterItem]:
     """Place the config's clutter in ``world`` (nothing, and nothing drawn, when its
     density is 0); the items placed, in order. Fewer are placed where the rules leave too
     little wall (logged)."""

@@ -27,18 +27,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
 import numpy as np
 
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.sim._pybullet import p
+from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.scene.bodies import RGBA, Part, box, compound_body, cylinder, sphere
 from pmnav_bt.sim.scene.corridors import Corridor, corridors
-
-if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.sim.clock import SimClock
-    from pmnav_bt.sim.world import SimWorld
+from pmnav_bt.sim.scene.host import SceneWorld
 
 PERSON = "person"  # their segmentation label
 PERSON_RADIUS_M = 0.25  # shoulders about 0.45-0.5 m across, arms swinging
@@ -166,7 +164,7 @@ class Crowd:
     people are upright cylinders, so the distance is exact and costs microseconds), and
     the bodies are moved to where the people are when a camera renders (``show``)."""
 
-    def __init__(self, world: SimWorld, people: list[Person], ways: list[Corridor]) -> None:
+    def __init__(self, world: SceneWorld, people: list[Person], ways: list[Corridor]) -> None:
         self.world = world
         self.people = people
         self.corridors = {c.index: c for c in ways}
@@ -386,7 +384,7 @@ def _lanes(c: Corridor, obstacles: list[np.ndarray]) -> tuple[np.ndarray, np.nda
     return fwd, back
 
 
-def populate(world: SimWorld) -> Crowd:
+def populate(world: SceneWorld) -> Crowd:
     """The config's people in ``world``, walking from random places of its corridors; an
     empty crowd (nothing drawn, nothing built) when ``people_per_100m`` is 0."""
     ways = [c for c in corridors(world.building) if c.length > 0.1]
