@@ -58,6 +58,7 @@ SIGN_FRONT_M = 1.0  # how far in front of a sign plate ordinary clutter keeps of
 SIGN_COVER = 0.7  # an item before a sign is shifted by up to this much of the overlap span
 WALL_GAP_M = 0.02  # furniture stands this far off the wall (clear of the skirting)
 TRIES_PER_ITEM = 60
+TALL_TRIES = 8  # draws of an item tall enough to stand before a given sign
 MIN_CORRIDOR_M = 0.5  # shorter corridors (stubs joining others) carry no clutter
 
 KIND_WEIGHTS: dict[str, dict[str, float]] = {
@@ -157,7 +158,7 @@ class ClutterPlan:
         shapely.prepare(self.keep_out)
         self.signs = self._sign_sites()
         self.sign_fronts = shapely.union_all(
-            [_front(it, 0.1, SIGN_FRONT_M) for it, _, _ in self.signs.values()]
+            [_front(it, 0.1, SIGN_FRONT_M) for it, _, _, _ in self.signs.values()]
         )
         shapely.prepare(self.sign_fronts)
         weights = KIND_WEIGHTS.get(b.kind.lower(), DEFAULT_WEIGHTS)
@@ -165,21 +166,33 @@ class ClutterPlan:
         w = np.array([weights[k] for k in self.kinds], float)
         self.weights = w / w.sum()
 
-    def _sign_sites(self) -> dict[str, tuple[Mounted, Corridor, float]]:
-        """Every sign plate that hangs on a corridor's side wall: label -> (plate, corridor, s)."""
+    def _on_side(self, it: Mounted) -> tuple[Corridor, float, int] | None:
+        """The corridor whose side wall ``it`` hangs on, ``s`` along it and the side."""
+        for c in self.corridors:
+            s, lat = c.local(it.centre)
+            facing = float(np.asarray(it.normal) @ c.left) * np.sign(lat)  # -1: inwards
+            on_wall = abs(abs(lat) - c.half_width) < 0.1 and facing < -0.9
+            if on_wall and -0.05 <= s <= c.length + 0.05:
+                return c, s, 1 if lat > 0 else -1
+        return None
+
+    def _sign_sites(self) -> dict[str, tuple[Mounted, Corridor, float, int]]:
+        """Every sign plate on a corridor's side wall: label -> (plate, corridor, s, away):
+        ``away`` (+-1 along s, 0 if none is near) points from the nearest door beside it."""
         w = self.world
         plates = [*w.signs.values(), *w.landmark_signs.values()]
         plates += [lm for lm in w.landmarks.values() if lm.z[0] >= 0.5]  # plain plates
+        doors = [d for d in map(self._on_side, w.doors.values()) if d is not None]
         out = {}
         for it in plates:
-            for c in self.corridors:
-                s, lat = c.local(it.centre)
-                facing = float(np.asarray(it.normal) @ c.left) * np.sign(lat)
-                if -0.05 <= s <= c.length + 0.05 and abs(abs(lat) - c.half_width) < 0.1 and (
-                    facing < -0.9
-                ):
-                    out[it.label + "/" + it.kind] = (it, c, s)
-                    break
+            at = self._on_side(it)
+            if at is None:
+                continue
+            c, s, side = at
+            near = [ds for dc, ds, dside in doors if dc is c and dside == side]
+            near = [ds for ds in near if abs(ds - s) < 3.0]
+            away = 0 if not near else (1 if s >= min(near, key=lambda ds: abs(ds - s)) else -1)
+            out[it.label + "/" + it.kind] = (it, c, s, away)
         return out
 
     # -- candidates ------------------------------------------------------------------------
@@ -211,12 +224,17 @@ class ClutterPlan:
             return None
         keys = sorted(self.signs)
         key = keys[int(rng.integers(len(keys)))]
-        plate, c, s_plate = self.signs[key]
-        kind, shape = self._shape(rng, floor_only=True)
-        if shape.top < plate.z[0] + 0.1:
+        plate, c, s_plate, away = self.signs[key]
+        for _ in range(TALL_TRIES):
+            kind, shape = self._shape(rng, floor_only=True)
+            if shape.top >= plate.z[0] + 0.1:
+                break
+        else:
             return None
         span = (shape.length + plate.width) / 2.0
-        s = s_plate + float(rng.uniform(-1.0, 1.0)) * span * SIGN_COVER
+        # Shifted along the wall, away from the door beside the plate (its approach is clear).
+        shift = float(rng.uniform(0.0, 1.0)) if away else float(rng.uniform(-1.0, 1.0))
+        s = s_plate + (away or 1) * shift * span * SIGN_COVER
         side = 1 if c.local(plate.centre)[1] > 0 else -1
         return _Site(c, side, s, shape, kind), plate.label
 
