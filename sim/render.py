@@ -223,7 +223,7 @@ def draw_top_down(
         cv2.fillPoly(img, [np.array([px(q) for q in corners], np.int32)], colour)
 
     for rid, door in world.doors.items():
-        mark(door, (150, 90, 40), 0.25)
+        mark(door, _door_colour(world, rid), 0.25)
         n = np.asarray(door.normal)
         q = px(np.asarray(door.centre) - n * 0.9)
         text(rid, (q[0] - 4 * len(rid), q[1] + 4), (120, 60, 20))
@@ -280,14 +280,31 @@ CLUTTER_COLOURS = {
 
 
 def _draw_clutter(img: np.ndarray, world: SimWorld, px) -> None:
-    """Each clutter item's footprint in its kind's colour, outlined in black."""
+    """Each clutter item's footprint in its kind's colour, outlined in black (a thin one,
+    a notice board, drawn 0.1 m deep so that it shows)."""
     for item in world.clutter:
-        pts = np.array([px(q) for q in item.footprint.exterior.coords], np.int32)
+        fp = item.footprint
+        if item.depth < 0.1:
+            fp = fp.buffer(0.05, join_style="mitre")
+        pts = np.array([px(q) for q in fp.exterior.coords], np.int32)
         cv2.fillPoly(img, [pts], CLUTTER_COLOURS.get(item.kind, (255, 120, 0)))
-        cv2.polylines(img, [pts], True, (0, 0, 0), 1, cv2.LINE_AA)
+        if item.depth >= 0.1:
+            cv2.polylines(img, [pts], True, (0, 0, 0), 1, cv2.LINE_AA)
 
 
 PERSON_COLOUR = (230, 40, 90)
+OPEN_DOOR_COLOUR = (30, 30, 30)
+GLASS_DOOR_COLOUR = (140, 200, 225)
+
+
+def _door_colour(world: SimWorld, room: str) -> tuple[int, int, int]:
+    """A door in the plan: brown when closed, black when open, pale blue when glazed."""
+    state = world.door_states.get(room)
+    if state is not None and state.open:
+        return OPEN_DOOR_COLOUR
+    if state is not None and state.glass:
+        return GLASS_DOOR_COLOUR
+    return (150, 90, 40)
 
 
 def _draw_people(img: np.ndarray, world: SimWorld, px, px_per_m: float) -> None:
