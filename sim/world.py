@@ -5,8 +5,9 @@ its width with square ends, so dead ends close half a width beyond the end waypo
 and corners are square); walls are thin boxes extruded outwards from every edge of
 that polygon, so junctions stay open. Doors, sign plates and landmarks are snapped to
 the nearest wall. Every body carries a semantic label ("floor", "wall", "ceiling",
-"door:<room>", "sign:<room>", "landmark:<id>", "obstacle", "robot"); segmentation
-images map to label ids through ``SimWorld.labels``.
+"door:<room>", "sign:<room>", "landmark:<id>", "obstacle", "robot", "person"); segmentation
+images map to label ids through ``SimWorld.labels``. What fills the corridors beyond the
+building file (door states, clutter, walking people) is built by ``pmnav_bt.sim.scene``.
 
 pybullet is not thread-safe: every pybullet call goes through ``SimWorld.lock``.
 """

@@ -17,10 +17,13 @@ move first in every tick and the robot then collides with them where they now st
 
 People never walk into the robot: a person whose way ahead holds the robot within
 ``YIELD_AHEAD_M`` stops (and after ``TURN_BACK_S`` turns back), and no step ever brings
-a person closer than ``KEEP_OFF_M`` to it. They are solid for the robot (its collision
-check sees their cylinders) but not part of the building: they are not in
-``obstacle_footprints``. Where the robot drives into a person the crowd counts a
-contact (``Crowd.contacts``, besides the robot's own collision count).
+a person closer than ``KEEP_OFF_M`` to it. They are solid for the robot (the world's
+``clearance`` asks ``Crowd.clearance``: a person is an upright cylinder of
+``PERSON_RADIUS_M``) but not part of the building: they are not in
+``obstacle_footprints``, and SPL's shortest path ignores them. Where the robot drives
+into a person the crowd counts a contact (``Crowd.contacts``, besides the robot's own
+collision count). People walk through each other (they keep right, so those walking
+towards each other pass side by side).
 """
 
 from __future__ import annotations
