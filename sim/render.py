@@ -70,6 +70,7 @@ def render_camera(
     target = (eye[0] + fwd[0], eye[1] + fwd[1], eye[2] + fwd[2])
     flags = 0 if segmentation else p.ER_NO_SEGMENTATION_MASK
     with world.lock:
+        world.people.show()  # the walking people where they are now
         c = world.client
         view = p.computeViewMatrix(eye, target, (0.0, 0.0, 1.0), physicsClientId=c)
         if window is None:
@@ -222,7 +223,7 @@ def draw_top_down(
         cv2.fillPoly(img, [np.array([px(q) for q in corners], np.int32)], colour)
 
     for rid, door in world.doors.items():
-        mark(door, (150, 90, 40), 0.25)
+        mark(door, _door_colour(world, rid), 0.25)
         n = np.asarray(door.normal)
         q = px(np.asarray(door.centre) - n * 0.9)
         text(rid, (q[0] - 4 * len(rid), q[1] + 4), (120, 60, 20))
@@ -237,6 +238,8 @@ def draw_top_down(
         mark(sign, (0, 170, 60), 0.15)
     for sign in world.directional_signs.values():  # wayfinding signs, blue
         mark(sign, (30, 110, 230), 0.15)
+    _draw_clutter(img, world, px)
+    _draw_people(img, world, px, px_per_m)
     for ox, oy, size in world.obstacles.values():
         cv2.rectangle(
             img,
@@ -259,8 +262,79 @@ def draw_top_down(
         cv2.circle(img, c, r, (255, 0, 255), -1)
         tip = (pose.x + 0.5 * math.cos(pose.yaw), pose.y + 0.5 * math.sin(pose.yaw))
         cv2.line(img, c, px(tip), (0, 0, 0), 2, cv2.LINE_AA)
+    _legend(img, world)
     title = f"{b.name} ({b.kind})   1 m = {px_per_m:g} px"
     cv2.putText(
         img, title, (8, 20), cv2.FONT_HERSHEY_SIMPLEX, 0.55, (255, 255, 255), 1, cv2.LINE_AA
     )
     return img
+
+
+# Clutter kinds in the top-down plan (RGB), and how the plan tells them apart.
+CLUTTER_COLOURS = {
+    "bench": (200, 190, 60),
+    "chair": (230, 150, 40),
+    "cart": (70, 130, 200),
+    "bed": (240, 240, 240),
+    "plant": (30, 110, 30),
+    "notice_board": (170, 60, 170),
+}
+
+
+def _draw_clutter(img: np.ndarray, world: SimWorld, px) -> None:
+    """Each clutter item's footprint in its kind's colour, outlined in black (a thin one,
+    a notice board, drawn 0.1 m deep so that it shows)."""
+    for item in world.clutter:
+        fp = item.footprint
+        if item.depth < 0.1:
+            fp = fp.buffer(0.05, join_style="mitre")
+        pts = np.array([px(q) for q in fp.exterior.coords], np.int32)
+        cv2.fillPoly(img, [pts], CLUTTER_COLOURS.get(item.kind, (255, 120, 0)))
+        if item.depth >= 0.1:
+            cv2.polylines(img, [pts], True, (0, 0, 0), 1, cv2.LINE_AA)
+
+
+PERSON_COLOUR = (230, 40, 90)
+OPEN_DOOR_COLOUR = (30, 30, 30)
+GLASS_DOOR_COLOUR = (140, 200, 225)
+
+
+def _door_colour(world: SimWorld, room: str) -> tuple[int, int, int]:
+    """A door in the plan: brown when closed, black when open, pale blue when glazed."""
+    state = world.door_states.get(room)
+    if state is not None and state.open:
+        return OPEN_DOOR_COLOUR
+    if state is not None and state.glass:
+        return GLASS_DOOR_COLOUR
+    return (150, 90, 40)
+
+
+def _draw_people(img: np.ndarray, world: SimWorld, px, px_per_m: float) -> None:
+    """Each walking person where they stand now: a disc of their size, a tick where they face."""
+    from pmnav_bt.sim.scene.people import PERSON_RADIUS_M
+
+    r = max(3, int(round(PERSON_RADIUS_M * px_per_m)))
+    for q in world.people.poses():
+        c = px((q.x, q.y))
+        cv2.circle(img, c, r, PERSON_COLOUR, -1, cv2.LINE_AA)
+        cv2.circle(img, c, r, (255, 255, 255), 1, cv2.LINE_AA)
+        tip = (q.x + 0.5 * math.cos(q.yaw), q.y + 0.5 * math.sin(q.yaw))
+        cv2.line(img, c, px(tip), (0, 0, 0), 2, cv2.LINE_AA)
+
+
+def _legend(img: np.ndarray, world: SimWorld) -> None:
+    """The clutter kinds present, in a row along the bottom edge (in the plan's margin)."""
+    x, y = 8, img.shape[0] - 8
+    for kind in sorted({item.kind for item in world.clutter}):
+        cv2.rectangle(img, (x, y - 11), (x + 12, y), CLUTTER_COLOURS.get(kind, (255, 120, 0)), -1)
+        cv2.rectangle(img, (x, y - 11), (x + 12, y), (0, 0, 0), 1)
+        cv2.putText(
+            img, kind, (x + 18, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA
+        )
+        x += 18 + 10 * len(kind) + 16
+    if world.people.people:
+        cv2.circle(img, (x + 6, y - 5), 6, PERSON_COLOUR, -1, cv2.LINE_AA)
+        cv2.putText(
+            img, "person", (x + 18, y), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1,
+            cv2.LINE_AA,
+        )

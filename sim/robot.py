@@ -166,6 +166,7 @@ class SimBase:
             self.body = p.createMultiBody(0.0, -1, vis, (0, 0, 0.045), physicsClientId=world.client)
             world.register(self.body, ROBOT, solid=False)
         self._sync_body()
+        world.people.attach(self)  # people move first in each tick, then the robot
         self.clock.add_listener(self._advance)
 
     # -- Base seam --------------------------------------------------------------------------
@@ -295,6 +296,7 @@ class SimBase:
         """Detach from the clock (the world is closed by its owner)."""
         if self._advance in self.clock._listeners:
             self.clock.remove_listener(self._advance)
+        self.world.people.detach(self)
 
     # -- motion integration -------------------------------------------------------------------
 

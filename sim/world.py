@@ -5,8 +5,9 @@ its width with square ends, so dead ends close half a width beyond the end waypo
 and corners are square); walls are thin boxes extruded outwards from every edge of
 that polygon, so junctions stay open. Doors, sign plates and landmarks are snapped to
 the nearest wall. Every body carries a semantic label ("floor", "wall", "ceiling",
-"door:<room>", "sign:<room>", "landmark:<id>", "obstacle", "robot"); segmentation
-images map to label ids through ``SimWorld.labels``.
+"door:<room>", "sign:<room>", "landmark:<id>", "obstacle", "robot", "person"); segmentation
+images map to label ids through ``SimWorld.labels``. What fills the corridors beyond the
+building file (door states, clutter, walking people) is built by ``pmnav_bt.sim.scene``.
 
 pybullet is not thread-safe: every pybullet call goes through ``SimWorld.lock``.
 """
@@ -19,6 +20,7 @@ import os
 import tempfile
 import threading
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +44,9 @@ from pmnav_bt.seams import (
 )
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.scene import scene_rng
+from pmnav_bt.sim.scene.clutter import ClutterItem, place_clutter
+from pmnav_bt.sim.scene.doors import DoorLeaf, DoorState, build_leaf, door_states
+from pmnav_bt.sim.scene.people import Crowd, populate
 from pmnav_bt.sim.scene.plates import make_line_plate
 from pmnav_bt.sim.scene.sign_mounting import SIGN_DEPTH, SIGN_GAP, mount_signage
 from pmnav_bt.sim.scene.signage import resolve_signage
@@ -234,18 +239,21 @@ class SimWorld:
         self._body_label: dict[int, int] = {}
         self._lut: np.ndarray | None = None
         self._solid: set[int] = set()
-        self._boxes: dict[int, tuple[Polygon, float]] = {}  # solid box -> footprint, bottom z
+        self._boxes: dict[int, tuple[Polygon, float]] = {}  # solid body -> footprint, bottom z
         self._probe_shapes: dict[tuple[float, float], int] = {}
         self._occupied: dict[int, list[tuple[float, float]]] = {}
         self._where: dict[str, tuple[int, float]] = {}  # label -> (wall, s) of the main item
         self._tmp = tempfile.TemporaryDirectory(prefix="pmnav_sim_")
         self.walls: list[WallSegment] = []
         self.doors: dict[str, WallItem] = {}
+        self.door_states: dict[str, DoorState] = {}
         self.signs: dict[str, WallItem] = {}
         self.landmarks: dict[str, WallItem] = {}
         self.landmark_signs: dict[str, WallItem] = {}
         self.directional_signs: dict[str, WallItem] = {}  # by index in the file, "0", "1" ...
         self.obstacles: dict[int, tuple[float, float, float]] = {}
+        self.clutter: list[ClutterItem] = []
+        self.people = Crowd(self, [], [])
         if gui:
             if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
                 raise SimError(
@@ -320,12 +328,23 @@ class SimWorld:
 
     # -- bodies ---------------------------------------------------------------------------
 
-    def register(self, body: int, label: str, solid: bool = False) -> int:
-        """Give a body created with this world's client a label; ``solid`` ones block the robot."""
+    def register(
+        self,
+        body: int,
+        label: str,
+        solid: bool = False,
+        footprint: Polygon | None = None,
+        bottom: float = 0.0,
+    ) -> int:
+        """Give a body created with this world's client a label; ``solid`` ones block the
+        robot, and a solid one with a floor ``footprint`` (its lowest point ``bottom`` m up)
+        counts in ``obstacle_footprints``."""
         self._body_label[body] = self.label_id(label)
         self._lut = None
         if solid:
             self._solid.add(body)
+            if footprint is not None:
+                self._boxes[body] = (footprint, float(bottom))
         return body
 
     def add_box(
@@ -476,7 +495,7 @@ class SimWorld:
         """
         z = 0.02 + height / 2.0
         r = radius + margin + 0.05
-        best = margin
+        best = min(margin, self.people.clearance(x, y, radius))  # upright cylinders too
         with self.lock:
             shape = self._probe(radius, height)
             found = p.getOverlappingObjects(
@@ -565,6 +584,7 @@ class SimWorld:
             self.label_id(sign_label(room.id))
         for lm in b.landmarks:
             self.label_id(landmark_label(lm.id))
+        self.door_states = door_states([r.id for r in b.rooms], self.scene, self.rng("doors"))
         self._signage = resolve_signage(b, self.scene.signage, self.rng("signage"))
         for room in b.rooms:
             self._build_door(room.id, room.door)
@@ -573,6 +593,8 @@ class SimWorld:
         self._build_signage()
         if self._grid_plan is not None:
             self._build_grid_walls()
+        self.clutter = place_clutter(self)
+        self.people = populate(self)
 
     def _build_grid_walls(self) -> None:
         """Walls from the grid's cells, kept clear in front of every door, sign and landmark.
@@ -725,14 +747,12 @@ class SimWorld:
         total = DOOR_WIDTH + 2 * FRAME_WIDTH
         wi, s = self._snap(f"door of {room_id}", pt, total / 2.0)
         fw, fd = FRAME_WIDTH, FRAME_DEPTH
-        self._wall_box(wi, s, PANEL_DEPTH, DOOR_WIDTH, 0.0, DOOR_HEIGHT, DOOR_RGBA, label)
+        leaf = DoorLeaf(DOOR_WIDTH, DOOR_HEIGHT, PANEL_DEPTH, DOOR_RGBA, HANDLE_RGBA)
+        build_leaf(partial(self._wall_box, wi), s, label, self.door_states[room_id], leaf)
         for side in (-1, 1):
             js = s + side * (DOOR_WIDTH + fw) / 2.0
             self._wall_box(wi, js, fd, fw, 0.0, DOOR_HEIGHT + fw, FRAME_RGBA, label)
         self._wall_box(wi, s, fd, DOOR_WIDTH, DOOR_HEIGHT, DOOR_HEIGHT + fw, FRAME_RGBA, label)
-        # Lever handle near the opening edge (the viewer's right, i.e. towards -s).
-        hs = s - DOOR_WIDTH / 2.0 + 0.12
-        self._wall_box(wi, hs, 0.04, 0.14, 0.98, 1.02, HANDLE_RGBA, label, out=PANEL_DEPTH)
         self.doors[room_id] = self._item(
             room_id, "door", label, wi, s, total, (0.0, DOOR_HEIGHT + fw)
         )

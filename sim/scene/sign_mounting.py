@@ -6,7 +6,9 @@ Mountings (``PlateStyle.mounting``), as buildings hang room signs:
   stretch of wall is free, else on the left (today's plates); ``beside_left`` and
   ``beside_right`` prefer that side. With no room on either side the plate goes above
   the door.
-- ``on_door``: on the door leaf, centred, at ``height`` (kept below the leaf's top).
+- ``on_door``: on the door leaf, centred, at ``height`` (kept below the leaf's top); an
+  open door's leaf stands swung into the room, so its plate hangs beside it (as the twin
+  plate buildings put beside doors that stand open).
 - ``above_door``: on the wall, centred over the door frame.
 - ``flag``: a double-sided plate projecting perpendicular from the wall beside the door,
   its bottom at least ``FLAG_MIN_BOTTOM_M`` above the floor, read end-on from down the
@@ -65,6 +67,7 @@ class SignWorld(Protocol):
     signs: dict
     directional_signs: dict
     _where: dict  # label -> (wall index, position along it)
+    door_states: dict[str, Any]  # room -> sim.scene.doors.DoorState
 
     def label_id(self, label: str) -> int: ...
     def rng(self, part: str) -> np.random.Generator: ...
@@ -108,16 +111,20 @@ def mount_room_sign(world: SignWorld, room_id: str, text: str, style: PlateStyle
         return _flag(world, door, wi, s_door, tex, style, label)
     w, h = tex.width_m + 2 * EDGE_M, tex.height_m + 2 * EDGE_M
     out = 0.0
-    if style.mounting == "on_door":
+    mounting = style.mounting
+    state = world.door_states.get(room_id)
+    if mounting == "on_door" and state is not None and state.open:
+        mounting = "beside"  # the leaf stands swung into the room: its twin plate beside it
+    if mounting == "on_door":
         s = s_door
         z = min(style.height, door.z[1] - DOOR_TOP_MARGIN_M - h / 2.0)
         out = _leaf_out(world, door, wi, s, z)
-    elif style.mounting == "above_door":
+    elif mounting == "above_door":
         s, z = s_door, _above(world, door, h)
     else:
         off = door.width / 2 + SIGN_GAP + w / 2
         right, left = s_door - off, s_door + off
-        order = (left, right) if style.mounting == "beside_left" else (right, left)
+        order = (left, right) if mounting == "beside_left" else (right, left)
         for s in order:  # -s is the viewer's right
             if world._fits(wi, s - w / 2, s + w / 2):
                 world._occupy(wi, s, w / 2)
