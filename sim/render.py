@@ -197,7 +197,7 @@ def draw_top_down(
         for ring in poly.interiors:
             cv2.fillPoly(img, [np.array([px(q) for q in ring.coords], np.int32)], (60, 60, 60))
     thick = max(2, int(round(0.1 * px_per_m)))
-    for wall in world.walls:
+    for wall in world.walls[: world.annotated_walls]:
         cv2.line(img, px(wall.a), px(wall.b), (235, 225, 190), thick)
 
     b = world.building
