@@ -159,12 +159,16 @@ class RealWalls:
         return WallMount((float(at[0]), float(at[1])), (float(nn[0]), float(nn[1])), a, fitted)
 
     def thickness(self, point, normal, most: float) -> float | None:
-        """How far behind the wall surface at ``point`` free space begins again (a room),
-        looking at most ``most`` metres; None when it does not within that."""
+        """How far behind the wall surface at ``point`` map_server's free space begins again
+        (a room, reached or not), looking at most ``most`` metres; None when it does not."""
         p0, n = np.asarray(point, float), np.asarray(normal, float)
         step = self.plan.resolution / 2.0
         t = np.arange(step, most + 1e-9, step)
-        free = self._free_at(p0[None, :] - t[:, None] * n)
+        cell = self.plan.world_to_cell(p0[None, :] - t[:, None] * n)
+        h, w = self.free.shape
+        inside = (cell[:, 0] >= 0) & (cell[:, 1] >= 0) & (cell[:, 0] < w) & (cell[:, 1] < h)
+        free = np.zeros(len(t), bool)
+        free[inside] = self.plan.occupancy()[cell[inside, 1], cell[inside, 0]] == 0
         first = np.nonzero(free)[0]
         return float(t[first[0]]) if len(first) else None
 
