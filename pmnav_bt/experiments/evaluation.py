@@ -96,7 +96,12 @@ def run_episode(
     """
     from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
-    from pmnav_bt.sim.episodes import episode_building_file, goal_geodesic, score_episode
+    from pmnav_bt.sim.episodes import (
+        episode_building_file,
+        goal_door_in_world,
+        goal_geodesic,
+        score_episode,
+    )
     from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.robot import COLLISION_HEIGHT
     from pmnav_bt.sim.world import SimWorld
@@ -113,7 +118,10 @@ def run_episode(
     ) as world:
         # SPL's shortest path: in the building as built (landmarks, not added obstacles).
         footprints = world.obstacle_footprints(COLLISION_HEIGHT)
-        geodesic = goal_geodesic(pm, episode.goal, footprints, floor=world.floor_space())
+        door = goal_door_in_world(world, pm, episode.goal)  # moved onto a grid wall, if so
+        geodesic = goal_geodesic(
+            pm, episode.goal, footprints, floor=world.floor_space(), door=door
+        )
         if setup_world is not None:
             setup_world(world)
         inner, base = simulated_robot(world, sim, episode.start_pose, episode.seed)
@@ -146,6 +154,7 @@ def run_episode(
         collisions=stats.collisions,
         wall_time=wall,
         failure=None if outcome.success else str(outcome.failure),
+        door=door,
     )
     plot_path = None
     if out_dir is not None and plot:

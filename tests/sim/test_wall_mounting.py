@@ -180,3 +180,33 @@ def test_a_tilted_wall_gives_its_own_direction():
     assert math.degrees(math.atan2(m.normal[1], m.normal[0])) == pytest.approx(98.0, abs=1.5)
     assert m.offset == pytest.approx(0.6, abs=0.05)
     assert m.point[0] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_success_is_measured_at_the_door_the_world_has(worlds):
+    from pmnav_bt.map.priori_map import parse_building
+    from pmnav_bt.sim.episodes import Episode, goal_door_in_world, score_episode
+
+    annotated, grid = worlds
+    pm = parse_building(grid.building)
+    assert goal_door_in_world(annotated, pm, "room1") == pytest.approx((5.0, ANNOTATED_HALF))
+    door = goal_door_in_world(grid, pm, "room1")
+    assert door == pytest.approx((5.0, REAL_HALF), abs=0.06)
+    ep = Episode(
+        id="e", building="narrow", tier="easy", start_x=0.0, start_y=0.0, start_yaw=0.0,
+        goal="room1", route_length=5.0, seed=0, goal_visible=True, turns=0, forks=0,
+    )
+
+    class Flat:  # a geodesic 5 m from everywhere: only success matters here
+        def distance(self, xy) -> float:
+            return 5.0
+
+    def scored(stop_y: float, door) -> bool:
+        r = score_episode(
+            pm, ep, (5.0, stop_y), geodesic=Flat(), path_length=5.0, steps=20, collisions=0,
+            wall_time=0.0, door=door,
+        )
+        return r.success
+
+    # 0.1 m from the centre line: within 1 m of the annotated door, not of the real one.
+    assert scored(0.1, None) and not scored(0.1, door)
+    assert scored(0.6, door)
