@@ -9,11 +9,14 @@ from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 import pytest
 import yaml
 from shapely.geometry import Polygon
+from typer.testing import CliRunner
 
+from pmnav_bt.experiments.sim_cli import app
 from pmnav_bt.map.building import building_from_data
 from pmnav_bt.map.checks import mount_warnings
 from pmnav_bt.map.floorplan import (
@@ -26,6 +29,7 @@ from pmnav_bt.map.floorplan import (
     save_ros_map,
 )
 from pmnav_bt.map.wall_surface import RealWalls
+from pmnav_bt.sim.render import GRID_WALL_RGB
 from pmnav_bt.sim.wall_mounting import summary
 from pmnav_bt.sim.world import PANEL_DEPTH, SIGN_CENTRE_Z, SIGN_DEPTH, WALL, SimWorld
 
@@ -210,3 +214,12 @@ def test_success_is_measured_at_the_door_the_world_has(worlds):
     # 0.1 m from the centre line: within 1 m of the annotated door, not of the real one.
     assert scored(0.1, None) and not scored(0.1, door)
     assert scored(0.6, door)
+
+
+def test_sim_show_says_what_moved_and_draws_the_grid_walls(narrow, tmp_path):
+    args = ["show", str(narrow), "--out", str(tmp_path), "--width", "64", "--height", "48"]
+    res = CliRunner().invoke(app, [*args, "--set", "sim.walls=grid"])
+    assert res.exit_code == 0, res.output
+    assert "5 of 7 doors, signs and landmarks moved onto the grid's walls (mean 0.5" in res.output
+    img = cv2.cvtColor(cv2.imread(str(tmp_path / "narrow_top_down.png")), cv2.COLOR_BGR2RGB)
+    assert (img == GRID_WALL_RGB).all(axis=2).any()
