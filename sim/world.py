@@ -4,9 +4,10 @@ The free space is the union of the corridor rectangles (each corridor buffered b
 its width with square ends, so dead ends close half a width beyond the end waypoint
 and corners are square); walls are thin boxes extruded outwards from every edge of
 that polygon, so junctions stay open. Doors, sign plates and landmarks are snapped to
-the nearest wall. Every body carries a semantic label ("floor", "wall", "ceiling",
-"door:<room>", "sign:<room>", "landmark:<id>", "obstacle", "robot"); segmentation
-images map to label ids through ``SimWorld.labels``.
+the nearest wall (with walls from a ros_map grid, then moved onto the grid's real
+wall). Every body carries a semantic label ("floor", "wall", "ceiling", "door:<room>",
+"sign:<room>", "landmark:<id>", "obstacle", "robot"); segmentation images map to label
+ids through ``SimWorld.labels``.
 
 pybullet is not thread-safe: every pybullet call goes through ``SimWorld.lock``.
 """
@@ -653,7 +654,8 @@ class SimWorld:
         self._occupied.setdefault(wall, []).append((s - half, s + half))
 
     def _snap(self, what: str, pt: tuple[float, float], half: float) -> tuple[int, float]:
-        """Wall and position along it for an item ``2*half`` wide nearest to ``pt``."""
+        """Wall and position along it for an item ``2*half`` wide nearest to ``pt`` (with
+        grid walls, the real wall behind that place: ``_mount``)."""
         wi, s = self._nearest_wall(pt)
         w = self.walls[wi]
         if w.length < 2.0 * half:
