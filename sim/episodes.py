@@ -78,6 +78,7 @@ __all__ = [
     "episodes_json",
     "generate_episodes",
     "goal_door",
+    "goal_door_in_world",
     "goal_geodesic",
     "goal_stop_point",
     "load_episodes",
@@ -404,6 +405,19 @@ def goal_door(pm: PrioriMap, room: str) -> tuple[float, float]:
     return float(r.door[0]), float(r.door[1])
 
 
+def goal_door_in_world(world, pm: PrioriMap, room: str) -> tuple[float, float]:
+    """The door point of a room where ``world`` (a SimWorld) has the door: the file's door
+    point, moved as far as the simulator moved the door onto the grid's real wall
+    (``SimWorld.moved_items``; none with the annotated walls). Success is measured here:
+    a person judging the run stands at the door the building has, not at the annotation."""
+    door = goal_door(pm, room)
+    rid = resolve_room(pm, room)
+    for m in world.moved_items:
+        if m.kind == "door" and m.id == rid:
+            return door[0] + m.shift[0], door[1] + m.shift[1]
+    return door
+
+
 def goal_stop_point(pm: PrioriMap, room: str) -> tuple[float, float]:
     """``STOP_OFFSET_M`` from the room's door point towards the corridor centre line."""
     door = goal_door(pm, room)
@@ -503,14 +517,16 @@ def goal_geodesic(
     robot_radius: float = CREATE3_RADIUS_M,
     radius: float = SUCCESS_RADIUS_M,
     floor=None,
+    door: tuple[float, float] | None = None,
 ) -> GeodesicField:
     """SPL's shortest paths to room ``room``: the geodesic through the open floor (the
     corridors unless ``floor`` says otherwise, e.g. ``SimWorld.floor_space()`` with grid
     walls), less the robot's radius and the footprints of ``obstacles``, to the success
-    disc of the door."""
+    disc of the door (the file's door point unless ``door`` says where the world has it,
+    :func:`goal_door_in_world`)."""
     return GeodesicField(
         free_space_polygon(pm.building) if floor is None else floor,
-        goal_door(pm, room),
+        goal_door(pm, room) if door is None else door,
         radius,
         robot_radius=robot_radius,
         obstacles=obstacles,
@@ -671,11 +687,13 @@ def score_episode(
     wall_time: float,
     failure: str | None = None,
     trace: list | None = None,
+    door: tuple[float, float] | None = None,
 ) -> EpisodeResult:
     """Score a run that stopped at ``stop_xy``: success within the radius of the goal door
-    (and no ``failure`` reported); SPL and soft SPL against the free-space ``geodesic``
-    (:func:`goal_geodesic`) from the start to the success disc."""
-    door = goal_door(pm, episode.goal)
+    (the file's door point unless ``door`` says where the world has it,
+    :func:`goal_door_in_world`; and no ``failure`` reported); SPL and soft SPL against the
+    free-space ``geodesic`` (:func:`goal_geodesic`) from the start to the success disc."""
+    door = goal_door(pm, episode.goal) if door is None else door
     stop = (float(stop_xy[0]), float(stop_xy[1]))
     dist = math.dist(stop, door)
     ok = failure is None and success(stop, door)

@@ -17,21 +17,9 @@ import numpy as np
 
 from pmnav_bt.geometry import Rect
 from pmnav_bt.map.floorplan import FREE, FloorPlanError, FloorPlanImage, fill_world_polygons
-from pmnav_bt.map.grid import free_mask
+from pmnav_bt.map.wall_surface import grid_free_space
 
 BAND_CELLS = 2  # wall thickness: non-free cells within this many cells of free space
-SMOOTH_M = 0.15  # free-space specks and slivers thinner than this are dropped
-
-
-def sim_free(plan: FloorPlanImage) -> np.ndarray:
-    """The free space the simulator keeps: the largest part, specks and slivers smoothed."""
-    free = free_mask(plan, clean_m=SMOOTH_M, clutter_m=0.0)
-    k = max(1, round(SMOOTH_M / plan.resolution))
-    free = cv2.morphologyEx(free.astype(np.uint8), cv2.MORPH_OPEN, np.ones((k, k), np.uint8)) > 0
-    # Nothing is known beyond the image: its border cells are wall.
-    b = BAND_CELLS
-    free[:b], free[-b:], free[:, :b], free[:, -b:] = False, False, False, False
-    return free
 
 
 def wall_cells(free: np.ndarray, band: int = BAND_CELLS) -> np.ndarray:
@@ -90,7 +78,7 @@ def grid_wall_boxes(plan: FloorPlanImage, band: int = BAND_CELLS, clear=()) -> l
     ox, oy = plan.origin[0], plan.origin[1]
     h = plan.height
     out = []
-    free = sim_free(plan)
+    free = grid_free_space(plan)
     for r0, c0, r1, c1 in merge_cells(wall_cells(free, band), ~free):
         # Image row r covers map y from oy + (h - 1 - r) * res to oy + (h - r) * res.
         out.append(Rect(ox + c0 * res, oy + (h - r1) * res, ox + c1 * res, oy + (h - r0) * res))

@@ -34,6 +34,7 @@ from pmnav_bt.sim.episodes import (
     Episode,
     EpisodeGenerationError,
     generate_episodes,
+    goal_door_in_world,
     goal_geodesic,
     score_episode,
 )
@@ -172,6 +173,7 @@ def run_oracle(
         wall_time=time.perf_counter() - t0,
         failure=reason,
         trace=runner.trace,
+        door=goal_door_in_world(base.world, pm, episode.goal),
     )
 
 
@@ -181,7 +183,8 @@ def goal_fields(world: SimWorld, pm: PrioriMap, goal: str) -> tuple[GeodesicFiel
     ``CLEARANCE_M`` inside the success disc)."""
     footprints = world.obstacle_footprints(COLLISION_HEIGHT)
     floor = world.floor_space()
-    score = goal_geodesic(pm, goal, footprints, floor=floor)
+    door = goal_door_in_world(world, pm, goal)
+    score = goal_geodesic(pm, goal, footprints, floor=floor, door=door)
     drive = goal_geodesic(
         pm,
         goal,
@@ -189,6 +192,7 @@ def goal_fields(world: SimWorld, pm: PrioriMap, goal: str) -> tuple[GeodesicFiel
         floor=floor,
         robot_radius=CREATE3_RADIUS_M + CLEARANCE_M,
         radius=SUCCESS_RADIUS_M - CLEARANCE_M,
+        door=door,
     )
     return score, drive
 

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
+import shapely
 
 from pmnav_bt.seams import CAMERA_HEIGHT_M, CREATE3_RADIUS_M, CameraIntrinsics, Pose2D
 from pmnav_bt.sim._pybullet import p
@@ -21,6 +22,7 @@ FAR = 100.0
 # The tiny renderer never returns when the eye lies (to float32 precision) in the plane of a
 # face, which round teleport poses easily hit (a camera at x = -1.3 beside a wall face at
 # x = -1.3). The eye is therefore moved by this sub-millimetre offset, off all round numbers.
+GRID_WALL_RGB = (130, 120, 100)  # top-down: the grid's walls (walls="grid")
 EYE_JITTER = (1.37e-4, 1.71e-4, 1.13e-4)
 
 
@@ -198,8 +200,14 @@ def draw_top_down(
         for ring in poly.interiors:
             cv2.fillPoly(img, [np.array([px(q) for q in ring.coords], np.int32)], (60, 60, 60))
     thick = max(2, int(round(0.1 * px_per_m)))
-    for wall in world.walls:
+    for wall in world.walls[: world.annotated_walls]:
         cv2.line(img, px(wall.a), px(wall.b), (235, 225, 190), thick)
+    if world.wall_source == "grid":  # the grid's walls, which the items hang on
+        grid_walls = shapely.box(*world.bounds()).difference(world.floor_space())
+        for g in getattr(grid_walls, "geoms", [grid_walls]):
+            rings = (g.exterior, *g.interiors)
+            pts = [np.array([px(q) for q in r.coords], np.int32) for r in rings]
+            cv2.fillPoly(img, pts, GRID_WALL_RGB)
 
     b = world.building
     pos = {wp.id: wp.pos for wp in b.waypoints}

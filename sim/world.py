@@ -4,10 +4,12 @@ The free space is the union of the corridor rectangles (each corridor buffered b
 its width with square ends, so dead ends close half a width beyond the end waypoint
 and corners are square); walls are thin boxes extruded outwards from every edge of
 that polygon, so junctions stay open. Doors, sign plates and landmarks are snapped to
-the nearest wall. Every body carries a semantic label ("floor", "wall", "ceiling",
-"door:<room>", "sign:<room>", "landmark:<id>", "obstacle", "robot", "person"); segmentation
-images map to label ids through ``SimWorld.labels``. What fills the corridors beyond the
-building file (door states, clutter, walking people) is built by ``pmnav_bt.sim.scene``.
+the nearest wall (with walls from a ros_map grid, then moved onto the grid's real
+wall). Every body carries a semantic label ("floor", "wall", "ceiling", "door:<room>",
+"sign:<room>", "landmark:<id>", "obstacle", "robot", "person"); segmentation images map
+to label ids through ``SimWorld.labels``. What fills the corridors beyond the building
+file (signage styles, door states, clutter, walking people) is built by
+``pmnav_bt.sim.scene``.
 
 pybullet is not thread-safe: every pybullet call goes through ``SimWorld.lock``.
 """
@@ -51,6 +53,7 @@ from pmnav_bt.sim.scene.plates import make_line_plate
 from pmnav_bt.sim.scene.sign_mounting import SIGN_DEPTH, SIGN_GAP, mount_signage
 from pmnav_bt.sim.scene.signage import resolve_signage
 from pmnav_bt.sim.textures import SignTexture, make_sign, write_png
+from pmnav_bt.sim.wall_mounting import GridMounts, MovedItem, grid_clearings, moved_items, summary
 
 log = logging.getLogger(__name__)
 
@@ -69,7 +72,6 @@ OBSTACLE = OBSTACLE_LABEL
 ROBOT = "robot"
 FIXED_LABELS = (BACKGROUND, FLOOR, WALL, CEILING, OBSTACLE, ROBOT)  # ids 0..5
 WALL_SOURCES = ("corridors", "grid")  # what the simulator builds its walls from
-ITEM_CLEAR_BEHIND, ITEM_CLEAR_FRONT = 0.05, 0.3  # m of grid wall cleared around wall items
 
 # door_label / sign_label / landmark_label: spelled once, in pmnav_bt.seams.
 
@@ -203,7 +205,8 @@ class SimWorld:
     p.GUI; needs a display), ``ceiling`` (add a ceiling at the wall height), ``walls``:
     ``corridors`` builds the walls from the annotated corridor rectangles, ``grid``
     from the occupied cells of the building's ros_map floor plan (rooms and open areas
-    included; doors and signs still stand on the annotated corridor walls);
+    included; doors, signs and landmarks are hung on the grid's real walls, and
+    ``moved_items`` says how far each moved, ``sim.wall_mounting``);
     ``base_dir`` is the folder the floor plan path is relative to (default: the
     building file's folder). ``scene`` (the config's ``world`` section; default: the clean
     preset) says what fills the building beyond its file, drawn from the episode's
@@ -231,6 +234,8 @@ class SimWorld:
         self.scene = scene if scene is not None else WorldConfig()
         self.seed = int(seed)
         self._grid_plan = self._load_grid_plan(base_dir) if walls == "grid" else None
+        self._mounts = GridMounts(self._grid_plan) if self._grid_plan is not None else None
+        self.moved_items: list[MovedItem] = []  # grid walls: what was hung on the real wall
         self.lock = threading.RLock()
         self.labels: dict[int, str] = {}
         self._label_ids: dict[str, int] = {}
@@ -245,6 +250,8 @@ class SimWorld:
         self._where: dict[str, tuple[int, float]] = {}  # label -> (wall, s) of the main item
         self._tmp = tempfile.TemporaryDirectory(prefix="pmnav_sim_")
         self.walls: list[WallSegment] = []
+        self.annotated_walls = 0  # walls[:annotated_walls] bound the free space; the rest
+        # are the grid's real walls that items hang on (walls="grid", ``_mount``)
         self.doors: dict[str, WallItem] = {}
         self.door_states: dict[str, DoorState] = {}
         self.signs: dict[str, WallItem] = {}
@@ -597,28 +604,14 @@ class SimWorld:
         self.people = populate(self)
 
     def _build_grid_walls(self) -> None:
-        """Walls from the grid's cells, kept clear in front of every door, sign and landmark.
-
-        Items stand on the annotated walls; where the grid's wall bulges a few
-        centimetres past them it would hide them, so the cells just in front of each
-        item are taken as free.
-        """
+        """Walls from the grid's cells, with each door's opening cut and the cells just in
+        front of every item kept free (items hang on the real walls: ``_mount``)."""
         from pmnav_bt.sim.grid_walls import grid_wall_boxes
 
         h = self.building.wall_height
-        clear = []
-        for it in (
-            *self.doors.values(),
-            *self.signs.values(),
-            *self.landmarks.values(),
-            *self.landmark_signs.values(),
-            *self.directional_signs.values(),
-        ):
-            c, n = np.asarray(it.centre), np.asarray(it.normal)
-            t = np.array([n[1], -n[0]]) * (it.width / 2.0 + 0.05)
-            back, front = c - n * ITEM_CLEAR_BEHIND, c + n * ITEM_CLEAR_FRONT
-            clear.append(np.array([back - t, back + t, front + t, front - t]))
-        for bx in grid_wall_boxes(self._grid_plan, clear=clear):
+        self.moved_items = moved_items(self)
+        log.info("%s: %s", self.building.name, summary(self.moved_items))
+        for bx in grid_wall_boxes(self._grid_plan, clear=grid_clearings(self)):
             (cx, cy), (hx, hy) = bx.centre, bx.half
             self.add_box((cx, cy, h / 2.0), (hx, hy, h / 2.0), 0.0, WALL_RGBA, WALL)
 
@@ -660,6 +653,7 @@ class SimWorld:
                     solid=False,
                     collision=False,
                 )
+        self.annotated_walls = len(self.walls)
 
     # -- placing things on walls ---------------------------------------------------------
 
@@ -667,7 +661,7 @@ class SimWorld:
         """Index of the wall segment nearest to ``pt`` and the distance along it."""
         q = np.asarray(pt, float)
         best, best_d, best_s = -1, math.inf, 0.0
-        for i, w in enumerate(self.walls):
+        for i, w in enumerate(self.walls[: self.annotated_walls]):
             a = np.asarray(w.a)
             s = float(np.clip(np.dot(q - a, w.tangent), 0.0, w.length))
             d = float(np.linalg.norm(q - w.point(s)))
@@ -685,7 +679,8 @@ class SimWorld:
         self._occupied.setdefault(wall, []).append((s - half, s + half))
 
     def _snap(self, what: str, pt: tuple[float, float], half: float) -> tuple[int, float]:
-        """Wall and position along it for an item ``2*half`` wide nearest to ``pt``."""
+        """Wall and position along it for an item ``2*half`` wide nearest to ``pt`` (with
+        grid walls, the real wall behind that place: ``_mount``)."""
         wi, s = self._nearest_wall(pt)
         w = self.walls[wi]
         if w.length < 2.0 * half:
@@ -696,7 +691,21 @@ class SimWorld:
         if not self._fits(wi, s - half, s + half):
             log.warning("%s at %s overlaps another item on the same wall", what, pt)
         self._occupy(wi, s, half)
-        return wi, s
+        return self._mount(wi, s, half), s
+
+    def _mount(self, wi: int, s: float, half: float) -> int:
+        """Where the item at ``s`` on annotated wall ``wi`` hangs: with grid walls, on a wall
+        segment of its own through the grid's real wall there (``GridMounts``), measured in
+        the same ``s`` and sharing the annotated wall's occupied stretches; else on ``wi``."""
+        if self._mounts is None:
+            return wi
+        w = self.walls[wi]
+        a, b, normal, found = self._mounts.real_wall(w.a, w.b, w.normal, s, half)
+        self.walls.append(WallSegment(a, b, normal))
+        mounted = len(self.walls) - 1
+        self._occupied[mounted] = self._occupied.setdefault(wi, [])
+        self._mounts.record(mounted, wi, found)
+        return mounted
 
     def _wall_box(
         self,

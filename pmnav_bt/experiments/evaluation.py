@@ -96,7 +96,12 @@ def run_episode(
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     ``also_log``: a second sink for the tree log's lines (the live web view, ``--view``).
     """
-    from pmnav_bt.sim.episodes import episode_map, goal_geodesic, score_episode
+    from pmnav_bt.sim.episodes import (
+        episode_map,
+        goal_door_in_world,
+        goal_geodesic,
+        score_episode,
+    )
     from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.robot import COLLISION_HEIGHT
     from pmnav_bt.sim.scene.blocking import block_segment
@@ -116,7 +121,10 @@ def run_episode(
             block_segment(world, pm, ref)
         # SPL's shortest path: in the building as built (landmarks, not added obstacles).
         footprints = world.obstacle_footprints(COLLISION_HEIGHT)
-        geodesic = goal_geodesic(pm, episode.goal, footprints, floor=world.floor_space())
+        door = goal_door_in_world(world, pm, episode.goal)  # moved onto a grid wall, if so
+        geodesic = goal_geodesic(
+            pm, episode.goal, footprints, floor=world.floor_space(), door=door
+        )
         if setup_world is not None:
             setup_world(world)
         inner, base = simulated_robot(world, sim, episode.start_pose, episode.seed)
@@ -155,6 +163,7 @@ def run_episode(
         collisions=stats.collisions,
         wall_time=wall,
         failure=None if outcome.success else str(outcome.failure),
+        door=door,
     )
     plot_path = None
     if out_dir is not None and plot:

@@ -98,6 +98,10 @@ def show(
             f"pose x={q.x:.2f} y={q.y:.2f} yaw={math.degrees(q.yaw):.0f} deg; sees: "
             + ", ".join(seen)
         )
+        if world.wall_source == "grid":
+            from pmnav_bt.sim.wall_mounting import summary
+
+            typer.echo(summary(world.moved_items))
         if gui:
             typer.echo("GUI open; close its window (or Ctrl-C) to quit")
             _hold_gui(world)

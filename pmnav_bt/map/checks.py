@@ -7,6 +7,9 @@ A building that loads is well formed; these checks look for what makes runs fail
 - very short corridor edges, and turns back to back (no corridor to take);
 - a centre line through walls or obstacles of the floor-plan grid, or a width the grid
   disagrees with;
+- a door or landmark whose annotated wall is more than ``MOUNT_TOL_M`` from the grid's
+  wall, or with no grid wall within reach (with ``sim.walls=grid`` the simulator hangs it
+  on the grid's wall, or leaves it standing free);
 - corridor stretches with fewer than two readable signs within reading range
   (localization has nothing to match there);
 - no start waypoint.
@@ -22,8 +25,10 @@ import numpy as np
 from pmnav_bt.errors import Problem
 from pmnav_bt.geometry import project_points_to_segments
 from pmnav_bt.map.building import Building, WaypointKind
-from pmnav_bt.map.floorplan import FloorPlanImage, door_frames, load_floor_plan
+from pmnav_bt.map.floorplan import DOOR_WIDTH_M, FloorPlanImage, door_frames, load_floor_plan
+from pmnav_bt.map.free_space import free_space_polygon
 from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask
+from pmnav_bt.map.wall_surface import SEARCH_M, RealWalls, nearest_boundary_point
 
 DOOR_OFF_WALL_M = 0.3  # a door farther than this from its annotated wall
 SHORT_EDGE_M = 1.0  # an edge shorter than this (or than its width) is very short
@@ -34,6 +39,8 @@ SIGN_RANGE_M = 9.0  # the grounder reads signs up to this far (GrounderConfig.ma
 MIN_SIGNS = 2  # localization needs this many readable signs in range
 MIN_STRETCH_M = 2.0  # shorter sparse stretches are not reported
 SAMPLE_M = 0.5  # spacing of the sample points along corridors
+MOUNT_TOL_M = 0.3  # an item's annotated wall may be this far from the grid's wall
+LANDMARK_HALF_M = 0.3  # half the width of a landmark's wall stretch the check looks at
 
 
 def building_warnings(
@@ -47,7 +54,7 @@ def building_warnings(
         except Exception:  # noqa: BLE001 - a floor plan that does not load is reported on load
             plan = None
     if plan is not None:
-        out += grid_warnings(b, plan)
+        out += grid_warnings(b, plan) + mount_warnings(b, plan)
     return out
 
 
@@ -224,6 +231,51 @@ def grid_warnings(b: Building, plan: FloorPlanImage) -> list[Problem]:
                     f"{e.a}-{e.b} is annotated {width:.2f} m wide but the grid shows about "
                     f"{measured:.2f} m (measured from the centre line): set width: "
                     f"{measured:.2f} or move the centre line",
+                )
+            )
+    return out
+
+
+def mount_warnings(b: Building, plan: FloorPlanImage, tol: float = MOUNT_TOL_M) -> list[Problem]:
+    """Doors and landmarks whose annotated wall (the corridor rectangles' side nearest
+    them) is more than ``tol`` from the grid's wall, or has no grid wall within
+    ``SEARCH_M`` (``pmnav_bt.map.wall_surface``, the search the simulator mounts them by)."""
+    if not (b.rooms or b.landmarks):
+        return []
+    poly = free_space_polygon(b)
+    polys = getattr(poly, "geoms", [poly])
+    rings = [list(g.exterior.coords)[:-1] for g in polys]
+    rings += [list(r.coords)[:-1] for g in polys for r in g.interiors]
+    walls = RealWalls(plan)
+    items = [
+        (f"rooms[{i}].door", f"the door of {r.id!r} (and its sign)", r.door, DOOR_WIDTH_M / 2.0)
+        for i, r in enumerate(b.rooms)
+    ] + [
+        (f"landmarks[{i}].pos", f"landmark {lm.id!r}", lm.pos, LANDMARK_HALF_M)
+        for i, lm in enumerate(b.landmarks)
+    ]
+    out = []
+    for field, what, pos, half in items:
+        at, normal = nearest_boundary_point(rings, pos)
+        m = walls.mount(at, normal, half)
+        if m is None:
+            out.append(
+                Problem(
+                    field,
+                    f"{what} at ({at[0]:.2f}, {at[1]:.2f}) on its annotated wall: no stretch of "
+                    f"the grid's wall within {SEARCH_M:g} m along the wall's normal; with walls "
+                    "from the grid it stands free there; check the item and the corridor's width",
+                )
+            )
+        elif m.distance > tol:
+            where = "in front of" if m.offset > 0 else "behind"
+            out.append(
+                Problem(
+                    field,
+                    f"{what}: its annotated wall at ({at[0]:.2f}, {at[1]:.2f}) stands "
+                    f"{m.distance:.2f} m {where} the grid's wall; with walls from the grid it "
+                    "is hung on the grid's wall, with the annotated walls it floats; fix the "
+                    "corridor's width or centre line",
                 )
             )
     return out

@@ -92,14 +92,15 @@ def test_draft_of_the_real_hospital_map_is_valid(hospital_grid, tmp_path):
     assert got.floor_plan.ros_map.endswith("hospital.yaml")
 
 
-def test_example_hospital_building_warns_only_about_its_pillar():
+def test_example_hospital_building_warns_only_about_its_pillar_and_the_lobby_door():
     from pathlib import Path
 
     from pmnav_bt.map.checks import building_warnings
 
     f = Path(__file__).resolve().parents[2] / "examples" / "hospital" / "building.yaml"
     w = building_warnings(load_building(f), f.parent)
-    assert len(w) == 1 and "branch4-branch5 runs into an obstacle" in w[0].message
+    assert len(w) == 2 and "branch4-branch5 runs into an obstacle" in w[0].message
+    assert w[1].field == "rooms[0].door" and "no stretch of the grid's wall" in w[1].message
 
 
 def test_pmnav_map_draft_command(tmp_path, capsys):
