@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import random
+from collections import Counter
 from dataclasses import dataclass
 
 import networkx as nx
@@ -41,6 +42,7 @@ BUILDING_KINDS = tuple(PROGRAMMES)  # hospital, school, office
 MOUTH_CLEARANCE_M = 1.6
 END_CLEARANCE_M = 1.4
 MIN_ROOM_M = 2.4  # no room narrower along the wall: a door and its sign plate
+PLATE_ROOM_M = 1.0  # a sign plate and its gap, kept free beside a landmark
 DESK_SLOT_M = 2.4  # the reception desk (1.9 m) and its margins
 STAIRS_SLOT_M = 2.4  # the stairs (1.8 m) and their margins
 SIGN_SLOT_M = 1.2  # a department sign plate
@@ -50,18 +52,22 @@ SIGN_SLOT_M = 1.2  # a department sign plate
 @dataclass(frozen=True)
 class _Shape:
     """A type's layouts: the chance of a ring (else a main corridor with wings), a ring's
-    core depth (m) and most wings, and a main corridor's length (m)."""
+    length and core depth (m) and its fewest and most wings, a main corridor's length (m)."""
 
     p_ring: float
+    ring_m: tuple[float, float]
     core_m: tuple[float, float]
-    ring_wings: int
+    ring_wings: tuple[int, int]
     main_m: tuple[float, float]
 
 
 _SHAPES = {
-    "hospital": _Shape(0.4, (10.0, 16.0), 3, (40.0, 80.0)),  # racetrack round support rooms
-    "school": _Shape(0.4, (14.0, 24.0), 3, (50.0, 90.0)),  # courtyard; long finger plans
-    "office": _Shape(0.55, (8.0, 12.0), 1, (36.0, 64.0)),  # the floor round its core
+    # a racetrack round its support rooms, or a hospital street with ward wings
+    "hospital": _Shape(0.4, (30.0, 60.0), (10.0, 16.0), (0, 3), (40.0, 80.0)),
+    # a courtyard with teaching wings off it, or a long finger plan
+    "school": _Shape(0.4, (36.0, 64.0), (14.0, 24.0), (1, 3), (50.0, 90.0)),
+    # the floor round its lift-and-stair core, or a double-loaded corridor (L, U, T)
+    "office": _Shape(0.55, (28.0, 48.0), (8.0, 12.0), (0, 1), (36.0, 64.0)),
 }
 COURTYARD_P = 0.6  # a school ring's inner walls face a courtyard: no doors there
 LAYOUT_TRIES = 12  # layouts drawn until one has a corridor bend (medium episodes need one)
@@ -95,7 +101,6 @@ class _DeptState:
         self.title = title
         self.once = list(dept.once)
         rng.shuffle(self.once)
-        self.counts: dict[str, int] = {}
 
     def draw(self, rng: random.Random, prog: Programme) -> Function:
         if self.once and rng.random() < self.dept.p_once:
@@ -103,10 +108,6 @@ class _DeptState:
         if rng.random() < prog.p_service:
             return rng.choice(prog.service)
         return rng.choice(self.dept.generic)
-
-    def count(self, template: str) -> int:
-        self.counts[template] = self.counts.get(template, 0) + 1
-        return self.counts[template]
 
 
 def generate_functional(kind: str, seed: int, name: str | None = None) -> Building:
@@ -177,7 +178,13 @@ def _layout(rng, kind: str, prog: Programme, main_w, wing_w, lobby_w) -> Layout:
     for _ in range(LAYOUT_TRIES):
         if rng.random() < shape.p_ring:
             layout = ring_layout(
-                rng, main_w, wing_w, lobby_w, prog.room_depth, shape.core_m, shape.ring_wings
+                rng,
+                main_w,
+                wing_w,
+                lobby_w,
+                prog.room_depth,
+                (shape.ring_m, shape.core_m),
+                shape.ring_wings,
             )
         else:
             layout = spine_layout(rng, main_w, wing_w, lobby_w, prog.room_depth, shape.main_m)
@@ -228,11 +235,13 @@ def _wall(layout: Layout, g: nx.Graph, c: int, ends, side: int) -> _Wall:
 
 
 def _reserve(wall: _Wall, s: float, width: float) -> bool:
-    """Take ``width`` centred at ``s`` out of the wall's free intervals, if it fits there."""
+    """Take ``width`` centred at ``s`` out of the wall's free intervals, if it fits there,
+    with a sign plate's room either side (a neighbouring door's sign may hang there)."""
     a, b = s - width / 2.0, s + width / 2.0
     for k, (lo, hi) in enumerate(wall.free):
         if lo - 0.01 <= a and b <= hi + 0.01:
-            wall.free[k : k + 1] = [iv for iv in ((lo, a), (b, hi)) if iv[1] - iv[0] > 0.05]
+            left, right = (lo, a - PLATE_ROOM_M), (b + PLATE_ROOM_M, hi)
+            wall.free[k : k + 1] = [iv for iv in (left, right) if iv[1] - iv[0] >= MIN_ROOM_M]
             return True
     return False
 
@@ -363,6 +372,7 @@ def _room_data(rooms: list[_Room], layout: Layout, scheme: str, floor: int) -> l
     names: set[str] = set()
     aliases_used: set[str] = set()
     cities = iter(CITIES)
+    counts: Counter[tuple[str, str]] = Counter()  # {n}: per department where named after it
     ordered = sorted(rooms, key=lambda r: (layout.corridors[r.corridor].wing, r.n))
     for k, r in enumerate(ordered, start=1):
         code = room_code(scheme, floor, r.n, wing_letter(layout.corridors[r.corridor].wing))
@@ -370,7 +380,7 @@ def _room_data(rooms: list[_Room], layout: Layout, scheme: str, floor: int) -> l
         fields = {
             "code": code,
             "dept": r.state.title,
-            "n": r.state.count(f.name) if "{n}" in f.name else 0,
+            "n": _count(counts, (f.name, r.state.title if "{dept}" in f.name else "")),
             "city": next(cities, code) if "{city}" in f.name else "",
         }
         name = f.name.format(**fields)
@@ -392,6 +402,11 @@ def _room_data(rooms: list[_Room], layout: Layout, scheme: str, floor: int) -> l
         room["sign"] = f"{code} {words}" if words else code
         out.append(room)
     return out
+
+
+def _count(counts: Counter, key: tuple[str, str]) -> int:
+    counts[key] += 1
+    return counts[key]
 
 
 def _waypoints(layout: Layout, g: nx.Graph) -> tuple[list[dict], dict[int, str]]:

@@ -194,13 +194,14 @@ def ring_layout(
     wing_w: float,
     lobby_w: float,
     depth: float,
-    core_m: tuple[float, float],
-    max_wings: int,
+    size_m: tuple[tuple[float, float], tuple[float, float]],
+    wings_n: tuple[int, int],
 ) -> Layout:
-    """A rectangular ring whose inside (``core_m`` deep between the walls) is the core,
-    with the lobby off the south side and up to ``max_wings`` wings off the others."""
-    w = round(rng.uniform(28.0, 56.0), 1)
-    h = round(rng.uniform(*core_m) + main_w, 1)
+    """A rectangular ring whose inside is the core: its length and its core's depth
+    between the walls drawn from the ranges ``size_m``; the lobby off the south side and
+    ``wings_n`` (fewest, most) wings off the others."""
+    w = round(rng.uniform(*size_m[0]), 1)
+    h = round(rng.uniform(*size_m[1]) + main_w, 1)
     lx = round(rng.uniform(0.3, 0.7) * w, 1)
     lobby_len = round(rng.uniform(*LOBBY_LENGTH_M), 1)
 
@@ -214,7 +215,7 @@ def ring_layout(
     ring = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h), (0.0, 0.0)]
     segs = _lines(ring, main_w) + _lines([(lx, -lobby_len), (lx, 0.0)], lobby_w)
     corners = [(x, y, wing_w / 2.0 + main_w + 1.0) for x, y in ring[:4]]
-    n = rng.randint(0, max_wings)
+    n = rng.randint(*wings_n)
     wings, hooks = _draw_wings(rng, segs, roots, n, wing_w, depth, corners)
     layout = Layout("ring", lobby_w, wings=len(wings), hooks=hooks, centre=(w / 2.0, h / 2.0))
     on: dict[str, set[float]] = {"s": {0.0, w, lx}, "e": {0.0, h}, "n": {0.0, w}, "w": {0.0, h}}
