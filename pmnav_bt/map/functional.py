@@ -70,6 +70,8 @@ _SHAPES = {
     "office": _Shape(0.55, (28.0, 48.0), (8.0, 12.0), (0, 1), (36.0, 64.0)),
 }
 COURTYARD_P = 0.6  # a school ring's inner walls face a courtyard: no doors there
+SPLIT_P = 0.12  # a small repeated room divided in two (117A, 117B), as rooms get divided
+SPLIT_MAX_M = 4.2  # ... if it is no wider than this (offices, consulting rooms, stores)
 LAYOUT_TRIES = 12  # layouts drawn until one has a corridor bend (medium episodes need one)
 
 
@@ -91,6 +93,8 @@ class _Room:
     function: Function
     state: _DeptState
     n: int = 0  # sequence number of the numbering scheme
+    half: str = ""  # "A" or "B": one half of a divided room (117A, 117B)
+    twin: _Room | None = None  # a B half's A half, whose number it shares
 
 
 class _DeptState:
@@ -140,9 +144,10 @@ def generate_functional(kind: str, seed: int, name: str | None = None) -> Buildi
     floor = rng.randint(1, 5)
     states = _departments(rng, prog, layout, floor)
     landmarks = _landmarks(rng, prog, layout, ends, walls, states)
-    rooms = _fill(rng, prog, layout, ends, walls, order, states)
     scheme = rng.choice(list(SCHEMES))
     odd_even = rng.random() < 0.5
+    split_p = 0.0 if scheme in PER_WING else SPLIT_P  # "3BA" is no code anyone uses
+    rooms = _fill(rng, prog, layout, ends, walls, order, states, split_p)
     _number(rooms, order, layout, scheme, odd_even)
     room_data = _room_data(rooms, layout, scheme, floor)
     waypoints, wp_ids = _waypoints(layout, g)
@@ -317,8 +322,11 @@ def _departments(rng, prog: Programme, layout: Layout, floor: int) -> dict[int, 
     return states
 
 
-def _fill(rng, prog: Programme, layout: Layout, ends, walls, order, states) -> list[_Room]:
-    """Rooms along every free stretch of wall, from the core outward."""
+def _fill(
+    rng, prog: Programme, layout: Layout, ends, walls, order, states, split_p: float
+) -> list[_Room]:
+    """Rooms along every free stretch of wall, from the core outward; a small repeated
+    room is divided in two with chance ``split_p``."""
     core = _DeptState(prog.core, "", rng)
     courtyard = prog.kind == "school" and rng.random() < COURTYARD_P
     rooms: list[_Room] = []
@@ -334,10 +342,24 @@ def _fill(rng, prog: Programme, layout: Layout, ends, walls, order, states) -> l
                 s = lo
                 while hi - s >= MIN_ROOM_M:
                     f = state.draw(rng, prog)
-                    width = min(round(rng.uniform(*f.widths), 1), hi - s)
-                    door = _on_wall(layout, i, ends[i], side, s + width / 2.0)
-                    rooms.append(_Room(i, side, s + width / 2.0, door, f, state))
-                    s += width
+                    halves = ("",)
+                    if (
+                        f in state.dept.generic
+                        and f.widths[1] <= SPLIT_MAX_M
+                        and hi - s >= 2 * MIN_ROOM_M
+                        and rng.random() < split_p
+                    ):
+                        halves = ("A", "B")
+                    for half in halves:
+                        top = MIN_ROOM_M + 0.4 if half else f.widths[1]
+                        width = min(round(rng.uniform(f.widths[0], top), 1), hi - s)
+                        width = max(width, MIN_ROOM_M) if half else width
+                        door = _on_wall(layout, i, ends[i], side, s + width / 2.0)
+                        room = _Room(i, side, s + width / 2.0, door, f, state, half=half)
+                        if half == "B":
+                            room.twin = rooms[-1]
+                        rooms.append(room)
+                        s += width
     return rooms
 
 
@@ -352,7 +374,9 @@ def _number(rooms: list[_Room], order, layout: Layout, scheme: str, odd_even: bo
     nxt: dict[int, int] = {}
     for i in order:
         wing = layout.corridors[i].wing if scheme in PER_WING else 0
-        mine = sorted((r for r in rooms if r.corridor == i), key=lambda r: (r.s, -r.side))
+        mine = sorted(
+            (r for r in rooms if r.corridor == i and r.twin is None), key=lambda r: (r.s, -r.side)
+        )
         base = nxt.get(wing, 0)
         if odd_even:
             for side, first in ((1, 1), (-1, 2)):
@@ -364,6 +388,9 @@ def _number(rooms: list[_Room], order, layout: Layout, scheme: str, odd_even: bo
             for k, r in enumerate(mine):
                 r.n = base + k + 1
             nxt[wing] = base + len(mine)
+    for r in rooms:
+        if r.twin is not None:
+            r.n = r.twin.n
 
 
 def _room_data(rooms: list[_Room], layout: Layout, scheme: str, floor: int) -> list[dict]:
@@ -375,7 +402,8 @@ def _room_data(rooms: list[_Room], layout: Layout, scheme: str, floor: int) -> l
     counts: Counter[tuple[str, str]] = Counter()  # {n}: per department where named after it
     ordered = sorted(rooms, key=lambda r: (layout.corridors[r.corridor].wing, r.n))
     for k, r in enumerate(ordered, start=1):
-        code = room_code(scheme, floor, r.n, wing_letter(layout.corridors[r.corridor].wing))
+        wing = wing_letter(layout.corridors[r.corridor].wing)
+        code = room_code(scheme, floor, r.n, wing) + r.half
         f = r.function
         fields = {
             "code": code,
@@ -384,12 +412,12 @@ def _room_data(rooms: list[_Room], layout: Layout, scheme: str, floor: int) -> l
             "city": next(cities, code) if "{city}" in f.name else "",
         }
         name = f.name.format(**fields)
+        words = (name if f.sign is None else f.sign.format(**fields)).strip()
         base, dup = name, 1
-        while name.casefold() in names:
+        while name.casefold() in names:  # a second "Toilets" is "Toilets 2"; its sign "Toilets"
             dup += 1
             name = f"{base} {dup}"
         names.add(name.casefold())
-        words = (name if f.sign is None else f.sign.format(**fields)).strip()
         aliases = []
         for a in (a.format(**fields) for a in f.aliases):
             if a.casefold() not in aliases_used and a.casefold() not in names:

@@ -76,7 +76,7 @@ def _f(name: str, lo: float, hi: float, *aliases: str, sign: str | None = None) 
 
 _TOILETS = _f("Toilets", 2.4, 3.2, sign="Toilets")
 _ACCESSIBLE = _f("Accessible Toilet", 2.4, 2.8, sign="Accessible WC")
-_STORE = _f("Store", 2.4, 3.0)
+_STORE = _f("Store {code}", 2.4, 3.0, sign="Store")
 _CLEANER = _f("Cleaner's Cupboard", 2.4, 2.6, sign="Cleaner")
 
 HOSPITAL = Programme(
@@ -168,7 +168,7 @@ HOSPITAL = Programme(
     ),
     core=Department(
         "",
-        generic=(_STORE, _f("Equipment Store", 2.4, 3.4)),
+        generic=(_STORE, _f("Equipment Store {code}", 2.4, 3.4, sign="Equipment")),
         once=(
             _f("Staff Room", 4.0, 6.0, "Staff Rest Room"),
             _f("Sluice", 2.6, 3.2, "Dirty Utility"),

@@ -34,10 +34,10 @@ CASES = [(kind, seed) for kind in BUILDING_KINDS for seed in SEEDS]
 
 # How each scheme's codes look (the code is the sign's first word).
 SCHEME_PATTERNS = {
-    "117": r"\d{3,}",
+    "117": r"\d{3,}[AB]?",
     "1G": r"\d+[A-Z]{1,2}",
-    "2.04": r"\d\.\d{2,}",
-    "L2-204": r"L\d-\d{3,}",
+    "2.04": r"\d\.\d{2,}[AB]?",
+    "L2-204": r"L\d-\d{3,}[AB]?",
     "B117": r"[A-Z]{1,2}\d{3,}",
 }
 
