@@ -77,10 +77,8 @@ LAYOUT_TRIES = 12  # layouts drawn until one has a corridor bend (medium episode
 
 @dataclass
 class _Wall:
-    """One side of a corridor: ``side`` +1 is the left of a -> b; free intervals along it."""
+    """One side of a corridor: the stretches (distances along it) free for rooms."""
 
-    corridor: int
-    side: int
     free: list[tuple[float, float]]
 
 
@@ -98,7 +96,7 @@ class _Room:
 
 
 class _DeptState:
-    """A department while its walls are filled: the once-rooms left and the counters."""
+    """A department while its walls are filled: its title and the once-rooms left."""
 
     def __init__(self, dept: Department, title: str, rng: random.Random):
         self.dept = dept
@@ -114,7 +112,7 @@ class _DeptState:
         return rng.choice(self.dept.generic)
 
 
-def generate_functional(kind: str, seed: int, name: str | None = None) -> Building:
+def generate_functional(kind: str, seed: int) -> Building:
     """A valid ``kind`` floor (hospital, school or office); the same seed, the same file."""
     if kind not in PROGRAMMES:
         raise ValueError(f"unknown building kind {kind!r}; choose {', '.join(PROGRAMMES)}")
@@ -140,7 +138,7 @@ def generate_functional(kind: str, seed: int, name: str | None = None) -> Buildi
         if c.role == "lobby":  # the lobby runs from the entrance in
             ends[i] = (layout.entrance, layout.core)
 
-    walls = {(i, side): _wall(layout, g, i, ends[i], side) for i in order for side in (1, -1)}
+    walls = {(i, side): _wall(layout, g, i, ends[i]) for i in order for side in (1, -1)}
     floor = rng.randint(1, 5)
     states = _departments(rng, prog, layout, floor)
     landmarks = _landmarks(rng, prog, layout, ends, walls, states)
@@ -156,7 +154,7 @@ def generate_functional(kind: str, seed: int, name: str | None = None) -> Buildi
         pair = [wp_ids[c.a], wp_ids[c.b]]
         wide = {"from": pair[0], "to": pair[1], "width": c.width}
         edges.append(pair if c.width == main_w else wide)
-    label = name or f"{kind}_{seed}"
+    label = f"{kind}_{seed}"  # the family member's name
     data = {
         "schema_version": SCHEMA_VERSION,
         "name": label,
@@ -199,6 +197,7 @@ def _layout(rng, kind: str, prog: Programme, main_w, wing_w, lobby_w) -> Layout:
 
 
 def _has_bend(layout: Layout) -> bool:
+    """Whether two corridors meet at an angle where no third one joins (a turn waypoint)."""
     g = nx.Graph([(c.a, c.b) for c in layout.corridors])
     for n in g:
         if g.degree(n) == 2:
@@ -224,7 +223,7 @@ def _on_wall(layout: Layout, c: int, ends, side: int, s: float) -> tuple[float, 
     return round(x0 + ux * s + nx_ * off, 3), round(y0 + uy * s + ny_ * off, 3)
 
 
-def _wall(layout: Layout, g: nx.Graph, c: int, ends, side: int) -> _Wall:
+def _wall(layout: Layout, g: nx.Graph, c: int, ends) -> _Wall:
     """A corridor side's wall less the mouths of the corridors meeting it at either end."""
     _, _, _, length = _frame(layout, ends)
     clear = []
@@ -236,7 +235,7 @@ def _wall(layout: Layout, g: nx.Graph, c: int, ends, side: int) -> _Wall:
         ]
         clear.append(max(widths) / 2.0 + MOUTH_CLEARANCE_M if widths else END_CLEARANCE_M)
     lo, hi = clear[0], length - clear[1]
-    return _Wall(c, side, [(lo, hi)] if hi - lo >= MIN_ROOM_M else [])
+    return _Wall([(lo, hi)] if hi - lo >= MIN_ROOM_M else [])
 
 
 def _reserve(wall: _Wall, s: float, width: float) -> bool:
@@ -255,7 +254,7 @@ def _landmarks(rng, prog: Programme, layout: Layout, ends, walls, states) -> lis
     """Reception, stairs and lift at the core, escape stairs far away, department signs."""
     out: list[dict] = []
     lobby = next(i for i, c in enumerate(layout.corridors) if c.role == "lobby")
-    _, (ux, uy), _, lobby_len = _frame(layout, ends[lobby])
+    _, (ux, uy), _, _ = _frame(layout, ends[lobby])
     desk_side = rng.choice((1, -1))
     wall = walls[(lobby, desk_side)]
     if wall.free:
