@@ -6,9 +6,10 @@ its YAML file; the name of a building shipped with the package (``fig2_hospital`
 (``sign_sparse_3``, ``gen_small_0``, ``hospital_12``: family and seed), whose file is
 written once to a cache folder so that it has a path and a hash like any other. Specs
 name several members at once: ``FAMILY:N`` (the first N development members) and
-``FAMILY_heldout:N`` (the first N held-out members; see ``HELDOUT_SEEDS``). This module turns such a
-name into a file, a hash and a ``Building``. It sits above ``building`` (the file format)
-and ``generate`` (the seeded generator), so those two need not know each other.
+``FAMILY_heldout:N`` (the first N held-out members; see ``HELDOUT_SEEDS``). This module
+turns such a name into a file, a hash and a ``Building``. It sits above ``building`` (the
+file format) and the seeded generators (``generate``, ``functional``), so those need not
+know each other.
 """
 
 from __future__ import annotations
