@@ -29,7 +29,12 @@ from dataclasses import dataclass
 
 import networkx as nx
 
-from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
+from pmnav_bt.map.building import (
+    DOOR_REACH_SLACK,
+    SCHEMA_VERSION,
+    Building,
+    building_from_data,
+)
 from pmnav_bt.map.layouts import Layout, ring_layout, spine_layout
 from pmnav_bt.map.numbering import PER_WING, SCHEMES, room_code, wing_letter
 from pmnav_bt.map.programmes import CITIES, PROGRAMMES, Department, Function, Programme
@@ -269,9 +274,15 @@ def _landmarks(rng, prog: Programme, layout: Layout, ends, walls, states) -> lis
         if _reserve(wall, s, STAIRS_SLOT_M):
             out.append(_lm("stairs1", "stairs", f"Stairs {wing_letter(0)}", "Stairs",
                            _on_wall(layout, lobby, ends[lobby], -desk_side, s)))
-    # The lift faces the entrance, on the back wall of the lift lobby past the main corridor.
+    # The lift faces the entrance, on the back wall of the lift lobby past the main corridor
+    # (the world mounts it on the nearest wall). Its position in the file stands in front
+    # of it, within reach of the main corridor: the file's rule measures reach from the
+    # nearest centre line, which there is the main corridor's.
     cx, cy = layout.pos[layout.core]
-    half = layout.lobby_width / 2.0
+    main_w = max(
+        c.width for c in layout.corridors if c.role != "lobby" and layout.core in (c.a, c.b)
+    )
+    half = min(layout.lobby_width, main_w + 2.0 * DOOR_REACH_SLACK) / 2.0 - 0.05
     lift = f"{prog.lift} {wing_letter(0)}"
     pos = (round(cx + ux * half, 3), round(cy + uy * half, 3))
     out.append(_lm("lift1", "elevator", lift, lift, pos))
@@ -350,9 +361,10 @@ def _fill(
                     ):
                         halves = ("A", "B")
                     for half in halves:
-                        top = MIN_ROOM_M + 0.4 if half else f.widths[1]
-                        width = min(round(rng.uniform(f.widths[0], top), 1), hi - s)
-                        width = max(width, MIN_ROOM_M) if half else width
+                        lo_w, hi_w = (MIN_ROOM_M, MIN_ROOM_M + 0.4) if half else f.widths
+                        room_w = round(rng.uniform(lo_w, hi_w), 1)
+                        # an A half leaves its B half a whole room's width
+                        width = min(room_w, hi - s - (MIN_ROOM_M if half == "A" else 0.0))
                         door = _on_wall(layout, i, ends[i], side, s + width / 2.0)
                         room = _Room(i, side, s + width / 2.0, door, f, state, half=half)
                         if half == "B":

@@ -6,11 +6,12 @@ functions of its rooms with the width each takes along the corridor wall (its do
 :mod:`pmnav_bt.map.functional` lays corridors out and walks their walls, drawing rooms
 from these tables. The numbers are from practice:
 
-- **Corridors.** Hospital corridors carry beds and trolleys side by side: 2.4-3.0 m (UK
-  HBN 00-04 asks 2.4 m where beds pass). School corridors carry a class change: 2.0-3.0 m
-  (BB 103). Office corridors carry people only: 1.5-2.0 m (1.5 m lets two wheelchairs pass).
+- **Corridors.** Hospital corridors carry beds and trolleys side by side: 2.4-3.0 m (US
+  guidance asks 8 ft, 2.44 m, where patients are moved in beds). School corridors carry a
+  class change: 2.0-3.0 m. Office corridors carry people only: 1.5-2.0 m (1.5 m lets a
+  wheelchair turn, 1.8 m lets two pass).
 - **Room widths along the wall** (the door pitch): a consulting room 3.2-4.0 m, a six-bed
-  bay 6.5-8 m, a single side room 3.4-4 m; a classroom 7-9 m (about 55 m2 deep 7 m), a
+  bay 6.5-8 m, a single side room 3.4-4 m; a classroom 7-9 m (55-60 m2, 7 m deep), a
   science lab 9-11 m; a cellular office 2.7-3.6 m (two or three 1.35-1.5 m planning-grid
   modules), a meeting room 4-6 m. Nothing is narrower than 2.4 m, so every door (1.16 m
   with its frame) keeps room for its sign plate beside it.
