@@ -58,6 +58,12 @@ def test_every_floor_is_valid_with_doors_on_their_walls(buildings):
         assert kinds["reception_desk"] == 1 and kinds["elevator"] == 1 and kinds["stairs"] >= 1
 
 
+def test_development_and_heldout_seeds_alike_give_valid_floors():
+    for kind in BUILDING_KINDS:
+        for seed in [*DEV_SEEDS[25:60], *HELDOUT_SEEDS[:60]]:
+            assert len(generate_functional(kind, seed).rooms) >= 10  # it validated
+
+
 def test_the_same_seed_gives_the_same_file_and_another_seed_another():
     for kind in BUILDING_KINDS:
         assert dump_building(generate_functional(kind, 7)) == dump_building(
