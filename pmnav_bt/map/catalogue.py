@@ -94,6 +94,15 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
     builtin = BUILTIN_DIR / f"{name_or_path}.yaml"
     if builtin.is_file():
         return builtin
+    try:
+        members = family_members(text)
+    except ValueError:
+        members = None
+    if members:  # "hospital:3" where one building is wanted
+        raise BuildingFileError(
+            text,
+            [Problem("", f"names {len(members)} buildings; give one, such as {members[0]}")],
+        )
     stem, _, seed = text.rpartition("_")
     if stem in RANGED_FAMILIES and seed.isdigit():
         raise BuildingFileError(

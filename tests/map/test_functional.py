@@ -163,6 +163,8 @@ def test_members_load_by_name_and_seeds_outside_the_ranges_do_not(tmp_path, monk
     with pytest.raises(BuildingFileError, match="held-out") as err:
         load_building("office_2000")
     assert "\n" not in str(err.value)
+    with pytest.raises(BuildingFileError, match="names 2 buildings; give one, such as hospital_0"):
+        load_building("functional:2")
 
 
 @pytest.mark.parametrize(
