@@ -11,7 +11,7 @@ import pytest
 from pmnav_bt.sim.world import SimWorld
 
 
-@pytest.mark.parametrize("name", ["hospital_1", "office_1000"])
+@pytest.mark.parametrize("name", ["hospital_1", "office_3"])
 def test_a_generated_floor_builds_with_every_door_sign_and_landmark(
     name, tmp_path, monkeypatch, caplog
 ):
