@@ -48,12 +48,26 @@ def _folder(file: str) -> Path:
 
 @app.command()
 def buildings() -> None:
-    """List the built-in buildings."""
-    from pmnav_bt.map.catalogue import builtin_buildings, load_building
+    """List the built-in buildings and the generated families."""
+    from pmnav_bt.map.catalogue import (
+        DEV_SEEDS,
+        FAMILIES,
+        HELDOUT_SEEDS,
+        MIXED_FAMILY,
+        builtin_buildings,
+        load_building,
+    )
 
     for name in builtin_buildings():
         b = load_building(name)
         typer.echo(f"{name:<16} {b.kind:<9} {len(b.rooms):>3} rooms  {b.description}")
+    typer.echo(
+        f"\nGenerated families ({', '.join(FAMILIES)}): FAMILY_SEED names one member, FAMILY:N "
+        f"the first N; {MIXED_FAMILY}:N takes hospital, school and office in turn. hospital, "
+        f"school, office and {MIXED_FAMILY} have development seeds {DEV_SEEDS.start}-"
+        f"{DEV_SEEDS.stop - 1} and held-out seeds {HELDOUT_SEEDS.start}-{HELDOUT_SEEDS.stop - 1} "
+        "(FAMILY_heldout:N; for evaluation only, never tuned on). See docs/scale.md."
+    )
 
 
 @app.command()

@@ -9,12 +9,13 @@ eye (legible at 640x480 from 2 m head-on to 4 m at 60 deg off the plate's normal
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
+
+from pmnav_bt.map.signage import ROOM_NUMBER
 
 PLATE_WIDTH_M = 0.8  # every plate is this wide
 LINE_PITCH_M = 0.12  # height of one text line on the plate
@@ -25,7 +26,6 @@ MAX_LINES = 4
 
 _FONT = cv2.FONT_HERSHEY_DUPLEX
 _SUPERSAMPLE = 4  # draw large, then shrink with area averaging (anti-aliased strokes)
-_NUMBER = re.compile(r"^[A-Za-z]?\d+[A-Za-z]?$")
 
 
 @dataclass(frozen=True)
@@ -45,7 +45,7 @@ def sign_lines(text: str, max_chars: int = MAX_CHARS) -> list[str]:
     if not words:
         return [""]
     lines: list[str] = []
-    if len(words) > 1 and _NUMBER.match(words[0]):
+    if len(words) > 1 and ROOM_NUMBER.match(words[0]):
         lines.append(words.pop(0))
     current = ""
     for w in words:

@@ -38,8 +38,8 @@ def tier_names(tier: str) -> list[str]:
 
 
 def building_names(building: str, option: str = "--building") -> list[str]:
-    """``--building``: comma-separated files, built-in names, 'all' (every built-in) and
-    FAMILY:N."""
+    """``--building``: comma-separated files, built-in names, 'all' (every built-in),
+    FAMILY:N and FAMILY_heldout:N (``catalogue.family_members``)."""
     from pmnav_bt.map.catalogue import builtin_buildings, family_members
 
     out: list[str] = []

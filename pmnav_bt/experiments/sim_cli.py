@@ -324,7 +324,9 @@ def eval_(
         "all",
         "--building",
         help="Comma-separated building files or built-in names, 'all' (the built-ins), or "
-        "FAMILY:N (N generated buildings: gen_small:100, sign_sparse:3).",
+        "FAMILY:N (the first N generated buildings: gen_small:100, sign_sparse:3, hospital:10; "
+        "functional:12 takes hospital, school and office in turn), or FAMILY_heldout:N (held-out "
+        "members, for evaluation only: functional_heldout:12).",
     ),
     tier: str = typer.Option("all", "--tier", help="easy, medium, hard, a list, or all."),
     n: int = typer.Option(20, "-n", min=1, help="Episodes per tier per building."),

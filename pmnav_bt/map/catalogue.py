@@ -3,20 +3,25 @@
 A building is named three ways (``--building``, an episode's record, a test): a path to
 its YAML file; the name of a building shipped with the package (``fig2_hospital``, from
 ``pmnav_bt/data/buildings``); or the name of a member of a generated family
-(``sign_sparse_3``, ``gen_small_0``: family and seed), whose file is written once to a
-cache folder so that it has a path and a hash like any other. This module turns such a
-name into a file, a hash and a ``Building``. It sits above ``building`` (the file format)
-and ``generate`` (the seeded generator), so those two need not know each other.
+(``sign_sparse_3``, ``gen_small_0``, ``hospital_12``: family and seed), whose file is
+written once to a cache folder so that it has a path and a hash like any other. Specs
+name several members at once: ``FAMILY:N`` (the first N development members) and
+``FAMILY_heldout:N`` (the first N held-out members; see ``HELDOUT_SEEDS``). This module
+turns such a name into a file, a hash and a ``Building``. It sits above ``building`` (the
+file format) and the seeded generators (``generate``, ``functional``), so those need not
+know each other.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+from functools import partial
 from pathlib import Path
 
 from pmnav_bt.errors import BuildingFileError, Problem
 from pmnav_bt.map.building import Building, dump_building, read_building_file
+from pmnav_bt.map.functional import BUILDING_KINDS, generate_functional
 from pmnav_bt.map.generate import (
     SIGN_SPARSE_FAMILY,
     SMALL_FAMILY,
@@ -26,8 +31,31 @@ from pmnav_bt.map.generate import (
 
 BUILTIN_DIR = Path(__file__).parent.parent / "data" / "buildings"
 
-# The generated families by name: "sign_sparse_3" is generate_sign_sparse(seed=3).
-FAMILIES = {SIGN_SPARSE_FAMILY: generate_sign_sparse, SMALL_FAMILY: generate_small}
+# The generated families by name: "sign_sparse_3" is generate_sign_sparse(seed=3),
+# "hospital_12" is generate_functional("hospital", 12).
+FAMILIES = {
+    SIGN_SPARSE_FAMILY: generate_sign_sparse,
+    SMALL_FAMILY: generate_small,
+    **{kind: partial(generate_functional, kind) for kind in BUILDING_KINDS},
+}
+
+DEV_SEEDS = range(0, 1000)
+"""Development seeds of the realistic families (hospital, school, office, functional):
+the members the project looks at, tunes and debugs on. ``FAMILY:N`` names the first N."""
+
+HELDOUT_SEEDS = range(1000, 2000)
+"""Held-out seeds of the realistic families: for evaluation only. The project never tunes
+on them, never looks at their episodes to fix a failure, and reports them apart (issue
+36): a result on them says how the robot does in buildings nobody has seen.
+``FAMILY_heldout:N`` names the first N (``hospital_heldout:3`` is hospital_1000, 1001,
+1002). A seed outside both ranges names no member of these families."""
+
+HELDOUT_SUFFIX = "_heldout"
+RANGED_FAMILIES = BUILDING_KINDS  # the families with a development and a held-out range
+MIXED_FAMILY = "functional"
+"""Not a family of its own: ``functional:N`` names the realistic families' members in
+turn, hospital, school, office, hospital ... (``functional:4`` is hospital_0, school_0,
+office_0, hospital_1), so that one spec spans every building type."""
 
 
 def load_building(name_or_path: str | Path) -> Building:
@@ -88,6 +116,28 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
     builtin = BUILTIN_DIR / f"{name_or_path}.yaml"
     if builtin.is_file():
         return builtin
+    try:
+        members = family_members(text)
+    except ValueError:
+        members = None
+    if members:  # "hospital:3" where one building is wanted
+        raise BuildingFileError(
+            text,
+            [Problem("", f"names {len(members)} buildings; give one, such as {members[0]}")],
+        )
+    stem, _, seed = text.rpartition("_")
+    if stem in RANGED_FAMILIES and seed.isdigit():
+        raise BuildingFileError(
+            text,
+            [
+                Problem(
+                    "",
+                    f"no such member: {stem} seeds are {DEV_SEEDS.start}-{DEV_SEEDS.stop - 1} "
+                    f"(development) and {HELDOUT_SEEDS.start}-{HELDOUT_SEEDS.stop - 1} "
+                    "(held-out, for evaluation only)",
+                )
+            ],
+        )
     raise BuildingFileError(
         str(name_or_path),
         [
@@ -104,25 +154,43 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
 
 
 def is_generated_name(name: str) -> bool:
-    """True for a generated family's building name, such as "sign_sparse_3"."""
+    """True for a generated family's building name, such as "sign_sparse_3" or
+    "hospital_1004" (a realistic family's seed must be in its development or held-out
+    range)."""
     stem, _, seed = name.rpartition("_")
-    return stem in FAMILIES and seed.isdigit() and len(seed) < 10
+    if stem not in FAMILIES or not seed.isdigit() or len(seed) >= 10:
+        return False
+    return stem not in RANGED_FAMILIES or int(seed) in DEV_SEEDS or int(seed) in HELDOUT_SEEDS
 
 
 def family_members(spec: str) -> list[str] | None:
-    """ "FAMILY:N" -> the family's first N building names ("gen_small:3" -> gen_small_0,
-    gen_small_1, gen_small_2); None when ``spec`` is not of that form; ValueError for an
+    """ "FAMILY:N" -> the family's first N development members ("gen_small:3" ->
+    gen_small_0, gen_small_1, gen_small_2); "FAMILY_heldout:N" -> its first N held-out
+    members; "functional:N" / "functional_heldout:N" -> the realistic families' members
+    in turn. None when ``spec`` is not of that form; ValueError (one line) for an
     unknown family or a bad N."""
     family, sep, count = spec.partition(":")
     if not sep:
         return None
-    if family not in FAMILIES:
+    base = family.removesuffix(HELDOUT_SUFFIX)
+    heldout = base != family
+    ranged = (*RANGED_FAMILIES, MIXED_FAMILY)
+    if base not in FAMILIES and base != MIXED_FAMILY:
+        known = [*FAMILIES, MIXED_FAMILY, *(f + HELDOUT_SUFFIX for f in ranged)]
+        raise ValueError(f"{spec!r}: unknown building family {family!r}; choose {', '.join(known)}")
+    if heldout and base not in ranged:
         raise ValueError(
-            f"{spec!r}: unknown building family {family!r}; choose {', '.join(FAMILIES)}"
+            f"{spec!r}: {base} has no held-out seeds; held-out families: "
+            + ", ".join(f + HELDOUT_SUFFIX for f in ranged)
         )
-    if not count.isdigit() or not 1 <= int(count) <= 100_000:
-        raise ValueError(f"{spec!r}: expected {family}:N with N from 1 to 100000")
-    return [f"{family}_{k}" for k in range(int(count))]
+    seeds = HELDOUT_SEEDS if heldout else DEV_SEEDS
+    kinds = RANGED_FAMILIES if base == MIXED_FAMILY else (base,)
+    most = len(seeds) * len(kinds) if base in ranged else 100_000
+    if not count.isdigit() or not 1 <= int(count) <= most:
+        raise ValueError(f"{spec!r}: expected {family}:N with N from 1 to {most}")
+    if base not in ranged:
+        return [f"{base}_{k}" for k in range(int(count))]
+    return [f"{kinds[k % len(kinds)]}_{seeds[k // len(kinds)]}" for k in range(int(count))]
 
 
 def generated_family(name: str) -> Building | None:

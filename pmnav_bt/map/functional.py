@@ -1,0 +1,466 @@
+"""Seeded hospital, school and office floors that look like the real thing (issue 36).
+
+A generated floor is built in four steps, each from the seed:
+
+1. a corridor layout of the type (:mod:`pmnav_bt.map.layouts`: a main corridor with
+   wings, an L or a U, or a ring round a core), with the type's corridor widths and a
+   wide entrance lobby whose far end opens into a lift lobby;
+2. landmarks where buildings have them: the reception desk in the lobby, the main stairs
+   beside it, a lift in the lift lobby facing the entrance, escape stairs at the far end,
+   and a sign at the mouth of every department's wing (``Ward 3B``, ``Imaging``);
+3. rooms along every corridor wall, drawn from the type's programme
+   (:mod:`pmnav_bt.map.programmes`): each department's rooms with their widths along the
+   wall (the door pitch), the building's named rooms near the lobby, services anywhere,
+   the core's rooms on the inside of a ring (a school's courtyard side has none);
+4. one numbering scheme for the building (:mod:`pmnav_bt.map.numbering`), from the core
+   outward; the sign of a numbered room reads its code (``117``), that of a named room
+   the code and a short name (``2.04 Library``), as the built-in building files do.
+
+Nothing here draws signage styles, clutter or light: the world preset does that per
+episode seed (``world.preset=realistic``). A floor takes a few milliseconds to make.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections import Counter
+from dataclasses import dataclass
+
+import networkx as nx
+
+from pmnav_bt.map.building import (
+    DOOR_REACH_SLACK,
+    SCHEMA_VERSION,
+    Building,
+    building_from_data,
+)
+from pmnav_bt.map.layouts import Layout, ring_layout, spine_layout
+from pmnav_bt.map.numbering import PER_WING, SCHEMES, room_code, wing_letter
+from pmnav_bt.map.programmes import CITIES, PROGRAMMES, Department, Function, Programme
+
+BUILDING_KINDS = tuple(PROGRAMMES)  # hospital, school, office
+
+# Wall clearances (m), from the world's door (1.16 m with its frame) and sign plate (0.82 m
+# beside it, 0.15 m off the frame): a door centre this far past the mouth of a meeting
+# corridor or a dead end leaves its sign room on the wall.
+MOUTH_CLEARANCE_M = 1.6
+END_CLEARANCE_M = 1.4
+MIN_ROOM_M = 2.4  # no room narrower along the wall: a door and its sign plate
+PLATE_ROOM_M = 1.0  # a sign plate and its gap, kept free beside a landmark
+DESK_SLOT_M = 2.4  # the reception desk (1.9 m) and its margins
+STAIRS_SLOT_M = 2.4  # the stairs (1.8 m) and their margins
+SIGN_SLOT_M = 1.2  # a department sign plate
+
+
+
+@dataclass(frozen=True)
+class _Shape:
+    """A type's layouts: the chance of a ring (else a main corridor with wings), a ring's
+    length and core depth (m) and its fewest and most wings, a main corridor's length (m)."""
+
+    p_ring: float
+    ring_m: tuple[float, float]
+    core_m: tuple[float, float]
+    ring_wings: tuple[int, int]
+    main_m: tuple[float, float]
+
+
+_SHAPES = {
+    # a racetrack round its support rooms, or a hospital street with ward wings
+    "hospital": _Shape(0.4, (30.0, 60.0), (10.0, 16.0), (0, 3), (40.0, 80.0)),
+    # a courtyard with teaching wings off it, or a long finger plan
+    "school": _Shape(0.4, (36.0, 64.0), (14.0, 24.0), (1, 3), (50.0, 90.0)),
+    # the floor round its lift-and-stair core, or a double-loaded corridor (L, U, T)
+    "office": _Shape(0.55, (28.0, 48.0), (8.0, 12.0), (0, 1), (36.0, 64.0)),
+}
+COURTYARD_P = 0.6  # a school ring's inner walls face a courtyard: no doors there
+SPLIT_P = 0.12  # a small repeated room divided in two (117A, 117B), as rooms get divided
+SPLIT_MAX_M = 4.2  # ... if it is no wider than this (offices, consulting rooms, stores)
+LAYOUT_TRIES = 12  # layouts drawn until one has a corridor bend (medium episodes need one)
+
+
+@dataclass
+class _Wall:
+    """One side of a corridor: the stretches (distances along it) free for rooms."""
+
+    free: list[tuple[float, float]]
+
+
+@dataclass
+class _Room:
+    corridor: int
+    side: int
+    s: float
+    door: tuple[float, float]
+    function: Function
+    state: _DeptState
+    n: int = 0  # sequence number of the numbering scheme
+    half: str = ""  # "A" or "B": one half of a divided room (117A, 117B)
+    twin: _Room | None = None  # a B half's A half, whose number it shares
+
+
+class _DeptState:
+    """A department while its walls are filled: its title and the once-rooms left."""
+
+    def __init__(self, dept: Department, title: str, rng: random.Random):
+        self.dept = dept
+        self.title = title
+        self.once = list(dept.once)
+        rng.shuffle(self.once)
+
+    def draw(self, rng: random.Random, prog: Programme) -> Function:
+        if self.once and rng.random() < self.dept.p_once:
+            return self.once.pop()
+        if rng.random() < prog.p_service:
+            return rng.choice(prog.service)
+        return rng.choice(self.dept.generic)
+
+
+def generate_functional(kind: str, seed: int) -> Building:
+    """A valid ``kind`` floor (hospital, school or office); the same seed, the same file."""
+    if kind not in PROGRAMMES:
+        raise ValueError(f"unknown building kind {kind!r}; choose {', '.join(PROGRAMMES)}")
+    prog = PROGRAMMES[kind]
+    rng = random.Random(f"{kind}:{seed}")  # a str seed is hashed stably (sha512)
+    main_w = round(rng.uniform(*prog.corridor), 1)
+    wing_w = round(rng.uniform(max(prog.corridor[0], main_w - 0.4), main_w), 1)
+    lobby_w = round(rng.uniform(*prog.lobby), 1)
+    layout = _layout(rng, kind, prog, main_w, wing_w, lobby_w)
+    g = nx.Graph()
+    for i, c in enumerate(layout.corridors):
+        g.add_edge(c.a, c.b, index=i)
+    depth = nx.single_source_shortest_path_length(g, layout.core)
+    # Orient every corridor away from the core; visit them from the core outward.
+    order = sorted(
+        range(len(layout.corridors)),
+        key=lambda i: min(depth[layout.corridors[i].a], depth[layout.corridors[i].b]),
+    )
+    ends = {}
+    for i in order:
+        c = layout.corridors[i]
+        ends[i] = (c.a, c.b) if depth[c.a] <= depth[c.b] else (c.b, c.a)
+        if c.role == "lobby":  # the lobby runs from the entrance in
+            ends[i] = (layout.entrance, layout.core)
+
+    walls = {(i, side): _wall(layout, g, i, ends[i]) for i in order for side in (1, -1)}
+    floor = rng.randint(1, 5)
+    states = _departments(rng, prog, layout, floor)
+    landmarks = _landmarks(rng, prog, layout, ends, walls, states)
+    scheme = rng.choice(list(SCHEMES))
+    odd_even = rng.random() < 0.5
+    split_p = 0.0 if scheme in PER_WING else SPLIT_P  # "3BA" is no code anyone uses
+    rooms = _fill(rng, prog, layout, ends, walls, order, states, split_p)
+    _number(rooms, order, layout, scheme, odd_even)
+    room_data = _room_data(rooms, layout, scheme, floor)
+    waypoints, wp_ids = _waypoints(layout, g)
+    edges = []
+    for c in layout.corridors:
+        pair = [wp_ids[c.a], wp_ids[c.b]]
+        wide = {"from": pair[0], "to": pair[1], "width": c.width}
+        edges.append(pair if c.width == main_w else wide)
+    label = f"{kind}_{seed}"  # the family member's name
+    data = {
+        "schema_version": SCHEMA_VERSION,
+        "name": label,
+        "kind": kind,
+        "description": (
+            f"Generated {kind} floor {floor} (seed {seed}): {layout.describe()}; corridors "
+            f"{main_w:g} m wide, an entrance lobby {lobby_w:g} m wide with reception, the "
+            f"main stairs and a lift lobby at its far end; {len(room_data)} rooms numbered "
+            f"like {room_data[0]['sign'].split()[0] if room_data else scheme} "
+            f"({'odd and even sides' if odd_even else 'in passing order'})."
+        ),
+        "corridor_width": main_w,
+        "waypoints": waypoints,
+        "edges": edges,
+        "rooms": room_data,
+        "landmarks": landmarks,
+    }
+    return building_from_data(data, source=label)
+
+
+def _layout(rng, kind: str, prog: Programme, main_w, wing_w, lobby_w) -> Layout:
+    """The type's layout; redrawn (a few times) until some corridor bends."""
+    shape = _SHAPES[kind]
+    for _ in range(LAYOUT_TRIES):
+        if rng.random() < shape.p_ring:
+            layout = ring_layout(
+                rng,
+                main_w,
+                wing_w,
+                lobby_w,
+                prog.room_depth,
+                (shape.ring_m, shape.core_m),
+                shape.ring_wings,
+            )
+        else:
+            layout = spine_layout(rng, main_w, wing_w, lobby_w, prog.room_depth, shape.main_m)
+        if _has_bend(layout):
+            break
+    return layout
+
+
+def _has_bend(layout: Layout) -> bool:
+    """Whether two corridors meet at an angle where no third one joins (a turn waypoint)."""
+    g = nx.Graph([(c.a, c.b) for c in layout.corridors])
+    for n in g:
+        if g.degree(n) == 2:
+            a, b = (layout.pos[m] for m in g.neighbors(n))
+            p = layout.pos[n]
+            if abs((a[0] - p[0]) * (b[1] - p[1]) - (a[1] - p[1]) * (b[0] - p[0])) > 1e-6:
+                return True
+    return False
+
+
+def _frame(layout: Layout, ends: tuple[int, int]):
+    """Start point, unit direction, left normal and length of a corridor from ends[0]."""
+    (x0, y0), (x1, y1) = layout.pos[ends[0]], layout.pos[ends[1]]
+    length = math.hypot(x1 - x0, y1 - y0)
+    ux, uy = (x1 - x0) / length, (y1 - y0) / length
+    return (x0, y0), (ux, uy), (-uy, ux), length
+
+
+def _on_wall(layout: Layout, c: int, ends, side: int, s: float) -> tuple[float, float]:
+    """The point ``s`` along corridor ``c`` on its ``side`` wall (rounded to mm)."""
+    (x0, y0), (ux, uy), (nx_, ny_), _ = _frame(layout, ends)
+    off = side * layout.corridors[c].width / 2.0
+    return round(x0 + ux * s + nx_ * off, 3), round(y0 + uy * s + ny_ * off, 3)
+
+
+def _wall(layout: Layout, g: nx.Graph, c: int, ends) -> _Wall:
+    """A corridor side's wall less the mouths of the corridors meeting it at either end."""
+    _, _, _, length = _frame(layout, ends)
+    clear = []
+    for node in ends:
+        widths = [
+            layout.corridors[g.edges[node, m]["index"]].width
+            for m in g.neighbors(node)
+            if g.edges[node, m]["index"] != c
+        ]
+        clear.append(max(widths) / 2.0 + MOUTH_CLEARANCE_M if widths else END_CLEARANCE_M)
+    lo, hi = clear[0], length - clear[1]
+    return _Wall([(lo, hi)] if hi - lo >= MIN_ROOM_M else [])
+
+
+def _reserve(wall: _Wall, s: float, width: float) -> bool:
+    """Take ``width`` centred at ``s`` out of the wall's free intervals, if it fits there,
+    with a sign plate's room either side (a neighbouring door's sign may hang there)."""
+    a, b = s - width / 2.0, s + width / 2.0
+    for k, (lo, hi) in enumerate(wall.free):
+        if lo - 0.01 <= a and b <= hi + 0.01:
+            left, right = (lo, a - PLATE_ROOM_M), (b + PLATE_ROOM_M, hi)
+            wall.free[k : k + 1] = [iv for iv in (left, right) if iv[1] - iv[0] >= MIN_ROOM_M]
+            return True
+    return False
+
+
+def _landmarks(rng, prog: Programme, layout: Layout, ends, walls, states) -> list[dict]:
+    """Reception, stairs and lift at the core, escape stairs far away, department signs."""
+    out: list[dict] = []
+    lobby = next(i for i, c in enumerate(layout.corridors) if c.role == "lobby")
+    _, (ux, uy), _, _ = _frame(layout, ends[lobby])
+    desk_side = rng.choice((1, -1))
+    wall = walls[(lobby, desk_side)]
+    if wall.free:
+        lo, hi = wall.free[0]
+        s = round(lo + DESK_SLOT_M / 2.0 + rng.uniform(0.0, 1.0) * (hi - lo - DESK_SLOT_M), 2)
+        if _reserve(wall, s, DESK_SLOT_M):
+            out.append(_lm("reception", "reception_desk", prog.reception, "Reception",
+                           _on_wall(layout, lobby, ends[lobby], desk_side, s)))
+    wall = walls[(lobby, -desk_side)]
+    if wall.free:
+        s = round(wall.free[-1][1] - STAIRS_SLOT_M / 2.0, 2)
+        if _reserve(wall, s, STAIRS_SLOT_M):
+            out.append(_lm("stairs1", "stairs", f"Stairs {wing_letter(0)}", "Stairs",
+                           _on_wall(layout, lobby, ends[lobby], -desk_side, s)))
+    # The lift faces the entrance, on the back wall of the lift lobby past the main corridor
+    # (the world mounts it on the nearest wall). Its position in the file stands in front
+    # of it, within reach of the main corridor: the file's rule measures reach from the
+    # nearest centre line, which there is the main corridor's.
+    cx, cy = layout.pos[layout.core]
+    main_w = max(
+        c.width for c in layout.corridors if c.role != "lobby" and layout.core in (c.a, c.b)
+    )
+    half = min(layout.lobby_width, main_w + 2.0 * DOOR_REACH_SLACK) / 2.0 - 0.05
+    lift = f"{prog.lift} {wing_letter(0)}"
+    pos = (round(cx + ux * half, 3), round(cy + uy * half, 3))
+    out.append(_lm("lift1", "elevator", lift, lift, pos))
+    # Escape stairs near the far end of the corridor farthest from the core.
+    g = nx.Graph()
+    for c in layout.corridors:
+        g.add_edge(c.a, c.b, w=math.dist(layout.pos[c.a], layout.pos[c.b]))
+    dist = nx.single_source_dijkstra_path_length(g, layout.core, weight="w")
+    inner = [i for i in ends if layout.corridors[i].role != "lobby"]
+    far = max(inner, key=lambda i: dist[ends[i][1]])
+    for side in rng.sample((1, -1), 2):
+        wall = walls[(far, side)]
+        if wall.free and wall.free[-1][1] - wall.free[-1][0] >= STAIRS_SLOT_M:
+            s = round(wall.free[-1][1] - STAIRS_SLOT_M / 2.0, 2)
+            _reserve(wall, s, STAIRS_SLOT_M)
+            out.append(_lm("stairs2", "stairs", f"Stairs {wing_letter(1)}", "Stairs",
+                           _on_wall(layout, far, ends[far], side, s)))
+            break
+    # A department's name where its wing leaves the main corridor.
+    for k, state in sorted(states.items()):
+        first = next((i for i in ends if layout.corridors[i].wing == k), None)
+        if not state.title or first is None:
+            continue
+        side = rng.choice((1, -1))
+        wall = walls[(first, side)]
+        if wall.free:
+            s = round(wall.free[0][0] + SIGN_SLOT_M / 2.0, 2)
+            if _reserve(wall, s, SIGN_SLOT_M):
+                out.append(_lm(f"sign{k}", "sign", state.title, state.title,
+                               _on_wall(layout, first, ends[first], side, s)))
+    return out
+
+
+def _lm(ident: str, kind: str, name: str, sign: str, pos) -> dict:
+    return {"id": ident, "kind": kind, "name": name, "pos": list(pos), "sign": sign}
+
+
+def _departments(rng, prog: Programme, layout: Layout, floor: int) -> dict[int, _DeptState]:
+    """The department of every wing (0: the main corridor and lobby)."""
+    pool = list(prog.wings)
+    rng.shuffle(pool)
+    states = {0: _DeptState(prog.main, "", rng)}
+    for k in range(1, layout.wings + 1):
+        dept = pool[(k - 1) % len(pool)]
+        title = dept.title.format(ward=f"{floor}{wing_letter(k)}")
+        states[k] = _DeptState(dept, title, rng)
+    return states
+
+
+def _fill(
+    rng, prog: Programme, layout: Layout, ends, walls, order, states, split_p: float
+) -> list[_Room]:
+    """Rooms along every free stretch of wall, from the core outward; a small repeated
+    room is divided in two with chance ``split_p``."""
+    core = _DeptState(prog.core, "", rng)
+    courtyard = prog.kind == "school" and rng.random() < COURTYARD_P
+    rooms: list[_Room] = []
+    for i in order:
+        c = layout.corridors[i]
+        for side in (1, -1):
+            state = states[c.wing]
+            if c.role == "ring" and _faces_centre(layout, i, ends[i], side):
+                if courtyard:
+                    continue
+                state = core
+            for lo, hi in walls[(i, side)].free:
+                s = lo
+                while hi - s >= MIN_ROOM_M:
+                    f = state.draw(rng, prog)
+                    halves = ("",)
+                    if (
+                        f in state.dept.generic
+                        and f.widths[1] <= SPLIT_MAX_M
+                        and hi - s >= 2 * MIN_ROOM_M
+                        and rng.random() < split_p
+                    ):
+                        halves = ("A", "B")
+                    for half in halves:
+                        lo_w, hi_w = (MIN_ROOM_M, MIN_ROOM_M + 0.4) if half else f.widths
+                        room_w = round(rng.uniform(lo_w, hi_w), 1)
+                        # an A half leaves its B half a whole room's width
+                        width = min(room_w, hi - s - (MIN_ROOM_M if half == "A" else 0.0))
+                        door = _on_wall(layout, i, ends[i], side, s + width / 2.0)
+                        room = _Room(i, side, s + width / 2.0, door, f, state, half=half)
+                        if half == "B":
+                            room.twin = rooms[-1]
+                        rooms.append(room)
+                        s += width
+    return rooms
+
+
+def _faces_centre(layout: Layout, c: int, ends, side: int) -> bool:
+    (x0, y0), _, (nx_, ny_), _ = _frame(layout, ends)
+    cx, cy = layout.centre
+    return side * ((cx - x0) * nx_ + (cy - y0) * ny_) > 0
+
+
+def _number(rooms: list[_Room], order, layout: Layout, scheme: str, odd_even: bool) -> None:
+    """Sequence numbers from the core outward, per wing in the per-wing schemes."""
+    nxt: dict[int, int] = {}
+    for i in order:
+        wing = layout.corridors[i].wing if scheme in PER_WING else 0
+        mine = sorted(
+            (r for r in rooms if r.corridor == i and r.twin is None), key=lambda r: (r.s, -r.side)
+        )
+        base = nxt.get(wing, 0)
+        if odd_even:
+            for side, first in ((1, 1), (-1, 2)):
+                for k, r in enumerate(x for x in mine if x.side == side):
+                    r.n = base + first + 2 * k
+            top = max((r.n for r in mine), default=base)
+            nxt[wing] = top + (top % 2)
+        else:
+            for k, r in enumerate(mine):
+                r.n = base + k + 1
+            nxt[wing] = base + len(mine)
+    for r in rooms:
+        if r.twin is not None:
+            r.n = r.twin.n
+
+
+def _room_data(rooms: list[_Room], layout: Layout, scheme: str, floor: int) -> list[dict]:
+    """Rooms as file data: ids in number order, unique names, aliases each given once."""
+    out = []
+    names: set[str] = set()
+    aliases_used: set[str] = set()
+    cities = iter(CITIES)
+    counts: Counter[tuple[str, str]] = Counter()  # {n}: per department where named after it
+    ordered = sorted(rooms, key=lambda r: (layout.corridors[r.corridor].wing, r.n))
+    for k, r in enumerate(ordered, start=1):
+        wing = wing_letter(layout.corridors[r.corridor].wing)
+        code = room_code(scheme, floor, r.n, wing) + r.half
+        f = r.function
+        fields = {
+            "code": code,
+            "dept": r.state.title,
+            "n": _count(counts, (f.name, r.state.title if "{dept}" in f.name else "")),
+            "city": next(cities, code) if "{city}" in f.name else "",
+        }
+        name = f.name.format(**fields)
+        words = (name if f.sign is None else f.sign.format(**fields)).strip()
+        base, dup = name, 1
+        while name.casefold() in names:  # a second "Toilets" is "Toilets 2"; its sign "Toilets"
+            dup += 1
+            name = f"{base} {dup}"
+        names.add(name.casefold())
+        aliases = []
+        for a in (a.format(**fields) for a in f.aliases):
+            if a.casefold() not in aliases_used and a.casefold() not in names:
+                aliases_used.add(a.casefold())
+                aliases.append(a)
+        room = {"id": f"room{k}", "name": name}
+        if aliases:
+            room["aliases"] = aliases
+        room["door"] = list(r.door)
+        room["sign"] = f"{code} {words}" if words else code
+        out.append(room)
+    return out
+
+
+def _count(counts: Counter, key: tuple[str, str]) -> int:
+    counts[key] += 1
+    return counts[key]
+
+
+def _waypoints(layout: Layout, g: nx.Graph) -> tuple[list[dict], dict[int, str]]:
+    """Key waypoints, named start, turnK, branchK, endK in the order met from the entrance."""
+    counters = {"turn": 0, "branch": 0, "end": 0}
+    ids: dict[int, str] = {}
+    out = []
+    for n in nx.bfs_tree(g, layout.entrance):
+        deg = g.degree(n)
+        if n == layout.entrance:
+            kind = "start"
+            ids[n] = "start"
+        else:
+            kind = "end" if deg == 1 else "turn" if deg == 2 else "branch"
+            counters[kind] += 1
+            ids[n] = f"{kind}{counters[kind]}"
+        out.append({"id": ids[n], "kind": kind, "pos": list(layout.pos[n])})
+    return out, ids
