@@ -224,6 +224,9 @@ class SimWorld:
         self.wall_source = walls
         self.scene = scene if scene is not None else WorldConfig()
         self.seed = int(seed)
+        from pmnav_bt.sim.scene.appearance import appearance_of
+
+        self.appearance = appearance_of(self)
         self._grid_plan = self._load_grid_plan(base_dir) if walls == "grid" else None
         self.lock = threading.RLock()
         self.labels: dict[int, str] = {}
@@ -399,8 +402,9 @@ class SimWorld:
         up = np.array([0.0, 0.0, height / 2.0])
         verts = [left - up, -left - up, -left + up, left + up]
         uvs = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
-        # Normals point at the light, so plates are fully lit (white) from every side.
-        normals = [list(LIGHT_DIRECTION)] * 4
+        # Normals point at the light, so plates are evenly lit from every side (as bright as
+        # the light's level makes a face turned to it).
+        normals = [list(self.appearance.light.direction)] * 4
         path = write_png(image, Path(self._tmp.name) / f"tex{len(self._body_label)}.png")
         c = self.client
         with self.lock:
@@ -545,14 +549,20 @@ class SimWorld:
         cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
         hx, hy = (x1 - x0) / 2.0, (y1 - y0) / 2.0
         self.add_box(
-            (cx, cy, -0.05), (hx, hy, 0.05), 0.0, FLOOR_RGBA, FLOOR, solid=False, collision=True
+            (cx, cy, -0.05),
+            (hx, hy, 0.05),
+            0.0,
+            self.appearance.floor,
+            FLOOR,
+            solid=False,
+            collision=True,
         )
         if self._ceiling_wanted:
             self.add_box(
                 (cx, cy, b.wall_height + 0.05),
                 (hx, hy, 0.05),
                 0.0,
-                CEILING_RGBA,
+                self.appearance.ceiling,
                 CEILING,
                 solid=False,
                 collision=True,
@@ -571,6 +581,7 @@ class SimWorld:
             self._build_room_sign(room.id, room.sign_text)
         if self._grid_plan is not None:
             self._build_grid_walls()
+        self.appearance.dress(self)
 
     def _build_grid_walls(self) -> None:
         """Walls from the grid's cells, kept clear in front of every door, sign and landmark.
@@ -595,7 +606,7 @@ class SimWorld:
             clear.append(np.array([back - t, back + t, front + t, front - t]))
         for bx in grid_wall_boxes(self._grid_plan, clear=clear):
             (cx, cy), (hx, hy) = bx.centre, bx.half
-            self.add_box((cx, cy, h / 2.0), (hx, hy, h / 2.0), 0.0, WALL_RGBA, WALL)
+            self.add_box((cx, cy, h / 2.0), (hx, hy, h / 2.0), 0.0, self.appearance.wall, WALL)
 
     def _build_walls(self) -> None:
         h = self.building.wall_height
@@ -623,14 +634,18 @@ class SimWorld:
                 if grid:  # the annotated walls only carry the doors and signs
                     continue
                 self.add_box(
-                    (mid[0], mid[1], h / 2.0), (half_len, t / 2.0, h / 2.0), yaw, WALL_RGBA, WALL
+                    (mid[0], mid[1], h / 2.0),
+                    (half_len, t / 2.0, h / 2.0),
+                    yaw,
+                    self.appearance.wall,
+                    WALL,
                 )
                 sk = (a + b) / 2.0 + inward * 0.005
                 self.add_box(
                     (sk[0], sk[1], SKIRTING_HEIGHT / 2.0),
                     (length / 2.0, 0.005, SKIRTING_HEIGHT / 2.0),
                     yaw,
-                    SKIRTING_RGBA,
+                    self.appearance.skirting,
                     WALL,
                     solid=False,
                     collision=False,
@@ -722,14 +737,20 @@ class SimWorld:
         total = DOOR_WIDTH + 2 * FRAME_WIDTH
         wi, s = self._snap(f"door of {room_id}", pt, total / 2.0)
         fw, fd = FRAME_WIDTH, FRAME_DEPTH
-        self._wall_box(wi, s, PANEL_DEPTH, DOOR_WIDTH, 0.0, DOOR_HEIGHT, DOOR_RGBA, label)
+        self._wall_box(
+            wi, s, PANEL_DEPTH, DOOR_WIDTH, 0.0, DOOR_HEIGHT, self.appearance.door, label
+        )
         for side in (-1, 1):
             js = s + side * (DOOR_WIDTH + fw) / 2.0
-            self._wall_box(wi, js, fd, fw, 0.0, DOOR_HEIGHT + fw, FRAME_RGBA, label)
-        self._wall_box(wi, s, fd, DOOR_WIDTH, DOOR_HEIGHT, DOOR_HEIGHT + fw, FRAME_RGBA, label)
+            self._wall_box(wi, js, fd, fw, 0.0, DOOR_HEIGHT + fw, self.appearance.frame, label)
+        self._wall_box(
+            wi, s, fd, DOOR_WIDTH, DOOR_HEIGHT, DOOR_HEIGHT + fw, self.appearance.frame, label
+        )
         # Lever handle near the opening edge (the viewer's right, i.e. towards -s).
         hs = s - DOOR_WIDTH / 2.0 + 0.12
-        self._wall_box(wi, hs, 0.04, 0.14, 0.98, 1.02, HANDLE_RGBA, label, out=PANEL_DEPTH)
+        self._wall_box(
+            wi, hs, 0.04, 0.14, 0.98, 1.02, self.appearance.handle, label, out=PANEL_DEPTH
+        )
         self.doors[room_id] = self._item(
             room_id, "door", label, wi, s, total, (0.0, DOOR_HEIGHT + fw)
         )
