@@ -18,7 +18,9 @@ palette per building and seed from what real functional buildings use:
 A building of another kind draws one of the three per seed. Textures are procedural
 (numpy), tiled in metres (the tiny renderer wraps texture coordinates) on quads 1 mm in
 front of the floor and the walls, so the boxes the robot collides with and every label are
-unchanged; plain walls get a per-segment shade instead (paint batches, patching).
+unchanged (the boxes a quad covers are made invisible: the tiny renderer then skips them
+instead of shading each of their pixels twice); plain walls get a per-segment shade
+instead (paint batches, patching).
 
 ``light_level`` [min, max] and ``light_turn_deg`` draw the light per episode: the clean
 light's ambient and diffuse coefficients scaled by the level (the tiny renderer's shade is
@@ -408,8 +410,16 @@ def _load_texture(world: SimWorld, surface: Surface, name: str) -> int:
         return p.loadTexture(str(path), physicsClientId=world.client)
 
 
+def _hide(world: SimWorld, body: int) -> None:
+    """Make a box the renderer draws no longer (alpha 0); it still blocks rays and the robot."""
+    with world.lock:
+        p.changeVisualShape(body, -1, rgbaColor=(1.0, 1.0, 1.0, 0.0), physicsClientId=world.client)
+
+
 def _texture_floor(world: SimWorld, surface: Surface) -> None:
-    """One quad over the floor's extent, the texture repeating every ``size_m``."""
+    """One quad over the floor's extent, the texture repeating every ``size_m``; it
+    replaces the floor box in the frames."""
+    (floor_box,) = world.bodies_with_label(FLOOR_LABEL)
     tex = _load_texture(world, surface, "floor_surface")
     x0, y0, x1, y1 = world.bounds(margin=3.0)
     z = SURFACE_OFFSET_M
@@ -417,11 +427,14 @@ def _texture_floor(world: SimWorld, surface: Surface) -> None:
     su, sv = surface.size_m
     uvs = [[x0 / su, y0 / sv], [x1 / su, y0 / sv], [x1 / su, y1 / sv], [x0 / su, y1 / sv]]
     _quad(world, corners, uvs, (0.0, 0.0, 1.0), tex, FLOOR_LABEL)
+    _hide(world, floor_box)
 
 
 def _texture_walls(world: SimWorld, surface: Surface, rng: np.random.Generator, shade: float):
     """A quad on the corridor face of every wall segment: the texture repeats every
-    ``size_m[0]`` along the wall and spans its height once; each segment is shaded a little."""
+    ``size_m[0]`` along the wall and spans its height once; each segment is shaded a little.
+    The quads replace the wall boxes in the frames."""
+    boxes = [b for b in world.bodies_with_label(WALL_LABEL) if b in world._solid]
     tex = _load_texture(world, surface, "wall_surface")
     h = world.building.wall_height
     su = surface.size_m[0]
@@ -443,6 +456,8 @@ def _texture_walls(world: SimWorld, surface: Surface, rng: np.random.Generator, 
             WALL_LABEL,
             (k, k, k, 1.0),
         )
+    for body in boxes:
+        _hide(world, body)
 
 
 def _shade_walls(world: SimWorld, rgba: RGBA, rng: np.random.Generator, shade: float) -> None:
