@@ -15,7 +15,8 @@ palette per building and seed from what real functional buildings use:
   each tile a shade apart (tiles are laid in alternating directions); wood, white or grey
   doors.
 
-A building of another kind draws one of the three per seed. Textures are procedural
+All three have suspended ceilings of 0.6 m tiles in a T-bar grid with a light panel
+every few tiles. A building of another kind draws one of the three per seed. Textures are procedural
 (numpy), tiled in metres (the tiny renderer wraps texture coordinates) on quads 1 mm in
 front of the floor and the walls, so the boxes the robot collides with and every label are
 unchanged (the boxes a quad covers are made invisible: the tiny renderer then skips them
@@ -42,6 +43,7 @@ from pmnav_bt.seams import FLOOR_LABEL, WALL_LABEL
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.textures import write_png
 from pmnav_bt.sim.world import (
+    CEILING,
     CEILING_RGBA,
     DOOR_RGBA,
     FLOOR_RGBA,
@@ -106,6 +108,7 @@ class Appearance:
     light: Light = CLEAN_LIGHT
     floor_surface: Surface | None = None
     wall_surface: Surface | None = None
+    ceiling_surface: Surface | None = None
     wall_shade: float = 0.0
 
     def dress(self, world: SimWorld) -> None:
@@ -114,6 +117,8 @@ class Appearance:
         rng = world.rng("appearance_surfaces")
         if self.floor_surface is not None:
             _texture_floor(world, self.floor_surface)
+        if self.ceiling_surface is not None and world.bodies_with_label(CEILING):
+            _texture_ceiling(world, self.ceiling_surface)
         corridor_walls = world.wall_source == "corridors"
         if self.wall_surface is not None and corridor_walls:
             _texture_walls(world, self.wall_surface, rng, self.wall_shade)
@@ -212,6 +217,7 @@ def _hospital(rng: np.random.Generator, light: Light, wall_h: float) -> Appearan
         floor_surface=Surface(floor_kind, floor_img, (floor_img.shape[1] / TEXELS_PER_M,) * 2),
         wall_surface=wall_surface,
         wall_shade=WALL_SHADE,
+        ceiling_surface=_ceiling(rng),
     )
 
 
@@ -247,6 +253,7 @@ def _school(rng: np.random.Generator, light: Light, wall_h: float) -> Appearance
         floor_surface=Surface(floor_kind, floor_img, (floor_img.shape[1] / TEXELS_PER_M,) * 2),
         wall_surface=Surface("blocks", wall_img, (wall_img.shape[1] / TEXELS_PER_M, wall_h)),
         wall_shade=WALL_SHADE,
+        ceiling_surface=_ceiling(rng),
     )
 
 
@@ -269,6 +276,7 @@ def _office(rng: np.random.Generator, light: Light, wall_h: float) -> Appearance
         light=light,
         floor_surface=Surface("carpet", floor_img, (floor_img.shape[1] / TEXELS_PER_M,) * 2),
         wall_shade=WALL_SHADE,
+        ceiling_surface=_ceiling(rng),
     )
 
 
@@ -343,6 +351,22 @@ def _carpet(rng, base, tile_m: float) -> np.ndarray:
     img[seam, :] *= 0.85
     img[:, seam] *= 0.85
     return _u8(img)
+
+
+def _ceiling(rng) -> Surface:
+    """A suspended ceiling: 0.6 m off-white tiles in a grey T-bar grid, a 0.6 x 1.2 m light
+    panel (brighter) in each 2.4 m square; 4 x 4 tiles per image."""
+    t = int(round(0.6 * TEXELS_PER_M))
+    n = 4 * t
+    tile = np.asarray(_pick(rng, ((0.93, 0.93, 0.91), (0.90, 0.90, 0.88), (0.95, 0.95, 0.95))))
+    img = np.empty((n, n, 3))
+    img[:] = tile
+    img *= 1.0 + 0.02 * rng.standard_normal((n, n, 1))
+    img[t : 3 * t, t : 2 * t] = 1.0  # the light panel: as bright as the texture goes
+    grid = (np.arange(n) % t) == 0
+    img[grid, :] = 0.62
+    img[:, grid] = 0.62
+    return Surface("ceiling_tiles", _u8(img), (n / TEXELS_PER_M, n / TEXELS_PER_M))
 
 
 def _two_tone(upper, lower, rail, wall_h: float) -> np.ndarray:
@@ -428,6 +452,20 @@ def _texture_floor(world: SimWorld, surface: Surface) -> None:
     uvs = [[x0 / su, y0 / sv], [x1 / su, y0 / sv], [x1 / su, y1 / sv], [x0 / su, y1 / sv]]
     _quad(world, corners, uvs, (0.0, 0.0, 1.0), tex, FLOOR_LABEL)
     _hide(world, floor_box)
+
+
+def _texture_ceiling(world: SimWorld, surface: Surface) -> None:
+    """One quad under the ceiling, facing down, the texture repeating every ``size_m``; it
+    replaces the ceiling box in the frames."""
+    (ceiling_box,) = world.bodies_with_label(CEILING)
+    tex = _load_texture(world, surface, "ceiling_surface")
+    x0, y0, x1, y1 = world.bounds(margin=3.0)
+    z = world.building.wall_height - SURFACE_OFFSET_M
+    corners = [np.array(v, float) for v in ((x0, y0, z), (x0, y1, z), (x1, y1, z), (x1, y0, z))]
+    su, sv = surface.size_m
+    uvs = [[x0 / su, y0 / sv], [x0 / su, y1 / sv], [x1 / su, y1 / sv], [x1 / su, y0 / sv]]
+    _quad(world, corners, uvs, (0.0, 0.0, -1.0), tex, CEILING)
+    _hide(world, ceiling_box)
 
 
 def _texture_walls(world: SimWorld, surface: Surface, rng: np.random.Generator, shade: float):
