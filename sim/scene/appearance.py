@@ -119,8 +119,9 @@ class Appearance:
             _texture_floor(world, self.floor_surface)
         if self.ceiling_surface is not None and world.bodies_with_label(CEILING):
             _texture_ceiling(world, self.ceiling_surface)
-        corridor_walls = world.wall_source == "corridors"
-        if self.wall_surface is not None and corridor_walls:
+        if world.wall_source != "corridors":
+            return  # walls from a grid's cells: one paint over the cells, no segments to vary
+        if self.wall_surface is not None:
             _texture_walls(world, self.wall_surface, rng, self.wall_shade)
         elif self.wall_shade > 0.0:
             _shade_walls(world, self.wall, rng, self.wall_shade)
