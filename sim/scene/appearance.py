@@ -112,8 +112,8 @@ class Appearance:
     wall_shade: float = 0.0
 
     def dress(self, world: SimWorld) -> None:
-        """Put the textures on the built world's floor and walls and shade plain wall
-        segments; the clean appearance has none of these and adds nothing."""
+        """Put the textures on the built world's floor, ceiling and walls and shade plain
+        wall segments; the clean appearance has none of these and adds nothing."""
         rng = world.rng("appearance_surfaces")
         if self.floor_surface is not None:
             _texture_floor(world, self.floor_surface)
