@@ -355,18 +355,19 @@ def _carpet(rng, base, tile_m: float) -> np.ndarray:
 
 
 def _ceiling(rng) -> Surface:
-    """A suspended ceiling: 0.6 m off-white tiles in a grey T-bar grid, a 0.6 x 1.2 m light
-    panel (brighter) in each 2.4 m square; 4 x 4 tiles per image."""
+    """A suspended ceiling: 0.6 m off-white tiles in a T-bar grid, a 0.6 x 1.2 m light
+    panel (brighter) in each 2.4 m square; 4 x 4 tiles per image. The grid is white-painted
+    steel, seen by its shadow line: a shade darker than the tiles, not a dark line."""
     t = int(round(0.6 * TEXELS_PER_M))
     n = 4 * t
     tile = np.asarray(_pick(rng, ((0.93, 0.93, 0.91), (0.90, 0.90, 0.88), (0.95, 0.95, 0.95))))
     img = np.empty((n, n, 3))
     img[:] = tile
     img *= 1.0 + 0.02 * rng.standard_normal((n, n, 1))
-    img[t : 3 * t, t : 2 * t] = 1.0  # the light panel: as bright as the texture goes
+    img[t : 3 * t, t : 2 * t] = np.minimum(1.0, tile + 0.05)  # the light panel
     grid = (np.arange(n) % t) == 0
-    img[grid, :] = 0.62
-    img[:, grid] = 0.62
+    img[grid, :] = tile * 0.85
+    img[:, grid] = tile * 0.85
     return Surface("ceiling_tiles", _u8(img), (n / TEXELS_PER_M, n / TEXELS_PER_M))
 
 
