@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from shapely.geometry import LineString
 
 from pmnav_bt.seams import FLOOR_LABEL, WALL_LABEL
 from pmnav_bt.sim._pybullet import p
@@ -54,6 +55,7 @@ from pmnav_bt.sim.world import (
     LIGHT_DIRECTION,
     SKIRTING_RGBA,
     WALL_RGBA,
+    WALL_THICKNESS,
 )
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -473,8 +475,9 @@ def _texture_ceiling(world: SimWorld, surface: Surface) -> None:
 def _texture_walls(world: SimWorld, surface: Surface, rng: np.random.Generator, shade: float):
     """A quad on the corridor face of every wall segment: the texture repeats every
     ``size_m[0]`` along the wall and spans its height once; each segment is shaded a little.
-    The quads replace the wall boxes in the frames."""
-    boxes = [b for b in world.bodies_with_label(WALL_LABEL) if b in world._solid]
+    The quads replace the wall boxes they cover whole in the frames (a box cut for an
+    opening stays drawn)."""
+    boxes = _segment_boxes(world)
     tex = _load_texture(world, surface, "wall_surface")
     h = world.building.wall_height
     su = surface.size_m[0]
@@ -498,6 +501,26 @@ def _texture_walls(world: SimWorld, surface: Surface, rng: np.random.Generator, 
         )
     for body in boxes:
         _hide(world, body)
+
+
+def _segment_boxes(world: SimWorld) -> list[int]:
+    """The solid wall boxes that run the whole length of a wall segment, behind it: the
+    walls a corridor-face quad covers entirely."""
+    behind = [
+        LineString(
+            [np.asarray(w.a) - np.asarray(w.normal) * WALL_THICKNESS / 2.0,
+             np.asarray(w.b) - np.asarray(w.normal) * WALL_THICKNESS / 2.0]
+        )
+        for w in world.walls
+    ]
+    out = []
+    for body in world.bodies_with_label(WALL_LABEL):
+        if body not in world._solid:
+            continue
+        footprint = world._boxes[body][0].buffer(1e-6)
+        if any(footprint.covers(line) for line in behind):
+            out.append(body)
+    return out
 
 
 def _shade_walls(world: SimWorld, rgba: RGBA, rng: np.random.Generator, shade: float) -> None:
