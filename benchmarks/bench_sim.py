@@ -1,7 +1,27 @@
-"""Simulator speed: camera frames per second, sim steps per second, building load times.
+"""Simulator speed: camera frames per second, sim steps per second, building load times,
+and what the config's world preset costs (issue 36: realistic at most 1.5x clean).
 
 Run: python benchmarks/bench_sim.py [--frames 60] [--building fig2_hospital]
-Target: >= 20 frames/s at 320x240 (RGB + depth + segmentation) on 2 CPU cores.
+         [--part all|speed|presets] [--presets clean,realistic] [--episodes 1]
+         [--set world.people_per_100m=0 ...]
+Targets: >= 20 frames/s at 320x240 (RGB + depth + segmentation) on 2 CPU cores; the
+realistic preset's episode CPU time at most 1.5x the clean preset's.
+
+The preset part measures CPU time (``time.process_time``: every thread of the process,
+so a loaded machine's waiting does not count) per preset, the presets interleaved episode
+by episode so both see the same machine:
+
+- views: a world built per building and seed (the build counted), then a scripted walk
+  of the robot's camera (the sim config's size, RGB + depth + segmentation, a reading
+  crop of a plate's size per frame), a third of the frames taken while turning;
+- episodes: whole episodes (``run_episode``: the tree, the grounder, the simulator) on a
+  hospital, a school and an office, easy and medium tiers. The grounder is the oracle
+  (``sim_gt``) unless ``--set grounder.backend=...`` says otherwise: the simulator's
+  share of the episode is then largest, so the ratio is the least forgiving.
+
+The presets are taken from the config as they stand (every knob at its preset default
+unless ``--set`` overrides it), so the figures follow whatever the presets fill a world
+with.
 """
 
 from __future__ import annotations
@@ -10,6 +30,7 @@ import argparse
 import math
 import time
 
+from pmnav_bt.config import Config, load_config
 from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.seams import DiscreteAction, MotionStatus, Pose2D
 from pmnav_bt.sim.clock import SimClock
@@ -17,6 +38,12 @@ from pmnav_bt.sim.robot import RADIUS, SimBase
 from pmnav_bt.sim.world import SimWorld
 
 TARGET_FPS_320 = 20.0
+TARGET_PRESET_RATIO = 1.5  # realistic / clean episode CPU time (issue 36)
+PRESET_BUILDINGS = ("fig2_hospital", "loop_school", "u_office")  # one per palette
+PRESET_TIERS = ("easy", "medium")
+VIEW_SEEDS = (0, 1)
+VIEW_FRAMES = 30  # per building and seed
+READING_BOX = (240, 200, 400, 260)  # a plate-sized crop of the 640-wide reading view
 
 
 def bench_fps(world: SimWorld, width: int, height: int, frames: int, **flags) -> float:
@@ -72,11 +99,111 @@ def bench_actions(world: SimWorld) -> float:
     return rate
 
 
+def preset_config(preset: str, sets: list[str]) -> Config:
+    """The config of one preset: the oracle grounder, then the user's ``--set`` overrides."""
+    return load_config(None, ["grounder.backend=sim_gt", f"world.preset={preset}", *sets])
+
+
+def view_cpu(config: Config, building: str, seed: int) -> tuple[float, float]:
+    """CPU seconds to build ``building``'s world for ``seed`` and to take ``VIEW_FRAMES``
+    frames walking and turning through it (a reading crop with each)."""
+    sim = config.sim
+    t0 = time.process_time()
+    world = SimWorld(building, walls=sim.walls, scene=config.world, seed=seed)
+    t1 = time.process_time()
+    base = SimBase(
+        world, SimClock(), width=sim.width, height=sim.height, reading_width=sim.reading_width
+    )
+    for k in range(VIEW_FRAMES):
+        if k % 3 == 2:
+            base.set_velocity(0.0, 1.0)  # a frame while turning (motion blur, if any)
+        obs = base.observe()
+        if obs.reading is not None:
+            obs.reading.crop(READING_BOX)
+        base.stop()
+        if base.execute(DiscreteAction.FORWARD if k % 3 else DiscreteAction.TURN_LEFT) != (
+            MotionStatus.IDLE
+        ):
+            base.execute(DiscreteAction.TURN_LEFT)
+    t2 = time.process_time()
+    base.close()
+    world.close()
+    return t1 - t0, t2 - t1
+
+
+def bench_presets(presets: list[str], sets: list[str], episodes: int) -> None:
+    """The preset part: per-preset CPU of built views and of whole episodes, and the ratio."""
+    from pmnav_bt.experiments.evaluation import episodes_for, run_episode
+
+    configs = {name: preset_config(name, sets) for name in presets}
+    build = {name: 0.0 for name in presets}
+    frames = {name: 0.0 for name in presets}
+    for b in PRESET_BUILDINGS:
+        for seed in VIEW_SEEDS:
+            for name, cfg in configs.items():
+                t_build, t_frames = view_cpu(cfg, b, seed)
+                build[name] += t_build
+                frames[name] += t_frames
+    n_worlds = len(PRESET_BUILDINGS) * len(VIEW_SEEDS)
+    n_frames = n_worlds * VIEW_FRAMES
+    print(f"world preset cost, views ({n_worlds} worlds, {VIEW_FRAMES} frames each, CPU time):")
+    for name in presets:
+        print(
+            f"  {name:<10} build {build[name] / n_worlds * 1000:7.1f} ms/world, "
+            f"{frames[name] / n_frames * 1000:6.1f} ms/frame (with its step and reading crop)"
+        )
+    if episodes <= 0:
+        return
+    eps, notes = episodes_for(PRESET_BUILDINGS, PRESET_TIERS, episodes, seed=0)
+    for note in notes:
+        print(f"  note: {note}")
+    cpu = {name: 0.0 for name in presets}
+    actions = {name: 0 for name in presets}
+    wins = {name: 0 for name in presets}
+    for ep in eps:
+        for name, cfg in configs.items():
+            t0 = time.process_time()
+            result = run_episode(ep, cfg, plot=False).result
+            cpu[name] += time.process_time() - t0
+            actions[name] += result.steps
+            wins[name] += int(result.success)
+    grounder = next(iter(configs.values())).grounder.backend
+    print(f"world preset cost, episodes ({len(eps)} per preset, grounder {grounder}, CPU time):")
+    for name in presets:
+        print(
+            f"  {name:<10} {cpu[name] / len(eps):6.2f} s/episode, "
+            f"{cpu[name] / max(1, actions[name]) * 1000:6.1f} ms/action, "
+            f"{wins[name]}/{len(eps)} succeeded"
+        )
+    if "clean" in cpu and "realistic" in cpu and cpu["clean"] > 0:
+        ratio = cpu["realistic"] / cpu["clean"]
+        per_action = (cpu["realistic"] / max(1, actions["realistic"])) / (
+            cpu["clean"] / max(1, actions["clean"])
+        )
+        verdict = "OK" if ratio <= TARGET_PRESET_RATIO else f"ABOVE TARGET {TARGET_PRESET_RATIO:g}"
+        print(
+            f"  realistic / clean: {ratio:.2f}x per episode, {per_action:.2f}x per action  "
+            f"{verdict}"
+        )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--frames", type=int, default=60)
     ap.add_argument("--building", default="fig2_hospital")
+    ap.add_argument("--part", choices=("all", "speed", "presets"), default="all")
+    ap.add_argument("--presets", default="clean,realistic", help="comma-separated presets")
+    ap.add_argument(
+        "--episodes", type=int, default=1, help="episodes per building and tier (0: views only)"
+    )
+    ap.add_argument(
+        "--set", action="append", default=[], dest="sets", help="config override KEY=VALUE"
+    )
     args = ap.parse_args()
+    if args.part in ("all", "presets"):
+        bench_presets(args.presets.split(","), args.sets, args.episodes)
+    if args.part == "presets":
+        return
 
     print("building load time (SimWorld from a parsed Building):")
     for name in builtin_buildings():

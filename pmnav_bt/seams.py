@@ -75,6 +75,7 @@ class CameraIntrinsics:
 # Segmentation labels of a simulated Observation (the only place they are spelled).
 FLOOR_LABEL = "floor"
 WALL_LABEL = "wall"
+CEILING_LABEL = "ceiling"
 OBSTACLE_LABEL = "obstacle"
 
 

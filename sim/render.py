@@ -12,7 +12,6 @@ import shapely
 
 from pmnav_bt.seams import CAMERA_HEIGHT_M, CREATE3_RADIUS_M, CameraIntrinsics, Pose2D
 from pmnav_bt.sim._pybullet import p
-from pmnav_bt.sim.world import LIGHT_AMBIENT, LIGHT_DIFFUSE, LIGHT_DIRECTION
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.sim.world import SimWorld
@@ -58,7 +57,8 @@ def render_camera(
 
     ``window`` (x0, y0, x1, y1, pixels of the camera's image): render only that part of
     the image (an off-axis frustum: the same pixels, for a fraction of the cost).
-    Uses pybullet's headless tiny renderer, under the world's lock.
+    Uses pybullet's headless tiny renderer, under the world's lock, lit by the world's
+    light (``world.appearance.light``).
     """
     w, h = intrinsics.width, intrinsics.height
     vfov = 2.0 * math.atan((h / 2.0) / intrinsics.fy)
@@ -71,6 +71,7 @@ def render_camera(
     eye = (x + jx, y + jy, height + jz)
     target = (eye[0] + fwd[0], eye[1] + fwd[1], eye[2] + fwd[2])
     flags = 0 if segmentation else p.ER_NO_SEGMENTATION_MASK
+    light = world.appearance.light
     with world.lock:
         world.people.show()  # the walking people where they are now
         c = world.client
@@ -98,9 +99,9 @@ def render_camera(
             view,
             proj,
             shadow=0,
-            lightDirection=LIGHT_DIRECTION,
-            lightAmbientCoeff=LIGHT_AMBIENT,
-            lightDiffuseCoeff=LIGHT_DIFFUSE,
+            lightDirection=light.direction,
+            lightAmbientCoeff=light.ambient,
+            lightDiffuseCoeff=light.diffuse,
             lightSpecularCoeff=0.0,
             renderer=p.ER_TINY_RENDERER,
             flags=flags,

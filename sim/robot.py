@@ -37,6 +37,7 @@ from pmnav_bt.seams import (
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.render import render_camera
+from pmnav_bt.sim.scene.camera_effects import CameraEffects
 from pmnav_bt.sim.world import ROBOT, SimWorld
 
 MAX_LINEAR = CREATE3_MAX_LINEAR  # m/s
@@ -62,7 +63,9 @@ class MotionStats:
 class RenderedReading:
     """A view rendered at a higher resolution when asked for (``seams.ReadingView``): RGB
     only, from the pose and heading of the observation it belongs to; ``crop`` renders
-    just the pixels asked for (a plate's crop: a few ms, the whole 640x480 view ~150 ms)."""
+    just the pixels asked for (a plate's crop: a few ms, the whole 640x480 view ~150 ms).
+    The same ``camera`` takes it as the observation (blur, exposure, noise), turning at
+    the observation's ``yaw_rate`` at time ``stamp``."""
 
     def __init__(
         self,
@@ -71,12 +74,21 @@ class RenderedReading:
         yaw_offset: float,
         intrinsics: CameraIntrinsics,
         camera_height: float,
+        camera: CameraEffects,
+        yaw_rate: float,
+        stamp: float,
     ) -> None:
         self.width, self.height = intrinsics.width, intrinsics.height
         self._args = (world, body.x, body.y, body.yaw + yaw_offset, intrinsics)
         self._height_m = camera_height
+        self._camera, self._yaw_rate, self._stamp = camera, yaw_rate, stamp
         self._rgb: np.ndarray | None = None
         self._lock = threading.Lock()
+
+    def _take(self, rgb: np.ndarray, window: tuple[int, int, int, int]) -> np.ndarray:
+        _, x, y, yaw, k = self._args
+        key = (self._stamp, x, y, yaw, *window)
+        return self._camera.apply(rgb, yaw_rate=self._yaw_rate, fx=k.fx, key=key)
 
     def rgb(self) -> np.ndarray:
         with self._lock:
@@ -84,7 +96,7 @@ class RenderedReading:
                 frame = render_camera(
                     *self._args, height=self._height_m, depth=False, segmentation=False
                 )
-                self._rgb = frame.rgb
+                self._rgb = self._take(frame.rgb, (0, 0, self.width, self.height))
             return self._rgb
 
     def crop(self, box: tuple[int, int, int, int]) -> np.ndarray:
@@ -95,10 +107,19 @@ class RenderedReading:
         window = (max(0, x0), max(0, y0), min(self.width, x1), min(self.height, y1))
         if window[2] <= window[0] or window[3] <= window[1]:
             return np.zeros((0, 0, 3), np.uint8)
+        if self._camera.identity:
+            frame = render_camera(
+                *self._args, height=self._height_m, depth=False, segmentation=False, window=window
+            )
+            return frame.rgb
+        # Rendered wider by the blur's reach, so the crop's edges blur as in the whole view.
+        m = self._camera.margin_px(self._yaw_rate, self._args[4].fx)
+        wide = (max(0, window[0] - m), window[1], min(self.width, window[2] + m), window[3])
         frame = render_camera(
-            *self._args, height=self._height_m, depth=False, segmentation=False, window=window
+            *self._args, height=self._height_m, depth=False, segmentation=False, window=wide
         )
-        return frame.rgb
+        rgb = self._take(frame.rgb, wide)
+        return rgb[:, window[0] - wide[0] : window[2] - wide[0]]
 
 
 class SimBase:
@@ -149,6 +170,7 @@ class SimBase:
         self.max_angular = max_angular
         self.stats = MotionStats()
         self.backup = None if backup_limit is None else BackupBuffer(limit=backup_limit)
+        self.camera_effects = CameraEffects.of_world(world)
         self._pose = pose if pose is not None else world.start_pose()
         self._status = MotionStatus.IDLE
         self._step: DiscreteAction | None = None
@@ -261,9 +283,11 @@ class SimBase:
     ) -> Observation:
         """Render the camera turned by ``yaw_offset`` (rad, left positive) from ``pose``
         (default: the current pose). The observation's pose is the body pose, not the
-        camera's; safe to call from a worker thread (for panoramas)."""
+        camera's; safe to call from a worker thread (for panoramas). The RGB is taken by
+        the episode's camera (``camera_effects``: blur while turning, exposure, noise)."""
         body = pose if pose is not None else self._pose
         stamp = self.clock.now()
+        yaw_rate = self.yaw_rate()
         with self.world.lock:
             labels = dict(self.world.labels)
         frame = render_camera(
@@ -276,12 +300,26 @@ class SimBase:
             depth=self.render_depth if depth is None else depth,
             segmentation=self.render_segmentation if segmentation is None else segmentation,
         )
+        yaw = body.yaw + yaw_offset
+        key = (stamp, body.x, body.y, yaw, 0, 0, self.intrinsics.width, self.intrinsics.height)
+        rgb = self.camera_effects.apply(
+            frame.rgb, yaw_rate=yaw_rate, fx=self.intrinsics.fx, key=key
+        )
         k = self.reading_intrinsics
         reading = None
         if k is not None:
-            reading = RenderedReading(self.world, body, yaw_offset, k, self.camera_height)
+            reading = RenderedReading(
+                self.world,
+                body,
+                yaw_offset,
+                k,
+                self.camera_height,
+                self.camera_effects,
+                yaw_rate,
+                stamp,
+            )
         return Observation(
-            rgb=frame.rgb,
+            rgb=rgb,
             pose=body,
             stamp=stamp,
             intrinsics=self.intrinsics,
@@ -291,6 +329,18 @@ class SimBase:
             camera_height=self.camera_height,
             reading=reading,
         )
+
+    def yaw_rate(self) -> float:
+        """The body's turn rate now (rad/s, left positive): a turning step's speed limit or
+        the commanded velocity's, 0 when it stands or is blocked."""
+        with self.world.lock:
+            if self._status != MotionStatus.MOVING:
+                return 0.0
+            if self._step == DiscreteAction.TURN_LEFT:
+                return self.max_angular
+            if self._step == DiscreteAction.TURN_RIGHT:
+                return -self.max_angular
+            return self._cmd[1] if self._step is None else 0.0
 
     def close(self) -> None:
         """Detach from the clock (the world is closed by its owner)."""

@@ -36,6 +36,7 @@ from pmnav_bt.map.catalogue import load_building, resolve_building_path
 from pmnav_bt.map.free_space import free_space_polygon
 from pmnav_bt.seams import (
     CAMERA_HEIGHT_M,
+    CEILING_LABEL,
     FLOOR_LABEL,
     OBSTACLE_LABEL,
     WALL_LABEL,
@@ -46,6 +47,7 @@ from pmnav_bt.seams import (
 )
 from pmnav_bt.sim._pybullet import p
 from pmnav_bt.sim.scene import scene_rng
+from pmnav_bt.sim.scene.appearance import WALL_THICKNESS, appearance_of
 from pmnav_bt.sim.scene.clutter import ClutterItem, place_clutter
 from pmnav_bt.sim.scene.doors import DoorLeaf, DoorState, build_leaf, door_states
 from pmnav_bt.sim.scene.people import Crowd, populate
@@ -67,7 +69,7 @@ class SimError(PmNavError):
 BACKGROUND = "background"
 FLOOR = FLOOR_LABEL
 WALL = WALL_LABEL
-CEILING = "ceiling"
+CEILING = CEILING_LABEL
 OBSTACLE = OBSTACLE_LABEL
 ROBOT = "robot"
 FIXED_LABELS = (BACKGROUND, FLOOR, WALL, CEILING, OBSTACLE, ROBOT)  # ids 0..5
@@ -78,13 +80,6 @@ WALL_SOURCES = ("corridors", "grid")  # what the simulator builds its walls from
 
 # -- appearance and sizes (metres, RGBA) -------------------------------------------------
 
-FLOOR_RGBA = (0.42, 0.45, 0.52, 1.0)
-WALL_RGBA = (0.93, 0.90, 0.80, 1.0)
-SKIRTING_RGBA = (0.25, 0.24, 0.22, 1.0)
-CEILING_RGBA = (0.97, 0.97, 0.97, 1.0)
-DOOR_RGBA = (0.58, 0.38, 0.20, 1.0)
-FRAME_RGBA = (0.30, 0.22, 0.16, 1.0)
-HANDLE_RGBA = (0.80, 0.80, 0.82, 1.0)
 PLATE_RGBA = (0.15, 0.15, 0.15, 1.0)
 METAL_RGBA = (0.70, 0.73, 0.78, 1.0)
 STEEL_DARK_RGBA = (0.35, 0.37, 0.40, 1.0)
@@ -93,14 +88,6 @@ DESK_RGBA = (0.40, 0.27, 0.18, 1.0)
 COUNTER_RGBA = (0.92, 0.92, 0.88, 1.0)
 OBSTACLE_RGBA = (0.95, 0.45, 0.10, 1.0)
 
-# Light for the tiny renderer: direction towards the light (map frame), and coefficients.
-LIGHT_DIRECTION = tuple(
-    float(v) for v in np.array([0.4, 0.3, 1.0]) / np.linalg.norm([0.4, 0.3, 1.0])
-)
-LIGHT_AMBIENT = 0.72
-LIGHT_DIFFUSE = 0.35
-
-WALL_THICKNESS = 0.10
 SKIRTING_HEIGHT = 0.10
 DOOR_WIDTH = 1.0
 DOOR_HEIGHT = 2.1
@@ -233,6 +220,7 @@ class SimWorld:
         self.wall_source = walls
         self.scene = scene if scene is not None else WorldConfig()
         self.seed = int(seed)
+        self.appearance = appearance_of(self)
         self._grid_plan = self._load_grid_plan(base_dir) if walls == "grid" else None
         self._mounts = GridMounts(self._grid_plan) if self._grid_plan is not None else None
         self.moved_items: list[MovedItem] = []  # grid walls: what was hung on the real wall
@@ -427,8 +415,9 @@ class SimWorld:
         up = np.array([0.0, 0.0, height / 2.0])
         verts = [left - up, -left - up, -left + up, left + up]
         uvs = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
-        # Normals point at the light, so plates are fully lit (white) from every side.
-        normals = [list(LIGHT_DIRECTION)] * 4
+        # Normals point at the light, so plates are evenly lit from every side (as bright as
+        # the light's level makes a face turned to it).
+        normals = [list(self.appearance.light.direction)] * 4
         path = write_png(image, Path(self._tmp.name) / f"tex{len(self._body_label)}.png")
         c = self.client
         with self.lock:
@@ -573,14 +562,20 @@ class SimWorld:
         cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
         hx, hy = (x1 - x0) / 2.0, (y1 - y0) / 2.0
         self.add_box(
-            (cx, cy, -0.05), (hx, hy, 0.05), 0.0, FLOOR_RGBA, FLOOR, solid=False, collision=True
+            (cx, cy, -0.05),
+            (hx, hy, 0.05),
+            0.0,
+            self.appearance.floor,
+            FLOOR,
+            solid=False,
+            collision=True,
         )
         if self._ceiling_wanted:
             self.add_box(
                 (cx, cy, b.wall_height + 0.05),
                 (hx, hy, 0.05),
                 0.0,
-                CEILING_RGBA,
+                self.appearance.ceiling,
                 CEILING,
                 solid=False,
                 collision=True,
@@ -602,6 +597,7 @@ class SimWorld:
             self._build_grid_walls()
         self.clutter = place_clutter(self)
         self.people = populate(self)
+        self.appearance.dress(self)  # last: it dresses what the rest built
 
     def _build_grid_walls(self) -> None:
         """Walls from the grid's cells, with each door's opening cut and the cells just in
@@ -613,7 +609,7 @@ class SimWorld:
         log.info("%s: %s", self.building.name, summary(self.moved_items))
         for bx in grid_wall_boxes(self._grid_plan, clear=grid_clearings(self)):
             (cx, cy), (hx, hy) = bx.centre, bx.half
-            self.add_box((cx, cy, h / 2.0), (hx, hy, h / 2.0), 0.0, WALL_RGBA, WALL)
+            self.add_box((cx, cy, h / 2.0), (hx, hy, h / 2.0), 0.0, self.appearance.wall, WALL)
 
     def _build_walls(self) -> None:
         h = self.building.wall_height
@@ -641,14 +637,18 @@ class SimWorld:
                 if grid:  # the annotated walls only carry the doors and signs
                     continue
                 self.add_box(
-                    (mid[0], mid[1], h / 2.0), (half_len, t / 2.0, h / 2.0), yaw, WALL_RGBA, WALL
+                    (mid[0], mid[1], h / 2.0),
+                    (half_len, t / 2.0, h / 2.0),
+                    yaw,
+                    self.appearance.wall,
+                    WALL,
                 )
                 sk = (a + b) / 2.0 + inward * 0.005
                 self.add_box(
                     (sk[0], sk[1], SKIRTING_HEIGHT / 2.0),
                     (length / 2.0, 0.005, SKIRTING_HEIGHT / 2.0),
                     yaw,
-                    SKIRTING_RGBA,
+                    self.appearance.skirting,
                     WALL,
                     solid=False,
                     collision=False,
@@ -756,12 +756,13 @@ class SimWorld:
         total = DOOR_WIDTH + 2 * FRAME_WIDTH
         wi, s = self._snap(f"door of {room_id}", pt, total / 2.0)
         fw, fd = FRAME_WIDTH, FRAME_DEPTH
-        leaf = DoorLeaf(DOOR_WIDTH, DOOR_HEIGHT, PANEL_DEPTH, DOOR_RGBA, HANDLE_RGBA)
+        look = self.appearance
+        leaf = DoorLeaf(DOOR_WIDTH, DOOR_HEIGHT, PANEL_DEPTH, look.door, look.handle)
         build_leaf(partial(self._wall_box, wi), s, label, self.door_states[room_id], leaf)
         for side in (-1, 1):
             js = s + side * (DOOR_WIDTH + fw) / 2.0
-            self._wall_box(wi, js, fd, fw, 0.0, DOOR_HEIGHT + fw, FRAME_RGBA, label)
-        self._wall_box(wi, s, fd, DOOR_WIDTH, DOOR_HEIGHT, DOOR_HEIGHT + fw, FRAME_RGBA, label)
+            self._wall_box(wi, js, fd, fw, 0.0, DOOR_HEIGHT + fw, look.frame, label)
+        self._wall_box(wi, s, fd, DOOR_WIDTH, DOOR_HEIGHT, DOOR_HEIGHT + fw, look.frame, label)
         self.doors[room_id] = self._item(
             room_id, "door", label, wi, s, total, (0.0, DOOR_HEIGHT + fw)
         )

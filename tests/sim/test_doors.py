@@ -16,7 +16,10 @@ from pmnav_bt.sim.scene.doors import CLOSED, door_states
 from pmnav_bt.sim.world import SimWorld
 
 K = CameraIntrinsics.from_hfov(160, 120, math.radians(60.0))
-MIXED = WorldConfig(preset="realistic", doors_open=0.3, doors_glass=0.2, people_per_100m=0.0)
+# Today's door colours (appearance clean), so a closed leaf is known to be wood.
+MIXED = WorldConfig(
+    preset="realistic", doors_open=0.3, doors_glass=0.2, people_per_100m=0.0, appearance="clean"
+)
 
 
 @pytest.mark.parametrize("n", [1, 7, 40])
