@@ -59,6 +59,9 @@ SIGN_COVER = 0.7  # an item before a sign is shifted by up to this much of the o
 WALL_GAP_M = 0.02  # furniture stands this far off the wall (clear of the skirting)
 TRIES_PER_ITEM = 60
 TALL_TRIES = 8  # draws of an item tall enough to stand before a given sign
+# Tries at an item before a sign; then it stands elsewhere (where plates hang high, or
+# every sign is on or above its door, few sites exist, and each try builds shapes).
+BEFORE_SIGN_TRIES = 12
 MIN_CORRIDOR_M = 0.5  # shorter corridors (stubs joining others) carry no clutter
 
 KIND_WEIGHTS: dict[str, dict[str, float]] = {
@@ -177,17 +180,24 @@ class ClutterPlan:
         return None
 
     def _sign_sites(self) -> dict[str, tuple[Mounted, Corridor, float, int]]:
-        """Every sign plate on a corridor's side wall: label -> (plate, corridor, s, away):
-        ``away`` (+-1 along s, 0 if none is near) points from the nearest door beside it."""
+        """Every sign plate on a corridor's side wall that an item may stand before:
+        label -> (plate, corridor, s, away): ``away`` (+-1 along s, 0 if none is near)
+        points from the nearest door beside it. A plate wholly within a door's approach (on or
+        above the door) is left out: an item before it would stand where the approach stays
+        clear."""
         w = self.world
         plates = [*w.signs.values(), *w.landmark_signs.values()]
         plates += [lm for lm in w.landmarks.values() if lm.z[0] >= 0.5]  # plain plates
         doors = [d for d in map(self._on_side, w.doors.values()) if d is not None]
+        door_xy = np.array([d.centre for d in w.doors.values()]).reshape(-1, 2)
         out = {}
         for it in plates:
             at = self._on_side(it)
             if at is None:
                 continue
+            gaps = np.linalg.norm(door_xy - np.asarray(it.centre), axis=1)
+            if gaps.size and gaps.min() + it.width / 2.0 < SUCCESS_RADIUS_M:
+                continue  # even its far edge is in a door's approach
             c, s, side = at
             near = [ds for dc, ds, dside in doors if dc is c and dside == side]
             near = [ds for ds in near if abs(ds - s) < 3.0]
@@ -309,14 +319,15 @@ def place_clutter(world: SceneWorld) -> list[ClutterItem]:
         return []
     rng = world.rng("clutter")
     plan = ClutterPlan(world)
-    expected = sum(w.length for w in world.walls) * scene.clutter_per_10m / 10.0
+    walls = world.walls[: world.annotated_walls]  # the corridors' walls (not grid hangers)
+    expected = sum(w.length for w in walls) * scene.clutter_per_10m / 10.0
     n = int(expected) + int(rng.random() < expected - int(expected))
     n_before = int(round(n * scene.clutter_before_signs))
     placed: list[ClutterItem] = []
     for i in range(n):
-        for _ in range(TRIES_PER_ITEM):
+        for attempt in range(TRIES_PER_ITEM):
             before = ""
-            if i < n_before:
+            if i < n_before and attempt < BEFORE_SIGN_TRIES:
                 found = plan.candidate_before_sign(rng)
                 site, before = found if found is not None else (None, "")
             else:

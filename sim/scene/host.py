@@ -40,6 +40,7 @@ class SceneWorld(Protocol):
     client: int
     lock: AbstractContextManager
     walls: Sequence[Segment]
+    annotated_walls: int  # walls[:annotated_walls] bound the corridors; the rest hang items
     doors: Mapping[str, Mounted]
     signs: Mapping[str, Mounted]
     landmarks: Mapping[str, Mounted]

@@ -63,6 +63,7 @@ class SignWorld(Protocol):
 
     building: Any
     walls: list  # WallSegment
+    annotated_walls: int  # walls[:annotated_walls] bound the corridors; the rest hang items
     doors: dict  # room id -> WallItem
     signs: dict
     directional_signs: dict
@@ -94,7 +95,9 @@ def mount_signage(world: SignWorld, signage: BuildingSignage, item: Callable[...
         world.signs[room.id] = item(*mount_room_sign(world, room.id, room.sign_text, style))
     directional = signage.directional
     if not directional and signage.wayfinding:
-        directional = junction_signs(world.building, world.walls, world.rng("wayfinding"))
+        directional = junction_signs(
+            world.building, world.walls[: world.annotated_walls], world.rng("wayfinding")
+        )
     for i, spec in enumerate(directional):
         world.label_id(directional_sign_label(i))
         fields = mount_directional_sign(world, i, spec, signage.style)
