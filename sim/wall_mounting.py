@@ -90,9 +90,10 @@ def moved_items(world) -> list[MovedItem]:
     mounts: GridMounts = world._mounts
     out = []
     for item in (*world.doors.values(), *world.signs.values(), *world.landmarks.values()):
-        wi, s = world._where[item.label]
-        if wi not in mounts.parent:
-            continue
+        where = world._where.get(item.label)
+        if where is None or where[0] not in mounts.parent:
+            continue  # a styled plate: it hangs by its door, on the door's wall
+        wi, s = where
         was, now = world.walls[mounts.parent[wi]].point(s), world.walls[wi].point(s)
         found = wi not in mounts.missed
         out.append(MovedItem(item.id, item.kind, item.label, _xy(was), _xy(now), found))

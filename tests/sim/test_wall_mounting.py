@@ -223,3 +223,18 @@ def test_sim_show_says_what_moved_and_draws_the_grid_walls(narrow, tmp_path):
     assert "5 of 7 doors, signs and landmarks moved onto the grid's walls (mean 0.5" in res.output
     img = cv2.cvtColor(cv2.imread(str(tmp_path / "narrow_top_down.png")), cv2.COLOR_BGR2RGB)
     assert (img == GRID_WALL_RGB).all(axis=2).any()
+
+
+@pytest.mark.parametrize("mounting", ["flag", "on_door", "beside_left"])
+def test_styled_plates_hang_with_their_door_on_the_grid_wall(narrow, mounting):
+    from pmnav_bt.config import WorldConfig
+
+    scene = WorldConfig(preset="realistic", people_per_100m=0.0)
+    styled = narrow.with_name(f"styled_{mounting}.yaml")
+    styled.write_text(narrow.read_text() + f"signage: {{style: {{mounting: {mounting}}}}}\n")
+    with SimWorld(styled, walls="grid", ceiling=False, scene=scene, seed=1) as w:
+        assert set(w.signs) == {"room1", "room2", "room3"}
+        doors = {m.id for m in w.moved_items if m.kind == "door"}
+        assert doors == {"room1", "room2", "room3"}
+        for room, sign in w.signs.items():  # by its door, not on the annotated wall
+            assert math.dist(sign.centre, w.doors[room].centre) < 1.5
