@@ -159,13 +159,18 @@ def run_cli(app: Callable, argv: list[str] | None, prog: str, format_error: Call
     except abort:
         _die(prog, "interrupted", 130)
     except OSError as err:  # a disk that filled up mid-write, a folder removed under us
-        name = f"{_short(err.filename, 80)}: " if err.filename else ""
+        name = f"{_path_tail(str(err.filename), 80)}: " if err.filename else ""
         _die(prog, f"{name}{err.strerror or err}", 1)
     except MemoryError:
         _die(prog, "out of memory", 1)
     except RecursionError:
         _die(prog, "input nested too deeply", 1)
     sys.exit(rv if isinstance(rv, int) else 0)
+
+
+def _path_tail(path: str, n: int) -> str:
+    """``path`` in at most ``n`` characters, cut at the front: the file's name stays."""
+    return path if len(path) <= n else "..." + path[-(n - 3) :]
 
 
 def _die(prog: str, message: str, code: int) -> None:

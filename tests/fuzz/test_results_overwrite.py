@@ -57,7 +57,7 @@ def test_interrupted_overwrite_leaves_the_earlier_results_whole(tmp_path):
     assert "stopped by SIGINT" in last and f"the earlier results in {out} are untouched" in last
     assert _files(out) == EARLIER  # not one byte of the earlier run replaced
     done = rows(staged / "results.jsonl")
-    assert 1 <= len(done) < 5 and all(r["variant"] == "pmnav" for r in done)
+    assert 1 <= len(done) < 5 and all(r["variant"] == "pmnav@clean" for r in done)
     assert "partial: stopped by SIGINT" in (staged / "results.md").read_text()
 
 
