@@ -151,6 +151,19 @@ def _lines(points, width) -> list[tuple[LineString, float]]:
     return [(LineString([p, q]), width) for p, q in zip(points, points[1:])]  # noqa: B905
 
 
+def _with_lobby_and_wings(
+    layout: Layout, lx: float, lobby_len: float, lobby_w: float, wings, wing_w: float
+) -> Layout:
+    """``layout`` with what every plan has after its main corridors: the lobby running
+    ``lobby_len`` south to the entrance from the core at (lx, 0), and the wings."""
+    layout.chain([(lx, -lobby_len), (lx, 0.0)], lobby_w, 0, "lobby")
+    for k, pts in enumerate(sorted(wings)):
+        layout.chain(pts, wing_w, k + 1, "wing")
+    layout.entrance = layout.node(lx, -lobby_len)
+    layout.core = layout.node(lx, 0.0)
+    return layout
+
+
 def spine_layout(
     rng: random.Random,
     main_w: float,
@@ -180,12 +193,7 @@ def spine_layout(
     layout = Layout("spine", lobby_w, wings=len(wings), hooks=hooks)
     xs = sorted({0.0, length, lx, *(w[0][0] for w in wings)})
     layout.chain([(x, 0.0) for x in xs], main_w, 0, "main")
-    layout.chain([(lx, -lobby_len), (lx, 0.0)], lobby_w, 0, "lobby")
-    for k, pts in enumerate(sorted(wings)):
-        layout.chain(pts, wing_w, k + 1, "wing")
-    layout.entrance = layout.node(lx, -lobby_len)
-    layout.core = layout.node(lx, 0.0)
-    return layout
+    return _with_lobby_and_wings(layout, lx, lobby_len, lobby_w, wings, wing_w)
 
 
 def ring_layout(
@@ -226,9 +234,4 @@ def ring_layout(
     layout.chain([(w, y) for y in sorted(on["e"])], main_w, 0, "ring")
     layout.chain([(x, h) for x in sorted(on["n"], reverse=True)], main_w, 0, "ring")
     layout.chain([(0.0, y) for y in sorted(on["w"], reverse=True)], main_w, 0, "ring")
-    layout.chain([(lx, -lobby_len), (lx, 0.0)], lobby_w, 0, "lobby")
-    for k, pts in enumerate(sorted(wings)):
-        layout.chain(pts, wing_w, k + 1, "wing")
-    layout.entrance = layout.node(lx, -lobby_len)
-    layout.core = layout.node(lx, 0.0)
-    return layout
+    return _with_lobby_and_wings(layout, lx, lobby_len, lobby_w, wings, wing_w)
