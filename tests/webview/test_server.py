@@ -209,3 +209,12 @@ def test_the_view_entry_is_checked_and_newer_versions_refused(tmp_path):
     write({"version": 3}, {})
     with pytest.raises(PmNavError, match="schema version 3 is newer"):
         read_tree_log(path)
+
+
+def test_the_recorded_v2_log_draws_its_map_on_any_machine(serve):
+    """The browser test's log names a built-in, so its map loads on a clean clone (a path
+    into one machine's checkout made the page wait for a map that never came)."""
+    log = DATA / "v2_fig2_room17_failed.tree.jsonl"
+    server = serve(Feed(str(log), live=False).load(log))
+    status, body = get(server, "/api/map")
+    assert status == 200 and json.loads(body).get("building") == "fig2_hospital", body[:200]
