@@ -716,6 +716,38 @@ def draft_drawing(
     return draft_building(grid, out_path, name or Path(drawing).stem, params)
 
 
+def draft_source(
+    source: str | Path,
+    out_path: str | Path,
+    name: str | None = None,
+    scale: float | None = None,
+    scale_from: str | None = None,
+    knobs: dict | None = None,
+) -> tuple[Building, Draft, str, FloorPlanImage]:
+    """Draft from a grid YAML or a drawing (by its suffix); (building, draft, text, grid).
+
+    A drawing needs its scale: ``scale`` metres per pixel, or ``scale_from`` two pixels
+    and their distance (``X1,Y1,X2,Y2,METRES``). ``knobs`` override DraftParams fields.
+    """
+    from pmnav_bt.map.drawing import DrawingError, scale_from_points
+
+    source = Path(source)
+    params = DraftParams(**(knobs or {}))
+    if source.suffix.lower() in (".yaml", ".yml"):
+        if scale is not None or scale_from is not None:
+            raise DrawingError(f"{source}: --scale and --scale-from are for drawings, not grids")
+        b, d, text = draft_building(source, out_path, name, params)
+        return b, d, text, load_ros_map(source)
+    if (scale is None) == (scale_from is None):
+        raise DrawingError(
+            f"{source}: a drawing needs its scale: --scale M_PER_PX or "
+            "--scale-from X1,Y1,X2,Y2,METRES (one of them)"
+        )
+    m_per_px = scale if scale is not None else scale_from_points(scale_from)
+    b, d, text = draft_drawing(source, out_path, m_per_px, name, params)
+    return b, d, text, load_ros_map(drawing_grid_path(out_path))
+
+
 def _flow(item: dict) -> str:
     import yaml
 
@@ -785,19 +817,20 @@ def draw_steps(plan: FloorPlanImage, d: Draft, path: str | Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m pmnav_bt.map.draft GRID.yaml -o building.yaml [--image steps.png]``."""
+    """``python -m pmnav_bt.map.draft SOURCE -o building.yaml [--scale M] [--image steps.png]``."""
     import argparse
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("grid")
+    ap.add_argument("source", help="a map_server YAML, or a drawing (PNG/JPEG) with --scale")
     ap.add_argument("-o", "--out", required=True)
+    ap.add_argument("--scale", type=float, help="a drawing's metres per pixel")
     ap.add_argument("--image")
     args = ap.parse_args(argv)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    b, d, text = draft_building(args.grid, args.out)
+    b, d, text, plan = draft_source(args.source, args.out, scale=args.scale)
     Path(args.out).write_text(text, encoding="utf-8")
     if args.image:
-        draw_steps(load_ros_map(args.grid), d, args.image)
+        draw_steps(plan, d, args.image)
     n = f"{len(b.waypoints)} waypoints, {len(b.edges)} corridors, {len(b.rooms)} door candidates"
     print(f"wrote {args.out}: {n}")
 
