@@ -771,8 +771,8 @@ def draft_text(data: dict, d: Draft, source: Path) -> str:
     for i, a in enumerate(d.open_areas):
         lines.append(
             f"# todo: open area {i + 1} (wider than a corridor) at x {a.xmin}..{a.xmax}, "
-            f"y {a.ymin}..{a.ymax}: left out of the corridors; add corridor edges across "
-            "it if the robot should use it"
+            f"y {a.ymin}..{a.ymax}: a hall; with two exits or more they meet at one "
+            "waypoint in its most open place: check the ways across it"
         )
     lines.append(yaml.safe_dump(head, sort_keys=False, width=100).strip())
     lines.append(f"floor_plan: {_flow(data['floor_plan'])}")
