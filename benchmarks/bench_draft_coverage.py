@@ -47,8 +47,9 @@ MAPS = {
     "hospital": (ROOT / "examples/hospital/hospital.yaml", None, DATA / "hospital_corridors.yaml"),
     "willow": (ROOT / "examples/maps/willow/willow.yaml", None, DATA / "willow_corridors.yaml"),
     "ccia": (_shared() / "ccia/ccia.yaml", None, None),
-    "clinic": (_shared() / "rmf/clinic/clinic.png", 0.0269, None),
-    "office": (_shared() / "rmf/office/office.png", 0.00846, None),
+    # The drawings' scales from their .building.yaml measurements (pixel pairs and metres).
+    "clinic": (_shared() / "rmf/clinic/clinic.png", 0.7 / 26.001, None),
+    "office": (_shared() / "rmf/office/office.png", 20.089 / 2374.04, None),
 }
 
 

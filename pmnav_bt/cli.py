@@ -151,26 +151,30 @@ def map_draft(
     scale_from: str | None = typer.Option(
         None, help="A drawing's scale from two pixels and their distance: X1,Y1,X2,Y2,METRES."
     ),
-    door_max: float = typer.Option(1.6, help="Widest door (m); wider places are not cut."),
-    corridor_min: float = typer.Option(1.0, help="Narrowest corridor (m); narrower is a sliver."),
-    open_width: float = typer.Option(6.0, help="Wider than this (m) is an open area, a hall."),
-    part_min: float = typer.Option(4.0, help="Shortest corridor part apart kept (m)."),
-    link_max: float = typer.Option(6.0, help="Longest straight link joining a part (m)."),
-    clutter: float = typer.Option(1.25, help="Obstacles up to this size (m) are filled."),
+    door_max: float | None = typer.Option(None, help="Widest door (m); shorter places cut."),
+    corridor_min: float | None = typer.Option(None, help="Narrowest corridor (m)."),
+    open_width: float | None = typer.Option(None, help="Wider (m) is an open area, a hall."),
+    part_min: float | None = typer.Option(None, help="Shortest part apart kept (m)."),
+    link_max: float | None = typer.Option(None, help="Longest link joining a part (m)."),
+    clutter: float | None = typer.Option(None, help="Obstacles this small (m) are filled."),
 ) -> None:
     """Draft a building file from an occupancy grid or a drawing ('pmnav map draft SRC -o FILE')."""
     from pmnav_bt.map.draft import draft_source, draw_steps
 
     out.parent.mkdir(parents=True, exist_ok=True)
-    knobs = dict(
-        door_max_m=door_max,
-        doorway_max_m=door_max,
-        corridor_min_m=corridor_min,
-        open_width_m=open_width,
-        part_min_m=part_min,
-        link_max_m=link_max,
-        clutter_m=clutter,
-    )
+    knobs = {  # the thresholds given; DraftParams holds the defaults (docs/real-maps.md)
+        k: v
+        for k, v in (
+            ("door_max_m", door_max),
+            ("doorway_max_m", door_max),
+            ("corridor_min_m", corridor_min),
+            ("open_width_m", open_width),
+            ("part_min_m", part_min),
+            ("link_max_m", link_max),
+            ("clutter_m", clutter),
+        )
+        if v is not None
+    }
     b, d, text, plan = draft_source(source, out, name, scale, scale_from, knobs)
     out.write_text(text, encoding="utf-8")
     if image is not None:

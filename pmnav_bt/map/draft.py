@@ -732,6 +732,10 @@ def draft_source(
     from pmnav_bt.map.drawing import DrawingError, scale_from_points
 
     source = Path(source)
+    for k, v in (knobs or {}).items():
+        if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
+            option = "--" + k.removesuffix("_m").replace("_", "-")
+            raise DraftError(f"{option} must be a positive number of metres, not {v!r}")
     params = DraftParams(**(knobs or {}))
     if source.suffix.lower() in (".yaml", ".yml"):
         if scale is not None or scale_from is not None:

@@ -11,6 +11,7 @@ import cv2
 import networkx as nx
 import numpy as np
 
+LINK_STEP_PX = 5  # a link may end at every fifth pixel along a corridor
 FREE_ALONG = 0.97  # a straight link needs this fraction of its pixels free (scan speckle)
 
 
@@ -61,13 +62,18 @@ def _length(h: nx.Graph, nodes) -> float:
     return sum(len(d["path"]) for _, _, d in h.subgraph(nodes).edges(data=True))
 
 
-def _nearest_on_edges(h: nx.Graph, p: np.ndarray, nodes: set) -> list[tuple[float, tuple, int]]:
-    """Per edge among ``nodes``: (distance, edge, index of its path pixel nearest ``p``)."""
-    out = []
+def _places(h: nx.Graph, nodes: set, step: int) -> tuple[np.ndarray, list]:
+    """Points of a part where a link may start or end: its waypoints, and every ``step``-th
+    pixel along its corridors; (points (N, 2), what each is: a node, or (edge, index))."""
+    pts, what = [], []
+    for m in nodes:
+        pts.append(h.nodes[m]["rc"])
+        what.append(m)
     for u, v, d in h.subgraph(nodes).edges(data=True):
-        k = int(np.argmin(np.linalg.norm(d["path"] - p, axis=1)))
-        out.append((float(np.linalg.norm(d["path"][k] - p)), (u, v), k))
-    return out
+        for k in range(step, len(d["path"]) - step, step):
+            pts.append(d["path"][k])
+            what.append(((u, v), k))
+    return np.array(pts, float), what
 
 
 def _split_edge(h: nx.Graph, u, v, k: int, new) -> None:
@@ -83,25 +89,17 @@ def _split_edge(h: nx.Graph, u, v, k: int, new) -> None:
 
 
 def _best_link(h: nx.Graph, part: set, main: set, free: np.ndarray, link_max_px: float):
-    """The shortest free straight link from ``part`` to ``main``: (from node, to node or
-    (edge, path index) to split), or None. Nodes link to nodes or to the middle of edges,
-    either way round."""
-    cands = []
-    for a, b in ((part, main), (main, part)):
-        for m in a:
-            p = h.nodes[m]["rc"]
-            for n in b:
-                cands.append((float(np.linalg.norm(h.nodes[n]["rc"] - p)), m, n))
-            for dist, e, k in _nearest_on_edges(h, p, b):
-                cands.append((dist, m, (e, k)))
-    for dist, m, target in sorted(cands, key=lambda c: c[0]):
-        if dist > link_max_px:
-            return None
-        end = h.nodes[target]["rc"] if not isinstance(target, tuple) else (
-            h.edges[target[0]]["path"][target[1]]
-        )
-        if free_along(free, h.nodes[m]["rc"], end):
-            return m, target
+    """The shortest free straight link between ``part`` and ``main``: the two places it
+    joins (a node, or (edge, path index) to split), or None."""
+    from scipy.spatial import cKDTree
+
+    step = LINK_STEP_PX
+    a_pts, a_what = _places(h, part, step)
+    b_pts, b_what = _places(h, main, step)
+    near = cKDTree(a_pts).sparse_distance_matrix(cKDTree(b_pts), link_max_px, output_type="ndarray")
+    for i, j, _ in sorted(near.tolist(), key=lambda r: r[2]):
+        if free_along(free, a_pts[int(i)], b_pts[int(j)]):
+            return a_what[int(i)], b_what[int(j)]
     return None
 
 
@@ -110,9 +108,9 @@ def link_parts(
 ) -> list[tuple[np.ndarray, float]]:
     """Join every part apart to the largest by its shortest free straight link.
 
-    A link runs from a waypoint of one to a waypoint or a corridor of the other (a new
-    waypoint splits the corridor there). Parts are joined largest first, each to whatever
-    is joined already; a part with no free straight link up to ``link_max_px`` long is
+    A link runs between waypoints or points along corridors of the two (a new waypoint
+    splits a corridor where a link meets it). Parts are joined largest first, each to
+    whatever is joined already; a part with no free straight link up to ``link_max_px`` long is
     removed. Returns per removed part its mean pixel (row, col) and length in pixels.
     """
     parts = sorted(nx.connected_components(h), key=lambda c: -_length(h, c))
@@ -128,13 +126,16 @@ def link_parts(
             best = _best_link(h, part, main, free, link_max_px)
             if best is None:
                 continue
-            m, target = best
-            if isinstance(target, tuple):
-                (u, v), k = target
-                _split_edge(h, u, v, k, nxt)
-                target, nxt = nxt, nxt + 1
+            ends = []
+            for place in best:
+                if isinstance(place, tuple):  # the middle of a corridor: split it there
+                    (u, v), k = place
+                    _split_edge(h, u, v, k, nxt)
+                    place, nxt = nxt, nxt + 1
+                ends.append(place)
+            m, target = ends
             h.add_edge(m, target, path=straight_path(h.nodes[m]["rc"], h.nodes[target]["rc"]))
-            main |= part | {target}
+            main |= part | set(ends)
             waiting.remove(part)
             changed = True
     left = []

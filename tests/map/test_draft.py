@@ -164,3 +164,24 @@ def test_a_part_that_cannot_be_joined_is_named_by_draft_and_validate(tmp_path):
     assert not _near(b, (16.0, 13.2), 2.0)
     w = unreached_warnings(b, load_ros_map(grid))
     assert len(w) == 1 and "no corridor reaches" in w[0].message
+
+
+def test_map_draft_options_set_the_thresholds(tmp_path, capsys):
+    from pmnav_bt.cli import main
+
+    grid = _grid(tmp_path, [(2, 2, 30, 4.4), (2, 12, 30, 14.4), (15.4, 4.4, 16.6, 12)])
+
+    def run(*opts):
+        with pytest.raises(SystemExit) as ex:
+            main(["map", "draft", str(grid), "-o", str(tmp_path / "b.yaml"), *opts])
+        return ex.value.code, capsys.readouterr()
+
+    # A 1.2 m corridor is a sliver when corridors are at least 1.5 m: the far corridor is
+    # then a part apart, 10 m away centre line to centre line: too far to join by default ...
+    code, out = run("--corridor-min", "1.5")
+    assert code == 0 and "has no free straight way to the rest within 6.0 m" in out.err
+    # ... and joined when links may be longer.
+    code, out = run("--corridor-min", "1.5", "--link-max", "11")
+    assert code == 0 and "warning" not in out.err
+    code, out = run("--link-max", "0")
+    assert code == 2 and "--link-max must be a positive number of metres" in out.err
