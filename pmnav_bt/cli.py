@@ -95,6 +95,7 @@ def validate(
     from pmnav_bt.map.catalogue import open_building
     from pmnav_bt.map.checks import building_warnings
     from pmnav_bt.map.priori_map import parse_building
+    from pmnav_bt.map.unreached import unreached_warnings_of
 
     try:
         b = open_building(file)
@@ -108,7 +109,7 @@ def validate(
         f"{file}: OK: {b.name}: {len(b.rooms)} rooms, {len(b.landmarks)} landmarks, "
         f"{len(b.waypoints)} key waypoints, {len(b.edges)} corridors, {len(pm.segments)} segments"
     )
-    warnings = building_warnings(b, _folder(file))
+    warnings = building_warnings(b, _folder(file)) + unreached_warnings_of(b, _folder(file))
     for w in warnings:
         typer.echo(f"{file}: warning: {w}", err=True)
     if warnings:
@@ -140,20 +141,46 @@ def map_(
 
 @app.command("map-draft")
 def map_draft(
-    grid: Path = typer.Argument(..., help="A ROS map_server YAML (its PGM beside it)."),
+    source: Path = typer.Argument(
+        ..., help="A ROS map_server YAML, or a floor-plan drawing (PNG/JPEG) with --scale."
+    ),
     out: Path = typer.Option(..., "-o", "--out", help="The building file to write."),
-    name: str | None = typer.Option(None, help="Building name (default: the grid's file name)."),
+    name: str | None = typer.Option(None, help="Building name (default: the source's file name)."),
     image: Path | None = typer.Option(None, "--image", help="Draw the extraction steps here."),
+    scale: float | None = typer.Option(None, help="A drawing's metres per pixel."),
+    scale_from: str | None = typer.Option(
+        None, help="A drawing's scale from two pixels and their distance: X1,Y1,X2,Y2,METRES."
+    ),
+    door_max: float | None = typer.Option(None, help="Widest door (m); shorter places cut."),
+    corridor_min: float | None = typer.Option(None, help="Narrowest corridor (m)."),
+    open_width: float | None = typer.Option(None, help="Wider (m) is an open area, a hall."),
+    part_min: float | None = typer.Option(None, help="Shortest part apart kept (m)."),
+    link_max: float | None = typer.Option(None, help="Longest link joining a part (m)."),
+    clutter: float | None = typer.Option(None, help="Obstacles this small (m) are filled."),
 ) -> None:
-    """Draft a building file from an occupancy grid (also: 'pmnav map draft GRID -o FILE')."""
-    from pmnav_bt.map.draft import draft_building, draw_steps
-    from pmnav_bt.map.floorplan import load_ros_map
+    """Draft a building file from an occupancy grid or a drawing ('pmnav map draft SRC -o FILE')."""
+    from pmnav_bt.map.draft import draft_source, draw_steps
 
     out.parent.mkdir(parents=True, exist_ok=True)
-    b, d, text = draft_building(grid, out, name=name)
+    knobs = {  # the thresholds given; DraftParams holds the defaults (docs/real-maps.md)
+        k: v
+        for k, v in (
+            ("door_max_m", door_max),
+            ("doorway_max_m", door_max),
+            ("corridor_min_m", corridor_min),
+            ("open_width_m", open_width),
+            ("part_min_m", part_min),
+            ("link_max_m", link_max),
+            ("clutter_m", clutter),
+        )
+        if v is not None
+    }
+    b, d, text, plan = draft_source(source, out, name, scale, scale_from, knobs)
     out.write_text(text, encoding="utf-8")
     if image is not None:
-        draw_steps(load_ros_map(grid), d, image)
+        draw_steps(plan, d, image)
+    for w in d.warnings:
+        typer.echo(f"{out}: warning: {w}", err=True)
     typer.echo(
         f"wrote {out}: {len(b.waypoints)} key waypoints, {len(b.edges)} corridors, "
         f"{len(b.rooms)} door candidates, {len(d.open_areas)} open area(s); "

@@ -3,19 +3,27 @@
 The steps (each a function, so a person can look at every stage; run
 ``python -m pmnav_bt.map.draft GRID.yaml -o building.yaml --image steps.png``):
 
-1. **Free space**: map_server's free cells, the largest connected part.
-2. **Corridor space**: the free space opened by a disc a little wider than a door,
-   so door gaps and rooms fall away; the largest part left is the corridor network.
+1. **Free space**: map_server's free cells, the largest connected part; specks closed
+   and small islands (bins, desks) filled.
+2. **Corridor space** (``corridor_space``): slivers narrower than a corridor (laser
+   fans, scan noise) opened away, the space cut at doorways (short narrow places), and
+   every piece that is long for its width kept, whatever its size: the main network
+   and the parts apart from it. Holes up to ``pillar_m`` (pillars) are filled.
 3. **Skeleton** of the corridor space (scikit-image), traced into a graph of pixel
    paths between junctions and ends; spurs shorter than the local half width plus
    ``spur_m`` are pruned and straight-through nodes merged.
 4. **Open areas**: skeleton stretches wider than ``open_width_m`` (a lobby, a hall)
-   are flagged and left out of the corridors, for the person to decide.
+   are cut out; each area becomes one waypoint at its most open point with a
+   straight corridor to each of its exits, not a lattice round its pillars.
 5. **Straight lines**: each path is split by Douglas-Peucker into straight pieces;
    every piece is fitted by total least squares, and every key waypoint moved to the
    least-squares crossing of its corridors' lines (so it sits on the centre lines).
-6. **Widths** from the distance transform along the middle of each corridor.
-7. **Door candidates**: runs along each annotated corridor wall where the wall is
+6. **Parts joined**: a part apart from the rest (cut off at a doorway, a pinch or a
+   hall) is joined to it by a straight corridor through free space from its nearest
+   waypoint, up to ``link_max_m`` long; a part that cannot be joined is left out
+   with a warning in the file and on the command line.
+7. **Widths** from the distance transform along the middle of each corridor.
+8. **Door candidates**: runs along each annotated corridor wall where the wall is
    open and free space lies behind it, as wide as a door; each is placed exactly on
    the annotated wall (half the corridor width from the centre line).
 
@@ -35,10 +43,19 @@ import networkx as nx
 import numpy as np
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.geometry import Rect
-from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
-from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map
-from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask, largest_component
+from pmnav_bt.geometry import Rect, project_points_to_segments
+from pmnav_bt.map.building import (
+    DOOR_REACH_SLACK,
+    SCHEMA_VERSION,
+    Building,
+    building_from_data,
+)
+from pmnav_bt.map.corridor_space import SpaceParams, corridor_space
+from pmnav_bt.map.draft_links import hall_hubs, link_parts
+from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map, save_ros_map
+from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask
+
+ROOM_SPUR_M = 8.0  # a dead end longer than this is a corridor, whatever lies at its end
 
 
 class DraftError(PmNavError):
@@ -47,7 +64,12 @@ class DraftError(PmNavError):
 
 @dataclass(frozen=True)
 class DraftParams:
-    """Knobs of the extraction, in metres."""
+    """Knobs of the extraction, in metres.
+
+    The defaults were measured on four real maps (the hospital SLAM map, the Willow
+    Garage office SLAM map, the CCIA university floor SLAM map and the RMF clinic
+    drawing; ``benchmarks/bench_draft_coverage.py``): see docs/real-maps.md.
+    """
 
     door_max_m: float = 1.6  # a wall opening wider than this is not a door
     door_min_m: float = 0.6  # narrower than this is noise, not a door
@@ -58,6 +80,23 @@ class DraftParams:
     min_edge_m: float = 0.8  # merge key waypoints closer than this
     clean_m: float = 0.1  # close free-space holes smaller than this (laser speckle)
     clutter_m: float = 1.25  # fill obstacles no longer than this in free space (bins, desks)
+    corridor_min_m: float = 1.0  # free space narrower than this is no corridor (laser fans)
+    doorway_max_m: float = 1.6  # a short place this narrow is a doorway: the space is cut
+    doorway_m: float = 1.2  # ... if it is no longer than this (longer: a narrow corridor)
+    corridor_ratio: float = 3.0  # a piece is corridor-shaped when this many times longer than wide
+    part_min_m: float = 4.0  # a corridor-shaped piece shorter than this is left out
+    link_max_m: float = 6.0  # join a part apart by a straight corridor up to this long
+    pillar_m: float = 2.0  # a hole in the corridor space this small is run past, not round
+    room_widening: float = 1.5  # a dead end this many times wider behind its mouth is a room
+
+    def space(self) -> SpaceParams:
+        return SpaceParams(
+            corridor_min_m=self.corridor_min_m,
+            doorway_max_m=self.doorway_max_m,
+            doorway_m=self.doorway_m,
+            corridor_ratio=self.corridor_ratio,
+            part_min_m=self.part_min_m,
+        )
 
 
 @dataclass
@@ -68,7 +107,7 @@ class Draft:
     edges: list[dict]
     rooms: list[dict]
     open_areas: list[Rect] = field(default_factory=list)  # free areas too wide for a corridor
-    notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # what was left out, and why
     # Stages, for pictures (pixel masks and the skeleton graph).
     free: np.ndarray | None = None
     corridor: np.ndarray | None = None
@@ -87,22 +126,6 @@ class Draft:
             "edges": self.edges,
             "rooms": self.rooms,
         }
-
-
-# -- masks ----------------------------------------------------------------------------
-
-
-def corridor_mask(free: np.ndarray, resolution: float, params: DraftParams) -> np.ndarray:
-    """The free space without door gaps and the rooms behind them.
-
-    Eroding by a disc wider than a door cuts every door gap (even in a wall one pixel
-    thin); the largest eroded part, grown back by the same disc within the free
-    space, is the corridor network.
-    """
-    r = round(params.door_max_m / 2.0 / resolution) + 1
-    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1,) * 2)
-    core = largest_component(cv2.erode(free.astype(np.uint8), disc))
-    return cv2.dilate(core.astype(np.uint8), disc).astype(bool) & free
 
 
 # -- skeleton graph ---------------------------------------------------------------------
@@ -230,14 +253,35 @@ def _oriented(path: np.ndarray, rc: np.ndarray, to_node: bool) -> np.ndarray:
 # -- open areas -------------------------------------------------------------------------
 
 
+def fill_pillars(corridor: np.ndarray, pillar_px: float) -> np.ndarray:
+    """The corridor space with its small holes (pillars, counters, bins) filled.
+
+    A skeleton goes round a hole both ways: a lattice of short corridors round every
+    pillar in a hall. Filled, the corridor runs past it; ``pmnav validate`` then names
+    the obstacle on the centre line, and the robot goes round it where depth shows the
+    floor beside it open.
+    """
+    n, lab, stats, _ = cv2.connectedComponentsWithStats((~corridor).astype(np.uint8), 4)
+    h, w = corridor.shape
+    x, y, bw, bh = (stats[:, i] for i in range(4))
+    inside = (x > 0) & (y > 0) & (x + bw < w) & (y + bh < h)
+    small = inside & (np.maximum(bw, bh) <= pillar_px)
+    small[0] = False
+    return corridor | small[lab]
+
+
 def open_area_mask(corridor: np.ndarray, dist_px: np.ndarray, res: float, params: DraftParams):
-    """Corridor-space pixels belonging to areas wider than ``open_width_m``."""
+    """Corridor-space pixels belonging to areas wider than ``open_width_m``.
+
+    The centres of the wide places grown by half the width limit (a distance transform,
+    not a dilation: a disc of a hundred pixels is slow) and kept inside the corridors.
+    """
     core = (dist_px * 2.0 - 1.0) * res > params.open_width_m
     if not core.any():
         return np.zeros(corridor.shape, bool)
-    r = round(params.open_width_m / 2.0 / res)
-    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1,) * 2)
-    return cv2.dilate(core.astype(np.uint8), disc).astype(bool) & corridor
+    r = params.open_width_m / 2.0 / res
+    near = cv2.distanceTransform((~core).astype(np.uint8), cv2.DIST_L2, 5) <= r
+    return near & corridor
 
 
 def _boxes(mask: np.ndarray, plan: FloorPlanImage) -> list[Rect]:
@@ -311,6 +355,62 @@ def _merge_close(h: nx.Graph, dist: np.ndarray, min_px: float) -> nx.Graph:
             changed = True
             break
     return h
+
+
+def prune_room_spurs(h: nx.Graph, dist: np.ndarray, res: float, widening: float) -> int:
+    """Remove dead ends that widen behind a narrower mouth: rooms and laser fans, not corridors.
+
+    A corridor's dead end keeps its width to the end; a room seen through a wide opening,
+    or the fan of laser rays through a door, is wider behind its mouth. Along each dead
+    end's centre line (up to ``ROOM_SPUR_M`` long), the mouth is the narrowest place in
+    the half next to the junction (past the junction's own width) and the room the
+    widest place in the far half; the dead end goes when the room is ``widening`` times
+    the mouth and 1 m wider. Repeated
+    until none goes; returns how many went.
+    """
+    gone = 0
+    changed = True
+    while changed:
+        changed = False
+        for end in [n for n in h.nodes if h.degree(n) == 1]:
+            chain = _dead_end_chain(h, end)
+            if chain is None:
+                continue
+            nodes, path = chain
+            if _path_len(path) * res > ROOM_SPUR_M:
+                continue  # a long corridor that ends in a room keeps its corridor
+            rc = np.clip(path.round().astype(int), 0, np.array(dist.shape) - 1)
+            w = 2.0 * dist[rc[:, 0], rc[:, 1]] * res
+            j = rc[0]
+            skip = int(np.searchsorted(np.linalg.norm(path - j, axis=1), dist[j[0], j[1]]))
+            half = max(len(path) // 2, skip + 1)
+            if half >= len(path):
+                continue
+            mouth, room = float(w[skip:half].min()), float(w[half:].max())
+            if room >= widening * mouth and room - mouth >= 1.0:
+                h.remove_nodes_from(nodes)
+                gone += 1
+                changed = True
+    return gone
+
+
+def _dead_end_chain(h: nx.Graph, end) -> tuple[list, np.ndarray] | None:
+    """The waypoints from a dead end back to its junction (not included), and the pixel
+    path from the junction out to the end; None for a corridor on its own."""
+    nodes, paths, prev, cur = [end], [], None, end
+    while True:
+        nxt = [m for m in h.neighbors(cur) if m != prev]
+        if len(nxt) != 1:
+            return None
+        paths.append(_oriented(h.edges[cur, nxt[0]]["path"], h.nodes[cur]["rc"], to_node=False))
+        prev, cur = cur, nxt[0]
+        if h.degree(cur) >= 3:
+            break
+        if h.degree(cur) == 1:
+            return None
+        nodes.append(cur)
+    out = [p[::-1] for p in reversed(paths)]
+    return nodes, np.vstack([out[0], *(p[1:] for p in out[1:])])
 
 
 def _fit_lines(h: nx.Graph, world: dict, dist_m: dict) -> dict:
@@ -427,12 +527,14 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
     free = free_mask(plan, params.clean_m, params.clutter_m)
     if not free.any():
         raise DraftError(f"{plan.source}: the grid has no free cells")
-    corridor = corridor_mask(free, res, params)
+    corridor, _ = corridor_space(free, res, params.space())
     if not corridor.any():
         raise DraftError(
-            f"{plan.source}: no free area wider than a door ({params.door_max_m} m); "
-            "check resolution and the free/occupied thresholds"
+            f"{plan.source}: no corridor-shaped free space (at least {params.corridor_min_m} m "
+            f"wide and {params.corridor_ratio} times longer than wide); check resolution and "
+            "the free/occupied thresholds"
         )
+    corridor = fill_pillars(corridor, params.pillar_m / res)
     dist = distance_map(free)
     open_mask = open_area_mask(corridor, dist, res, params)
     skel = skeletonize(corridor) & ~open_mask
@@ -442,12 +544,17 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
         raise DraftError(f"{plan.source}: no corridor found in the free space")
     h = _split_straight(g, params.line_tol_m / res)
     h = _merge_close(h, dist, params.min_edge_m / res)
-    notes = []
-    parts = sorted(nx.connected_components(h), key=len, reverse=True)
-    if len(parts) > 1:
-        notes.append(f"{len(parts) - 1} small corridor part(s) apart from the rest were left out")
-        h = h.subgraph(parts[0]).copy()
     h.remove_edges_from(nx.selfloop_edges(h))
+    prune_room_spurs(h, dist, res, params.room_widening)
+    hall_hubs(h, open_mask, free, dist)
+    warnings = []
+    for rc, n_px in link_parts(h, free, params.link_max_m / res):
+        x, y = plan.pixel_to_world([rc[::-1]])[0]
+        warnings.append(
+            f"a corridor part of {n_px * res:.0f} m near ({x:.1f}, {y:.1f}) has no free straight "
+            f"way to the rest within {params.link_max_m} m (--link-max): left out; "
+            "join it by hand if the robot should reach it"
+        )
 
     def to_world(rc: np.ndarray) -> np.ndarray:
         return plan.pixel_to_world(np.asarray(rc).reshape(-1, 2)[:, ::-1])
@@ -470,7 +577,9 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
         w = centre_line_width(plan, dist, pos[u], pos[v], half[u] + 0.2, half[v] + 0.2)
         if w is None:
             w = 2.0 * float(np.median(d["half"]))
-        widths[frozenset((u, v))] = round(w, 2)
+        # A short link through a doorway can measure next to nothing: no corridor is
+        # narrower than the narrowest the draft looks for.
+        widths[frozenset((u, v))] = round(max(w, params.corridor_min_m), 2)
 
     open_areas = _boxes(open_mask, plan)
     names = _name_nodes(h, pos, open_areas)
@@ -494,7 +603,24 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
                 continue  # the mouth of a corridor meeting this one, not a door
             xy = [round(float(x), 2) for x in door]
             rooms.append({"id": f"room{len(rooms) + 1}", "door": xy})
-    return Draft(waypoints, edges, rooms, open_areas, notes, free, corridor, skel)
+    rooms = _reachable_doors(rooms, edges, {names[n]: pos[n] for n in h.nodes})
+    return Draft(waypoints, edges, rooms, open_areas, warnings, free, corridor, skel)
+
+
+def _reachable_doors(rooms: list[dict], edges: list[dict], pos: dict) -> list[dict]:
+    """The door candidates whose nearest corridor reaches them (as the building file checks).
+
+    A candidate on the wall of a wide corridor (a hall's) can lie nearer the centre line
+    of a narrow one that does not reach it; such a candidate is dropped, renumbered.
+    """
+    if not rooms:
+        return rooms
+    a = np.array([pos[e["from"]] for e in edges])
+    b = np.array([pos[e["to"]] for e in edges])
+    half = np.array([e["width"] / 2.0 for e in edges])
+    j, _, dist = project_points_to_segments(np.array([r["door"] for r in rooms]), a, b)
+    kept = [r for r, jj, d in zip(rooms, j, dist, strict=True) if d <= half[jj] + DOOR_REACH_SLACK]
+    return [{"id": f"room{i + 1}", "door": r["door"]} for i, r in enumerate(kept)]
 
 
 def _beside(p: np.ndarray, a: np.ndarray, b: np.ndarray, width: float) -> bool:
@@ -564,6 +690,68 @@ def draft_building(
     return b, d, draft_text(data, d, grid_yaml)
 
 
+def drawing_grid_path(out_path: str | Path) -> Path:
+    """Where a drawing's grid is written for the building at ``out_path``: ``NAME_grid.yaml``."""
+    out_path = Path(out_path)
+    return out_path.with_name(f"{out_path.stem}_grid.yaml")
+
+
+def draft_drawing(
+    drawing: str | Path,
+    out_path: str | Path,
+    scale_m_per_px: float,
+    name: str | None = None,
+    params: DraftParams = DraftParams(),
+) -> tuple[Building, Draft, str]:
+    """Draft a building from a floor-plan drawing; its grid is written beside ``out_path``.
+
+    The drawing is read as a grid (``pmnav_bt.map.drawing``), saved as a map_server
+    map (``drawing_grid_path``) so the building's floor plan and ``sim.walls=grid``
+    work at once, and drafted like any grid.
+    """
+    from pmnav_bt.map.drawing import drawing_plan
+
+    plan = drawing_plan(drawing, scale_m_per_px)
+    grid = save_ros_map(plan, drawing_grid_path(out_path), ".png")  # PNG: a tenth of a PGM
+    return draft_building(grid, out_path, name or Path(drawing).stem, params)
+
+
+def draft_source(
+    source: str | Path,
+    out_path: str | Path,
+    name: str | None = None,
+    scale: float | None = None,
+    scale_from: str | None = None,
+    knobs: dict | None = None,
+) -> tuple[Building, Draft, str, FloorPlanImage]:
+    """Draft from a grid YAML or a drawing (by its suffix); (building, draft, text, grid).
+
+    A drawing needs its scale: ``scale`` metres per pixel, or ``scale_from`` two pixels
+    and their distance (``X1,Y1,X2,Y2,METRES``). ``knobs`` override DraftParams fields.
+    """
+    from pmnav_bt.map.drawing import DrawingError, scale_from_points
+
+    source = Path(source)
+    for k, v in (knobs or {}).items():
+        if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
+            option = "--" + k.removesuffix("_m").replace("_", "-")
+            raise DraftError(f"{option} must be a positive number of metres, not {v!r}")
+    params = DraftParams(**(knobs or {}))
+    if source.suffix.lower() in (".yaml", ".yml"):
+        if scale is not None or scale_from is not None:
+            raise DrawingError(f"{source}: --scale and --scale-from are for drawings, not grids")
+        b, d, text = draft_building(source, out_path, name, params)
+        return b, d, text, load_ros_map(source)
+    if (scale is None) == (scale_from is None):
+        raise DrawingError(
+            f"{source}: a drawing needs its scale: --scale M_PER_PX or "
+            "--scale-from X1,Y1,X2,Y2,METRES (one of them)"
+        )
+    m_per_px = scale if scale is not None else scale_from_points(scale_from)
+    b, d, text = draft_drawing(source, out_path, m_per_px, name, params)
+    return b, d, text, load_ros_map(drawing_grid_path(out_path))
+
+
 def _flow(item: dict) -> str:
     import yaml
 
@@ -582,13 +770,13 @@ def draft_text(data: dict, d: Draft, source: Path) -> str:
         "#       add landmarks (elevators, stairs, desks, signs); check which end is 'start'.",
         "# Then: pmnav validate THIS_FILE, and look at pmnav map THIS_FILE --image map.png.",
     ]
-    for note in d.notes:
-        lines.append(f"# note: {note}")
+    for warning in d.warnings:
+        lines.append(f"# warning: {warning}")
     for i, a in enumerate(d.open_areas):
         lines.append(
             f"# todo: open area {i + 1} (wider than a corridor) at x {a.xmin}..{a.xmax}, "
-            f"y {a.ymin}..{a.ymax}: left out of the corridors; add corridor edges across "
-            "it if the robot should use it"
+            f"y {a.ymin}..{a.ymax}: a hall; with two exits or more they meet at one "
+            "waypoint in its most open place: check the ways across it"
         )
     lines.append(yaml.safe_dump(head, sort_keys=False, width=100).strip())
     lines.append(f"floor_plan: {_flow(data['floor_plan'])}")
@@ -633,19 +821,20 @@ def draw_steps(plan: FloorPlanImage, d: Draft, path: str | Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m pmnav_bt.map.draft GRID.yaml -o building.yaml [--image steps.png]``."""
+    """``python -m pmnav_bt.map.draft SOURCE -o building.yaml [--scale M] [--image steps.png]``."""
     import argparse
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("grid")
+    ap.add_argument("source", help="a map_server YAML, or a drawing (PNG/JPEG) with --scale")
     ap.add_argument("-o", "--out", required=True)
+    ap.add_argument("--scale", type=float, help="a drawing's metres per pixel")
     ap.add_argument("--image")
     args = ap.parse_args(argv)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    b, d, text = draft_building(args.grid, args.out)
+    b, d, text, plan = draft_source(args.source, args.out, scale=args.scale)
     Path(args.out).write_text(text, encoding="utf-8")
     if args.image:
-        draw_steps(load_ros_map(args.grid), d, args.image)
+        draw_steps(plan, d, args.image)
     n = f"{len(b.waypoints)} waypoints, {len(b.edges)} corridors, {len(b.rooms)} door candidates"
     print(f"wrote {args.out}: {n}")
 

@@ -299,10 +299,13 @@ def _is_number(v: Any) -> bool:
 # -- saving ----------------------------------------------------------------------------
 
 
-def save_ros_map(plan: FloorPlanImage, yaml_path: str | Path) -> Path:
-    """Write ``plan`` as a map_server map: ``<stem>.pgm`` beside the YAML. Returns the YAML path."""
+def save_ros_map(plan: FloorPlanImage, yaml_path: str | Path, image_suffix: str = ".pgm") -> Path:
+    """Write ``plan`` as a map_server map: ``<stem>.pgm`` (or .png) beside the YAML.
+
+    Returns the YAML path.
+    """
     yaml_path = Path(yaml_path)
-    pgm = yaml_path.with_suffix(".pgm")
+    pgm = yaml_path.with_suffix(image_suffix)
     grey = plan.image if plan.image.ndim == 2 else np.rint(plan.grey()).astype(np.uint8)
     if not cv2.imwrite(str(pgm), grey):
         raise FloorPlanError(pgm, "", "cannot write the map image; check the folder exists")

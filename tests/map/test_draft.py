@@ -7,7 +7,7 @@ import pytest
 
 from pmnav_bt.map.catalogue import builtin_buildings, load_building
 from pmnav_bt.map.draft import DraftError, draft_building
-from pmnav_bt.map.floorplan import FloorPlanImage, rasterize_building, save_ros_map
+from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map, rasterize_building, save_ros_map
 
 
 def _draft(name, tmp_path):
@@ -114,3 +114,74 @@ def test_pmnav_map_draft_command(tmp_path, capsys):
     assert load_building(out).floor_plan.ros_map == "../g.yaml"
     assert (tmp_path / "s.png").is_file()
     assert "3 key waypoints, 2 corridors, 31 door candidates" in capsys.readouterr().out
+
+
+def _grid(tmp_path, rects, size=(34.0, 16.0), res=0.05, name="g"):
+    """A map_server grid: unknown everywhere but the free rectangles (x0, y0, x1, y1)."""
+    w, h = round(size[0] / res), round(size[1] / res)
+    img = np.full((h, w), 205, np.uint8)
+    for x0, y0, x1, y1 in rects:
+        img[h - round(y1 / res) : h - round(y0 / res), round(x0 / res) : round(x1 / res)] = 254
+    return save_ros_map(FloorPlanImage(img, res, (0.0, 0.0, 0.0)), tmp_path / f"{name}.yaml")
+
+
+def _near(b, xy, tol=1.0):
+    return any(np.hypot(w.pos[0] - xy[0], w.pos[1] - xy[1]) <= tol for w in b.waypoints)
+
+
+def test_a_narrow_corridor_between_wide_ones_is_a_corridor(tmp_path):
+    # Two 2.4 m corridors joined by a 1.2 m one, narrower than a wide door: the draft used
+    # to cut it away with the rooms, and the second wide corridor with it.
+    grid = _grid(tmp_path, [(2, 2, 30, 4.4), (2, 12, 30, 14.4), (15.4, 4.4, 16.6, 12)])
+    b, d, _ = draft_building(grid, tmp_path / "b.yaml")
+    for xy in ((2.5, 3.2), (29.5, 3.2), (2.5, 13.2), (29.5, 13.2)):
+        assert _near(b, xy), xy
+    pos = {w.id: np.array(w.pos) for w in b.waypoints}
+    narrow = [e for e in b.edges if abs((pos[e.a] + pos[e.b])[0] / 2 - 16.0) < 0.3]
+    assert narrow and all(abs(b.edge_width(e) - 1.2) <= 0.2 for e in narrow)
+    assert not d.warnings
+
+
+def test_a_corridor_part_beyond_a_doorway_is_joined(tmp_path):
+    # A fire door 0.9 m wide parts a 28 m corridor in two: both halves stay, joined.
+    grid = _grid(tmp_path, [(2, 6, 15.8, 8.4), (16.2, 6, 30, 8.4), (15.8, 6.75, 16.2, 7.65)])
+    b, d, _ = draft_building(grid, tmp_path / "b.yaml")
+    assert _near(b, (2.5, 7.2)) and _near(b, (29.5, 7.2))
+    assert not d.warnings
+
+
+def test_a_part_that_cannot_be_joined_is_named_by_draft_and_validate(tmp_path):
+    from pmnav_bt.map.unreached import unreached_warnings
+
+    # The second corridor is reached only by a 0.8 m passage with a bend: no corridor,
+    # and no straight way.
+    rects = [(2, 2, 30, 4.4), (2, 12, 30, 14.4), (30, 2, 30.8, 9), (22, 8.2, 30.8, 9),
+             (22, 8.2, 22.8, 12)]
+    grid = _grid(tmp_path, rects)
+    b, d, text = draft_building(grid, tmp_path / "b.yaml")
+    assert len(d.warnings) == 1 and "no free straight way" in d.warnings[0]
+    assert "# warning: a corridor part of 2" in text
+    assert not _near(b, (16.0, 13.2), 2.0)
+    w = unreached_warnings(b, load_ros_map(grid))
+    assert len(w) == 1 and "no corridor reaches" in w[0].message
+
+
+def test_map_draft_options_set_the_thresholds(tmp_path, capsys):
+    from pmnav_bt.cli import main
+
+    grid = _grid(tmp_path, [(2, 2, 30, 4.4), (2, 12, 30, 14.4), (15.4, 4.4, 16.6, 12)])
+
+    def run(*opts):
+        with pytest.raises(SystemExit) as ex:
+            main(["map", "draft", str(grid), "-o", str(tmp_path / "b.yaml"), *opts])
+        return ex.value.code, capsys.readouterr()
+
+    # A 1.2 m corridor is a sliver when corridors are at least 1.5 m: the far corridor is
+    # then a part apart, 10 m away centre line to centre line: too far to join by default ...
+    code, out = run("--corridor-min", "1.5")
+    assert code == 0 and "has no free straight way to the rest within 6.0 m" in out.err
+    # ... and joined when links may be longer.
+    code, out = run("--corridor-min", "1.5", "--link-max", "11")
+    assert code == 0 and "warning" not in out.err
+    code, out = run("--link-max", "0")
+    assert code == 2 and "--link-max must be a positive number of metres" in out.err

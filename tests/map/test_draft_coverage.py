@@ -1,0 +1,105 @@
+"""Draft coverage: the measure itself, and the drafts of real maps against hand annotations."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from pmnav_bt.loading import InputFileError
+from pmnav_bt.map.building import building_from_data
+from pmnav_bt.map.draft import draft_building
+from pmnav_bt.map.draft_coverage import load_annotation, measure
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = Path(__file__).resolve().parent / "data"
+# The issue's targets: a draft covers 90 % of the annotated corridor length, and at most
+# 10 % of what it drafts is spurious.
+TARGET_COVERAGE, TARGET_SPURIOUS = 0.90, 0.10
+
+
+def _building(points: dict, edges: list[tuple[str, str]]):
+    wps = [{"id": k, "kind": "start" if i == 0 else "turn", "pos": list(p)}
+           for i, (k, p) in enumerate(points.items())]
+    deg = {k: sum(k in e for e in edges) for k in points}
+    for w in wps[1:]:
+        w["kind"] = {1: "end", 2: "turn"}.get(deg[w["id"]], "branch")
+    data = {
+        "schema_version": 1,
+        "name": "t",
+        "corridor_width": 2.0,
+        "waypoints": wps,
+        "edges": [{"from": a, "to": b} for a, b in edges],
+        "rooms": [],
+    }
+    return building_from_data(data, "<test>")
+
+
+def _annotation(tmp_path, text: str):
+    f = tmp_path / "ann.yaml"
+    f.write_text(text, encoding="utf-8")
+    return load_annotation(f)
+
+
+def test_coverage_and_spurious_are_fractions_of_length(tmp_path):
+    ann = _annotation(
+        tmp_path, "corridors:\n  - [[0, 0], [20, 0]]\n  - [[20, 0], [20, 10]]\n"
+    )
+    # The draft follows the first corridor 0.5 m off its line (within the 0.75 m
+    # tolerance), misses the second but for its first 1.25 m (within 0.75 m of the draft's
+    # corner at (20, 0.5)), and adds 11 m going south of which the first 1.25 m lie
+    # within 0.75 m of the annotation.
+    b = _building({"a": (0, 0.5), "b": (20, 0.5), "c": (20, -10.5)}, [("a", "b"), ("b", "c")])
+    m = measure(b, ann)
+    assert m.annotated_m == pytest.approx(30.0)
+    assert m.coverage == pytest.approx(21.25 / 30.0, abs=0.01)
+    assert m.spurious == pytest.approx(9.75 / 31.0, abs=0.01)
+
+
+def test_what_lies_in_an_open_area_is_not_spurious(tmp_path):
+    text = (
+        "corridors:\n  - [[0, 0], [20, 0]]\n"
+        "open_areas:\n  - [[18, -1], [30, -1], [30, 12], [18, 12]]\n"
+    )
+    ann = _annotation(tmp_path, text)
+    b = _building({"a": (0, 0), "b": (20, 0), "c": (26, 10)}, [("a", "b"), ("b", "c")])
+    m = measure(b, ann)
+    assert m.coverage == pytest.approx(1.0)
+    assert m.spurious == pytest.approx(0.0)
+
+
+def test_a_malformed_annotation_is_one_clear_error(tmp_path):
+    with pytest.raises(InputFileError, match="corridors"):
+        _annotation(tmp_path, "corridors:\n  - [[0, 0], [1]]\n")
+
+
+REAL = {
+    "hospital": (ROOT / "examples/hospital/hospital.yaml", DATA / "hospital_corridors.yaml"),
+    "willow": (ROOT / "examples/maps/willow/willow.yaml", DATA / "willow_corridors.yaml"),
+}
+
+
+@pytest.fixture(scope="module", params=sorted(REAL))
+def measured(request, tmp_path_factory):
+    grid, ann = REAL[request.param]
+    out = tmp_path_factory.mktemp(request.param) / "building.yaml"
+    b, _, _ = draft_building(grid, out)
+    return request.param, measure(b, load_annotation(ann))
+
+
+def test_draft_finds_most_of_a_real_building(measured):
+    # Before the draft cut its corridor space only at doorways, it found 79 % of the
+    # hospital's annotated corridors and none of the Willow Garage office's.
+    name, m = measured
+    assert m.coverage >= 0.75, (name, m)
+    assert m.spurious <= 0.5, (name, m)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="not met yet: measured hospital 88.6 % covered / 37.5 % spurious, willow 78.0 % / "
+    "47.6 %: corridors into rooms with wide openings and along laser fans (docs/real-maps.md)",
+)
+def test_draft_meets_the_coverage_target(measured):
+    name, m = measured
+    assert m.coverage >= TARGET_COVERAGE and m.spurious <= TARGET_SPURIOUS, (name, m)
