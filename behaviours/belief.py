@@ -251,28 +251,41 @@ class NoSignInReach(PmNavBehaviour):
     one of several mirror-image places has a sign, the six views between the panorama's
     are not worth their turn. Before the first glimpse the share is that of the last
     estimate (0 or 1), else of the whole map (a sign-sparse building has signs in reach
-    of a fifth of its corridors). FAILURE otherwise.
+    of a fifth of its corridors). FAILURE otherwise. The share (``sign_share``: tens of ms
+    on a large belief, the map's readable lattice the first time) is weighed in the worker.
 
     Reads ``belief``, ``map_T_odom``."""
 
     READS = ("belief", "map_T_odom")
+    JOBS = ("_job",)
+
+    def initialise(self) -> None:
+        ctx, belief, tf = self.ctx, self.get("belief"), self.get("map_T_odom")
+        pose, reach = ctx.base.pose(), sign_lead_range(ctx.config)
+        self._job = ctx.worker.submit(lambda c: sign_share(ctx.pm, reach, belief, tf, pose))
+        self.feedback_message = "weighing where signs are in reach"
 
     def update(self) -> Status:
-        belief: CorridorBelief | None = self.get("belief")
-        pose = self.ctx.base.pose()
-        if belief is not None and belief.ref is not None:
-            share, of = belief.sign_in_reach(pose), "the belief"
-        else:  # before the first glimpse: the last estimate, else anywhere on the map
-            vis = Visibility.of(self.ctx.pm, sign_lead_range(self.ctx.config))
-            tf = self.get("map_T_odom")
-            if tf is not None:
-                share = float(bool(vis.readable_from(se2_apply(tf, (pose.x, pose.y)))))
-                of = "the last estimate"
-            else:
-                share = float(np.mean([bool(p.readable) for p in vis.lattice_points]))
-                of = "the corridors"
+        status, got = self.poll(self._job, "weighing where signs are in reach")
+        if status is not None:
+            return status
+        share, of = got
         self.feedback_message = f"{share:.0%} of {of} puts a sign in reach"
         return Status.SUCCESS if share < NO_SIGN_SHARE else Status.FAILURE
+
+
+def sign_share(pm, reach: float | None, belief, map_T_odom, pose: Pose2D) -> tuple[float, str]:
+    """The share of the belief (with a glimpse), else of the last estimate (``map_T_odom``:
+    0 or 1), else of the map's corridors, that puts a sign within ``reach`` of ``pose``
+    (odometry), and which of the three it is."""
+    if belief is not None and belief.ref is not None:
+        return belief.sign_in_reach(pose), "the belief"
+    vis = Visibility.of(pm, reach)
+    if map_T_odom is not None:
+        return float(bool(vis.readable_from(se2_apply(map_T_odom, (pose.x, pose.y))))), (
+            "the last estimate"
+        )
+    return float(np.mean([bool(p.readable) for p in vis.lattice_points])), "the corridors"
 
 
 class DriveEnd(StrEnum):

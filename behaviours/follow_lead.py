@@ -9,11 +9,11 @@ the most open view of the last panorama.
   steers the heading), and face it again.
 - ``DriveAlongCorridor``: drive, keeping parallel to the walls seen in depth (odometry's
   rotation error does not steer it into a wall) and adding the walls' axis and the free
-  floor ahead to the belief every metre. It ends when the distance is covered (cut short
-  when a sign comes into view ahead: look round near it), when the lead worked out again
-  every few metres goes another way, at a wall ahead (the corridor ends: the belief notes
-  the way blocked), when the body is blocked (the tree then backs off the wall with the
-  ``BackUp`` recovery), or at a corner early in the drive.
+  floor ahead to the belief every metre (weighed in the worker). It ends when the distance
+  is covered (cut short when a sign comes into view ahead: look round near it), when the
+  lead worked out again every few metres goes another way, at a wall ahead (the corridor
+  ends: the belief notes the way blocked), when the body is blocked (the tree then backs
+  off the wall with the ``BackUp`` recovery), or at a corner early in the drive.
 - ``SlidePastCorner``: a wall met in the drive's first metres with open floor on one
   side of it is a corner: slide past it, then align and drive on (once a drive).
 
@@ -300,22 +300,25 @@ class DriveAlongCorridor(_LooksAtWalls):
     ``MIN_BLOCKED_DRIVE_M``). That tick at rest comes before the body turns to slide or
     reverses.
 
-    Reads ``belief``, ``corridor_drive``; writes ``corridor_drive``, ``drive_end``.
+    Reads ``belief``, ``corridor_drive``; writes ``belief`` (with a drive ray weighed in,
+    in the worker), ``corridor_drive``, ``drive_end``.
     """
 
     READS = ("belief", "corridor_drive")
-    WRITES = ("corridor_drive", "drive_end")
-    JOBS = ("_look", "_rethink_job")
+    WRITES = ("belief", "corridor_drive", "drive_end")
+    JOBS = ("_look", "_rethink_job", "_ray_job")
 
     def initialise(self) -> None:
         super().initialise()
         self._rethink_job = None
+        self._ray_job = None
         self._best_t = self.ctx.now()
         self._stopped = False
 
     def update(self) -> Status:
-        if self._stopped:  # the tick at rest after stopping for a corner or a block
-            return Status.SUCCESS
+        self._take_ray()
+        if self._stopped:  # at rest after stopping: for a corner or a block, or for a ray
+            return Status.RUNNING if self._ray_job is not None else Status.SUCCESS
         base, now, drive = self.ctx.base, self.ctx.now(), self.drive
         pose = base.pose()
         if (took := self._take_look()) is not None:
@@ -324,14 +327,12 @@ class DriveAlongCorridor(_LooksAtWalls):
         # At the lead's end: stop, unless driving on to a wall ahead measures the distance.
         if done_m >= drive.distance and not self._approach_to_measure(base, done_m):
             base.set_velocity(0.0, 0.0)
-            self.bb.set("drive_end", DriveEnd.SIGN if drive.sign_stop else DriveEnd.COVERED)
-            return Status.SUCCESS
+            return self._end(DriveEnd.SIGN if drive.sign_stop else DriveEnd.COVERED)
         if self._rethink(pose):
             # The belief now says another way: look again from here.
             base.set_velocity(0.0, 0.0)
-            self.bb.set("drive_end", DriveEnd.RETHOUGHT)
             self.feedback_message = f"after {done_m:.1f} m the belief says another way: look again"
-            return Status.SUCCESS
+            return self._end(DriveEnd.RETHOUGHT)
         self._cut_short_for_signs(done_m)
         if done_m > drive.best + 0.1:
             drive.best, self._best_t = done_m, now
@@ -346,8 +347,7 @@ class DriveAlongCorridor(_LooksAtWalls):
                 return self._end_after_rest(DriveEnd.CORNER)
             self._note_blocked()
             self.feedback_message = f"a wall ahead after {done_m:.1f} m: the corridor ends"
-            self.bb.set("drive_end", DriveEnd.WALL)
-            return Status.SUCCESS
+            return self._end(DriveEnd.WALL)
         if base.motion_status() == MotionStatus.BLOCKED or stuck:
             base.stop()
             if done_m >= MIN_BLOCKED_DRIVE_M:
@@ -359,6 +359,15 @@ class DriveAlongCorridor(_LooksAtWalls):
         err = math.atan2(math.sin(drive.heading - pose.yaw), math.cos(drive.heading - pose.yaw))
         lim = self.ctx.limits
         base.set_velocity(lim.linear, max(-lim.angular, min(lim.angular, 2.0 * err)))
+        return Status.RUNNING
+
+    def _end(self, end: DriveEnd) -> Status:
+        """End the drive (the body stopped): SUCCESS, or while a drive ray is still being
+        weighed, RUNNING at rest until it is in the belief the next look adds to."""
+        self.bb.set("drive_end", end)
+        if self._ray_job is None:
+            return Status.SUCCESS
+        self._stopped = True
         return Status.RUNNING
 
     def _end_after_rest(self, end: DriveEnd) -> Status:
@@ -388,12 +397,15 @@ class DriveAlongCorridor(_LooksAtWalls):
     def _note_ray(self, look: WallLook, axis: float | None) -> None:
         """Add the free floor ahead, the walls' axis (odometry; None: not seen) and the
         doors seen along the walls (None: not looked for) to the belief every
-        ``RAY_SPACING_M`` of the drive. Not after the odometry's distance gain
-        has changed until the next look moves the belief to it (in the worker: too slow for
-        a tick): a ray would mix two gains."""
+        ``RAY_SPACING_M`` of the drive. Weighing every hypothesis with them (10-20 ms on
+        a sign-sparse building's belief) runs in the worker, on a fork of the belief that
+        replaces it when done (``_take_ray``); one ray at a time, and none while the lead
+        is worked out again on the belief. Not after the odometry's distance gain has
+        changed until the next look moves the belief to it: a ray would mix two gains."""
         belief: CorridorBelief | None = self.get("belief")
-        if belief is None or look.free is None or self._rethink_job is not None:
-            return  # (not while the lead is worked out again on the belief, in the worker)
+        busy = self._rethink_job is not None or self._ray_job is not None
+        if belief is None or look.free is None or busy:
+            return
         base, drive, seen_from = self.ctx.base, self.drive, look.seen_from
         if isinstance(base, CalibratedBase) and belief.rescale_due(base.distance_gain):
             return
@@ -401,7 +413,30 @@ class DriveAlongCorridor(_LooksAtWalls):
         if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:
             return
         drive.last_ray = (seen_from.x, seen_from.y)
-        belief.observe_ray(seen_from, min(look.free, 50.0), axis, look.doors)
+        free, doors = min(look.free, 50.0), look.doors
+
+        def weigh(cancelled) -> CorridorBelief:
+            fork = belief.fork()
+            fork.observe_ray(seen_from, free, axis, doors)
+            return fork
+
+        self._ray_job = self.ctx.worker.submit(weigh)
+
+    def _take_ray(self) -> None:
+        """The belief with the last drive ray weighed in, in place of the one it was forked
+        from (with what the drive noted on that one since: ``pending_blocked``)."""
+        job = self._ray_job
+        if job is None or not job.done():
+            return
+        self._ray_job = None
+        try:
+            fork = job.result()
+        except Exception:  # noqa: BLE001 - a lost ray: the belief stays as it was
+            return
+        was: CorridorBelief | None = self.get("belief")
+        if was is not None:
+            fork.pending_blocked = was.pending_blocked
+        self.bb.set("belief", fork)
 
     def _rethink(self, pose: Pose2D) -> bool:
         """Whether the lead, worked out again (worker) every ``RETHINK_EVERY_M`` of the drive
@@ -417,7 +452,7 @@ class DriveAlongCorridor(_LooksAtWalls):
                 return False
         drive = self.drive
         moved = math.hypot(pose.x - drive.thought_at[0], pose.y - drive.thought_at[1])
-        if belief is not None and moved >= RETHINK_EVERY_M:
+        if belief is not None and moved >= RETHINK_EVERY_M and self._ray_job is None:
             drive.thought_at = (pose.x, pose.y)
             heading, most = drive.heading, drive.max_distance
             self._rethink_job = self.ctx.worker.submit(

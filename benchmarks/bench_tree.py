@@ -9,8 +9,10 @@ busy. Two worker modes are measured:
   a pessimistic figure for the robot, whose worker decodes images and runs models.
 
 The sign_sparse_2 case starts with no sign in reach: the corridor belief is built,
-weighed with each look (``UpdateBelief``, in the worker) and with the depth along each
-drive (``behaviours/follow_lead.py``), which is where the slowest ticks were.
+weighed with each look (``UpdateBelief``) and with the depth along each drive
+(``behaviours/follow_lead.py``), and asked whether a sign is in reach
+(``NoSignInReach``), all in the worker; the drive's rays weighed in the tick were the
+slowest ticks (10 ms of CPU each, p99 7 ms of CPU, before they moved).
 
 ``--log`` says where the tree log goes: nowhere (``none``, the default), a file
 (``file``), or the live web view (``view``: a ``pmnav view`` server fed through its

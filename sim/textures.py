@@ -15,9 +15,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from pmnav_bt.map.signage import ROOM_NUMBER
+from pmnav_bt.map.signage import HISTORICAL_PLATE_M, ROOM_NUMBER
 
-PLATE_WIDTH_M = 0.8  # every plate is this wide
+PLATE_WIDTH_M = HISTORICAL_PLATE_M  # every plate is this wide
 LINE_PITCH_M = 0.12  # height of one text line on the plate
 MARGIN_M = 0.05  # white margin above and below the text
 TEXELS_PER_M = 200.0  # texture resolution on the plate (see the module docstring)

@@ -33,7 +33,30 @@ from pmnav_bt.config import WorldConfig
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.map.building import Building, Landmark, WaypointKind
 from pmnav_bt.map.catalogue import load_building, resolve_building_path
-from pmnav_bt.map.free_space import free_space_polygon
+from pmnav_bt.map.floorplan import DOOR_WIDTH_M
+from pmnav_bt.map.free_space import free_space_polygon, free_space_rings
+from pmnav_bt.map.landmark_kinds import (
+    DESK,
+    DESK_DEPTH_M,
+    DESK_LENGTH_M,
+    ELEVATOR,
+    ELEVATOR_FRAME_M,
+    ELEVATOR_PANEL_M,
+    ELEVATOR_WIDTH_M,
+    PLATE_BACKING_M,
+    STAIRS,
+    STAIRS_DEPTH_M,
+    STAIRS_LENGTH_M,
+    landmark_shape,
+)
+from pmnav_bt.map.wall_items import (
+    DOOR_FRAME_M,
+    WallPlacer,
+    WallSegment,
+    annotated_walls,
+    door_item,
+    landmark_item,
+)
 from pmnav_bt.seams import (
     CAMERA_HEIGHT_M,
     CEILING_LABEL,
@@ -89,47 +112,14 @@ COUNTER_RGBA = (0.92, 0.92, 0.88, 1.0)
 OBSTACLE_RGBA = (0.95, 0.45, 0.10, 1.0)
 
 SKIRTING_HEIGHT = 0.10
-DOOR_WIDTH = 1.0
 DOOR_HEIGHT = 2.1
-FRAME_WIDTH = 0.08
 FRAME_DEPTH = 0.04  # how far door frames stand out of the wall
 PANEL_DEPTH = 0.02
 SIGN_CENTRE_Z = CAMERA_HEIGHT_M  # sign plates are centred at camera height
-ELEVATOR_WIDTH = 1.6
 ELEVATOR_HEIGHT = 2.2
 STAIRS_STEPS = 6
-STAIRS_LENGTH = 1.8
-STAIRS_DEPTH = 0.45
 STAIRS_RISE = 0.17
-DESK_LENGTH = 1.8
-DESK_DEPTH = 0.6
 DESK_HEIGHT = 1.0
-
-_ELEVATOR_KINDS = {"elevator", "lift"}
-_STAIRS_KINDS = {"stairs", "stair", "staircase", "stairway"}
-_DESK_KINDS = {"reception_desk", "reception", "desk", "counter", "information_desk"}
-
-
-@dataclass(frozen=True)
-class WallSegment:
-    """One straight piece of the free-space boundary; ``normal`` points into the free space."""
-
-    a: tuple[float, float]
-    b: tuple[float, float]
-    normal: tuple[float, float]
-
-    @property
-    def length(self) -> float:
-        return math.dist(self.a, self.b)
-
-    @property
-    def tangent(self) -> np.ndarray:
-        d = np.subtract(self.b, self.a)
-        return d / np.linalg.norm(d)
-
-    def point(self, s: float) -> np.ndarray:
-        """The point ``s`` metres from ``a`` towards ``b``."""
-        return np.asarray(self.a, float) + s * self.tangent
 
 
 @dataclass(frozen=True)
@@ -166,15 +156,6 @@ class RayHit:
     distance: float
     point: tuple[float, float, float]
     normal: tuple[float, float, float]
-
-
-def _rings(geom: Polygon | MultiPolygon) -> list[list[tuple[float, float]]]:
-    polys = geom.geoms if isinstance(geom, MultiPolygon) else [geom]
-    rings = []
-    for poly in polys:
-        rings.append(list(poly.exterior.coords)[:-1])
-        rings.extend(list(r.coords)[:-1] for r in poly.interiors)
-    return rings
 
 
 def _xy(v) -> tuple[float, float]:
@@ -234,10 +215,10 @@ class SimWorld:
         self._solid: set[int] = set()
         self._boxes: dict[int, tuple[Polygon, float]] = {}  # solid body -> footprint, bottom z
         self._probe_shapes: dict[tuple[float, float], int] = {}
-        self._occupied: dict[int, list[tuple[float, float]]] = {}
         self._where: dict[str, tuple[int, float]] = {}  # label -> (wall, s) of the main item
         self._tmp = tempfile.TemporaryDirectory(prefix="pmnav_sim_")
         self.walls: list[WallSegment] = []
+        self._placer = WallPlacer(self.walls)  # what hangs where on them (_build_walls)
         self.annotated_walls = 0  # walls[:annotated_walls] bound the free space; the rest
         # are the grid's real walls that items hang on (walls="grid", ``_mount``)
         self.doors: dict[str, WallItem] = {}
@@ -615,7 +596,9 @@ class SimWorld:
         h = self.building.wall_height
         t = WALL_THICKNESS
         grid = self.wall_source == "grid"
-        for ring in _rings(self.free_space):
+        self.walls.extend(annotated_walls(self.free_space))
+        self._placer = WallPlacer(self.walls)
+        for ring in free_space_rings(self.free_space):
             n = len(ring)
             pts = [np.asarray(q, float) for q in ring]
             for i in range(n):
@@ -633,7 +616,6 @@ class SimWorld:
                 mid = (a + b) / 2.0 + tan * (ext_b - ext_a) / 2.0 - inward * t / 2.0
                 yaw = math.atan2(tan[1], tan[0])
                 half_len = length / 2.0 + (ext_a + ext_b) / 2.0
-                self.walls.append(WallSegment(_xy(a), _xy(b), _xy(inward)))
                 if grid:  # the annotated walls only carry the doors and signs
                     continue
                 self.add_box(
@@ -659,39 +641,22 @@ class SimWorld:
 
     def _nearest_wall(self, pt: tuple[float, float]) -> tuple[int, float]:
         """Index of the wall segment nearest to ``pt`` and the distance along it."""
-        q = np.asarray(pt, float)
-        best, best_d, best_s = -1, math.inf, 0.0
-        for i, w in enumerate(self.walls[: self.annotated_walls]):
-            a = np.asarray(w.a)
-            s = float(np.clip(np.dot(q - a, w.tangent), 0.0, w.length))
-            d = float(np.linalg.norm(q - w.point(s)))
-            if d < best_d - 1e-9:
-                best, best_d, best_s = i, d, s
-        return best, best_s
+        return self._placer.nearest(pt)
 
     def _fits(self, wall: int, s0: float, s1: float) -> bool:
-        w = self.walls[wall]
-        if s0 < -1e-6 or s1 > w.length + 1e-6:
-            return False
-        return all(s1 <= o0 or s0 >= o1 for o0, o1 in self._occupied.get(wall, []))
+        return self._placer.fits(wall, s0, s1)
 
     def _occupy(self, wall: int, s: float, half: float) -> None:
-        self._occupied.setdefault(wall, []).append((s - half, s + half))
+        self._placer.occupy(wall, s, half)
 
     def _snap(self, what: str, pt: tuple[float, float], half: float) -> tuple[int, float]:
         """Wall and position along it for an item ``2*half`` wide nearest to ``pt`` (with
-        grid walls, the real wall behind that place: ``_mount``)."""
-        wi, s = self._nearest_wall(pt)
-        w = self.walls[wi]
-        if w.length < 2.0 * half:
-            log.warning("%s: wall %.2f m long is too short for %.2f m", what, w.length, 2 * half)
-            s = w.length / 2.0
-        else:
-            s = float(np.clip(s, half, w.length - half))
-        if not self._fits(wi, s - half, s + half):
-            log.warning("%s at %s overlaps another item on the same wall", what, pt)
-        self._occupy(wi, s, half)
-        return self._mount(wi, s, half), s
+        grid walls, the real wall behind that place: ``_mount``); what does not fit there
+        is logged (``pmnav validate`` warns of the same, ``map.wall_items``)."""
+        placed = self._placer.place(what, pt, half)
+        for problem in placed.problems:
+            log.warning("%s", problem)
+        return self._mount(placed.wall, placed.s, half), placed.s
 
     def _mount(self, wi: int, s: float, half: float) -> int:
         """Where the item at ``s`` on annotated wall ``wi`` hangs: with grid walls, on a wall
@@ -703,7 +668,7 @@ class SimWorld:
         a, b, normal, found = self._mounts.real_wall(w.a, w.b, w.normal, s, half)
         self.walls.append(WallSegment(a, b, normal))
         mounted = len(self.walls) - 1
-        self._occupied[mounted] = self._occupied.setdefault(wi, [])
+        self._placer.share(mounted, wi)
         self._mounts.record(mounted, wi, found)
         return mounted
 
@@ -753,16 +718,16 @@ class SimWorld:
 
     def _build_door(self, room_id: str, pt: tuple[float, float]) -> None:
         label = door_label(room_id)
-        total = DOOR_WIDTH + 2 * FRAME_WIDTH
-        wi, s = self._snap(f"door of {room_id}", pt, total / 2.0)
-        fw, fd = FRAME_WIDTH, FRAME_DEPTH
+        total = DOOR_WIDTH_M + 2 * DOOR_FRAME_M
+        wi, s = self._snap(door_item(room_id), pt, total / 2.0)
+        fw, fd = DOOR_FRAME_M, FRAME_DEPTH
         look = self.appearance
-        leaf = DoorLeaf(DOOR_WIDTH, DOOR_HEIGHT, PANEL_DEPTH, look.door, look.handle)
+        leaf = DoorLeaf(DOOR_WIDTH_M, DOOR_HEIGHT, PANEL_DEPTH, look.door, look.handle)
         build_leaf(partial(self._wall_box, wi), s, label, self.door_states[room_id], leaf)
         for side in (-1, 1):
-            js = s + side * (DOOR_WIDTH + fw) / 2.0
+            js = s + side * (DOOR_WIDTH_M + fw) / 2.0
             self._wall_box(wi, js, fd, fw, 0.0, DOOR_HEIGHT + fw, look.frame, label)
-        self._wall_box(wi, s, fd, DOOR_WIDTH, DOOR_HEIGHT, DOOR_HEIGHT + fw, look.frame, label)
+        self._wall_box(wi, s, fd, DOOR_WIDTH_M, DOOR_HEIGHT, DOOR_HEIGHT + fw, look.frame, label)
         self.doors[room_id] = self._item(
             room_id, "door", label, wi, s, total, (0.0, DOOR_HEIGHT + fw)
         )
@@ -827,35 +792,35 @@ class SimWorld:
             mount_signage(self, self._signage, WallItem)
 
     def _build_landmark(self, lm: Landmark) -> None:
-        kind = lm.kind.lower()
+        shape = landmark_shape(lm.kind)
         label = landmark_label(lm.id)
         text = lm.sign_text
-        if kind in _ELEVATOR_KINDS:
+        if shape is ELEVATOR:
             item = self._build_elevator(lm, label)
-        elif kind in _STAIRS_KINDS:
+        elif shape is STAIRS:
             item = self._build_stairs(lm, label)
-        elif kind in _DESK_KINDS:
+        elif shape is DESK:
             item = self._build_desk(lm, label)
         else:
-            half = (self._plate_texture(text).width_m + 0.02) / 2.0
-            wi, s = self._snap(f"landmark {lm.id}", lm.pos, half)
+            half = (self._plate_texture(text).width_m + PLATE_BACKING_M) / 2.0
+            wi, s = self._snap(landmark_item(lm.id), lm.pos, half)
             item = self._build_plate(lm.id, label, text, wi, s, SIGN_CENTRE_Z, lm.kind)
             self.landmarks[lm.id] = item
             return
         self.landmarks[lm.id] = item
         wi, s = self._where[label]
-        if kind in _ELEVATOR_KINDS:
+        if shape is ELEVATOR:
             wi, s, z = self._plate_beside(item, wi, s, f"sign of {lm.id}", text)
         else:  # above the steps or the desk, on the wall at camera height
             z = SIGN_CENTRE_Z
         self.landmark_signs[lm.id] = self._build_plate(lm.id, label, text, wi, s, z, "lmsign")
 
     def _build_elevator(self, lm: Landmark, label: str) -> WallItem:
-        fw = 0.12
-        total = ELEVATOR_WIDTH + 2 * fw + 0.3  # the call button panel beside it
-        wi, s = self._snap(f"landmark {lm.id}", lm.pos, total / 2.0)
-        s_door = s + 0.15  # the call panel sits on the viewer's right (-s)
-        half = ELEVATOR_WIDTH / 4.0
+        fw = ELEVATOR_FRAME_M
+        total = ELEVATOR.span_m  # the doors, their frame and the call-button panel beside it
+        wi, s = self._snap(landmark_item(lm.id), lm.pos, total / 2.0)
+        s_door = s + ELEVATOR_PANEL_M / 2.0  # the call panel sits on the viewer's right (-s)
+        half = ELEVATOR_WIDTH_M / 4.0
         for side in (-1, 1):
             self._wall_box(
                 wi,
@@ -869,7 +834,7 @@ class SimWorld:
             )
             self._wall_box(
                 wi,
-                s_door + side * (ELEVATOR_WIDTH + fw) / 2.0,
+                s_door + side * (ELEVATOR_WIDTH_M + fw) / 2.0,
                 0.06,
                 fw,
                 0.0,
@@ -882,13 +847,13 @@ class SimWorld:
             wi,
             s_door,
             0.06,
-            ELEVATOR_WIDTH,
+            ELEVATOR_WIDTH_M,
             ELEVATOR_HEIGHT,
             ELEVATOR_HEIGHT + fw,
             STEEL_DARK_RGBA,
             label,
         )
-        panel = s_door - ELEVATOR_WIDTH / 2.0 - fw - 0.15
+        panel = s_door - ELEVATOR_WIDTH_M / 2.0 - fw - ELEVATOR_PANEL_M / 2.0
         self._wall_box(wi, panel, 0.02, 0.12, 0.95, 1.25, STEEL_DARK_RGBA, label)
         self._wall_box(wi, panel, 0.015, 0.05, 1.05, 1.10, (0.95, 0.75, 0.2, 1.0), label, out=0.02)
         return self._item(
@@ -903,24 +868,25 @@ class SimWorld:
         )
 
     def _build_stairs(self, lm: Landmark, label: str) -> WallItem:
-        wi, s = self._snap(f"landmark {lm.id}", lm.pos, STAIRS_LENGTH / 2.0)
-        step = STAIRS_LENGTH / STAIRS_STEPS
+        wi, s = self._snap(landmark_item(lm.id), lm.pos, STAIRS.span_m / 2.0)
+        step = STAIRS_LENGTH_M / STAIRS_STEPS
         for k in range(STAIRS_STEPS):
-            sk = s - STAIRS_LENGTH / 2.0 + (k + 0.5) * step
+            sk = s - STAIRS_LENGTH_M / 2.0 + (k + 0.5) * step
             self._wall_box(
-                wi, sk, STAIRS_DEPTH, step, 0.0, (k + 1) * STAIRS_RISE, STEP_RGBA[k % 2], label
+                wi, sk, STAIRS_DEPTH_M, step, 0.0, (k + 1) * STAIRS_RISE, STEP_RGBA[k % 2], label
             )
         top = STAIRS_STEPS * STAIRS_RISE
-        return self._item(lm.id, lm.kind, label, wi, s, STAIRS_LENGTH, (0.0, top), lm.sign_text)
+        return self._item(lm.id, lm.kind, label, wi, s, STAIRS_LENGTH_M, (0.0, top), lm.sign_text)
 
     def _build_desk(self, lm: Landmark, label: str) -> WallItem:
-        wi, s = self._snap(f"landmark {lm.id}", lm.pos, (DESK_LENGTH + 0.1) / 2.0)
-        self._wall_box(wi, s, DESK_DEPTH, DESK_LENGTH, 0.0, DESK_HEIGHT - 0.04, DESK_RGBA, label)
+        wi, s = self._snap(landmark_item(lm.id), lm.pos, DESK.span_m / 2.0)
+        top = DESK_HEIGHT - 0.04  # the desk, under its counter top
+        self._wall_box(wi, s, DESK_DEPTH_M, DESK_LENGTH_M, 0.0, top, DESK_RGBA, label)
         self._wall_box(
             wi,
             s,
-            DESK_DEPTH + 0.1,
-            DESK_LENGTH + 0.1,
+            DESK.depth_m,
+            DESK.span_m,
             DESK_HEIGHT - 0.04,
             DESK_HEIGHT,
             COUNTER_RGBA,
@@ -932,7 +898,7 @@ class SimWorld:
             label,
             wi,
             s,
-            DESK_LENGTH + 0.1,
+            DESK.span_m,
             (0.0, DESK_HEIGHT),
             lm.sign_text,
         )

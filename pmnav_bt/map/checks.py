@@ -12,6 +12,8 @@ A building that loads is well formed; these checks look for what makes runs fail
   on the grid's wall, or leaves it standing free);
 - corridor stretches with fewer than two readable signs within reading range
   (localization has nothing to match there);
+- a door or landmark on a wall too short for it, or two on one stretch of wall
+  (``pmnav_bt.map.wall_items``: the simulator hangs them by the same placer);
 - no start waypoint.
 """
 
@@ -26,8 +28,9 @@ from pmnav_bt.errors import Problem
 from pmnav_bt.geometry import project_points_to_segments
 from pmnav_bt.map.building import Building, WaypointKind
 from pmnav_bt.map.floorplan import DOOR_WIDTH_M, FloorPlanImage, door_frames, load_floor_plan
-from pmnav_bt.map.free_space import free_space_polygon
+from pmnav_bt.map.free_space import free_space_polygon, free_space_rings
 from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask
+from pmnav_bt.map.wall_items import wall_item_warnings
 from pmnav_bt.map.wall_surface import SEARCH_M, RealWalls, nearest_boundary_point
 
 DOOR_OFF_WALL_M = 0.3  # a door farther than this from its annotated wall
@@ -47,7 +50,8 @@ def building_warnings(
     b: Building, base_dir: str | Path | None = None, plan: FloorPlanImage | None = None
 ) -> list[Problem]:
     """Every warning for a valid building; grid checks need ``plan`` or a loadable floor plan."""
-    out = door_warnings(b) + shape_warnings(b) + sign_warnings(b) + start_warnings(b)
+    out = door_warnings(b) + wall_item_warnings(b) + shape_warnings(b) + sign_warnings(b)
+    out += start_warnings(b)
     if plan is None and b.floor_plan is not None and base_dir is not None:
         try:
             plan = load_floor_plan(b, base_dir)
@@ -242,10 +246,7 @@ def mount_warnings(b: Building, plan: FloorPlanImage, tol: float = MOUNT_TOL_M) 
     ``SEARCH_M`` (``pmnav_bt.map.wall_surface``, the search the simulator mounts them by)."""
     if not (b.rooms or b.landmarks):
         return []
-    poly = free_space_polygon(b)
-    polys = getattr(poly, "geoms", [poly])
-    rings = [list(g.exterior.coords)[:-1] for g in polys]
-    rings += [list(r.coords)[:-1] for g in polys for r in g.interiors]
+    rings = free_space_rings(free_space_polygon(b))
     walls = RealWalls(plan)
     items = [
         (f"rooms[{i}].door", f"the door of {r.id!r} (and its sign)", r.door, DOOR_WIDTH_M / 2.0)

@@ -30,3 +30,15 @@ def free_space_polygon(building: Building) -> Polygon | MultiPolygon:
     if isinstance(geom, MultiPolygon):
         return MultiPolygon([orient(g, 1.0) for g in geom.geoms])
     return orient(geom, 1.0)
+
+
+def free_space_rings(geom: Polygon | MultiPolygon) -> list[list[tuple[float, float]]]:
+    """The boundary of the free space as closed rings of points (the last point not
+    repeated): each part's exterior (counter-clockwise) and its holes (clockwise), so the
+    free space is on the left going round every ring."""
+    polys = geom.geoms if isinstance(geom, MultiPolygon) else [geom]
+    rings = []
+    for poly in polys:
+        rings.append([(float(x), float(y)) for x, y in poly.exterior.coords[:-1]])
+        rings.extend([(float(x), float(y)) for x, y in r.coords[:-1]] for r in poly.interiors)
+    return rings

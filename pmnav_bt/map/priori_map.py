@@ -340,11 +340,10 @@ def parse_building(b: Building) -> PrioriMap:
             chain.append(node_id)
         chain.append(e.b)
         width = b.edge_width(e)
+        along = heading(a_xy, b_xy)  # every segment's: a 0 m one (two items at one spot) too
         for u, v in pairwise(chain):
             pu, pv = nodes[u].pos, nodes[v].pos
-            seg = Segment(
-                len(segments) + 1, u, v, math.dist(pu, pv), heading(pu, pv), (e.a, e.b), width
-            )
+            seg = Segment(len(segments) + 1, u, v, math.dist(pu, pv), along, (e.a, e.b), width)
             segments.append(seg)
             graph.add_edge(u, v, length=seg.length, segment=seg.index)
 

@@ -38,7 +38,8 @@ SIGN_FONTS: dict[str, str | None] = {
     "dejavu_sans_mono_bold": "DejaVuSansMono-Bold.ttf",
 }
 
-PLATE_WIDTH_LIMITS_M = (0.1, 0.8)  # a door-number plate to the historical 0.8 m plate
+HISTORICAL_PLATE_M = 0.8  # the simulator's first plates: every one this wide (sim/textures.py)
+PLATE_WIDTH_LIMITS_M = (0.1, HISTORICAL_PLATE_M)  # a door-number plate to the historical plate
 CAP_HEIGHT_LIMITS_M = (0.015, 0.09)  # capitals; 0.0864 m is the historical plate's
 HEIGHT_LIMITS_M = (0.9, 2.8)  # plate centre above the floor (flag signs hang at 2.1-2.5 m)
 MAX_DIRECTIONAL = 500

@@ -28,6 +28,9 @@ from pmnav_bt.seams import PlanStart as SeamStart
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.backends import BackendDeps
 
+SAME_PLACE_M = 1e-6  # route points closer than this are one place (no leg to drive between)
+
+
 @dataclass(frozen=True)
 class GraphPlanner:
     """Shortest-path planner over the priori-map (the default planner)."""
@@ -138,6 +141,33 @@ def _target_of(
     return None, None
 
 
+def _places(
+    pm: PrioriMap, sp: StartPoint, start_xy: np.ndarray, nodes: list[str]
+) -> tuple[list[np.ndarray], list[str | None], list[str]]:
+    """The route as the places the robot passes: their points, the node at each (None for a
+    start point off every node) and the name of the segment that leads there.
+
+    Consecutive route points at one place are one place: the start on its first node, or
+    two landmarks at one spot of a wall, which the map links to one point of the centre
+    line with a 0 m segment between them. A step over that segment would have no distance
+    to drive and no heading (it would read as a turn around and back). The later node is
+    kept, so the goal stays the last place, with the segment that led to the place.
+    """
+    pts, route, via = [np.asarray(start_xy, float)], [None], [sp.segment.name]
+    for n in nodes:
+        xy = pm.node_xy(n)
+        seg = sp.segment.name
+        if route[-1] is not None and pm.graph.has_edge(route[-1], n):
+            seg = pm.segments[graph_segment(pm, route[-1], n) - 1].name
+        if np.linalg.norm(xy - pts[-1]) < SAME_PLACE_M:
+            pts[-1], route[-1] = xy, n
+        else:
+            pts.append(xy)
+            route.append(n)
+            via.append(seg)
+    return pts, route, via
+
+
 def build_plan(
     pm: PrioriMap,
     sp: StartPoint,
@@ -150,13 +180,7 @@ def build_plan(
     avoid_landmarks: frozenset[str] = frozenset(),
 ) -> Plan:
     """Turn a node route into plan steps (actions, predictions, forks, sides)."""
-    pts = [start_xy] + [pm.node_xy(n) for n in nodes]
-    # Drop the start point when it sits on the first node.
-    if np.linalg.norm(pts[1] - pts[0]) < 1e-6:
-        pts = pts[1:]
-        route = list(nodes)  # index i of route matches pts[i]
-    else:
-        route = [None, *nodes]
+    pts, route, via = _places(pm, sp, start_xy, nodes)  # index i of route matches pts[i]
     cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
     notes: list[str] = []
     if len(pts) == 1:
@@ -196,19 +220,15 @@ def build_plan(
         node = pm.nodes[node_id]
         fork = None
         if node.kind == "branch" and not is_goal:
-            prev = route[i - 1]
+            k = nodes.index(node_id)  # its neighbours on the route, before places merged
+            came, goes = nodes[k - 1] if k > 0 else route[i - 1], nodes[k + 1]
             others = [
                 relative_action(h_in, heading(pts[i], pm.node_xy(nb)))
                 for nb in pm.graph.neighbors(node_id)
-                if nb not in (prev, route[i + 1])
+                if nb not in (came, goes)
             ]
             fork = ForkChoice(action, tuple(others))
         look_for, target = _target_of(pm, node_id, goal_id, avoid_landmarks)
-        prev_node = route[i - 1] if route[i - 1] is not None else None
-        if prev_node is not None and pm.graph.has_edge(prev_node, node_id):
-            seg_name = pm.segments[pm.graph.edges[prev_node, node_id]["segment"] - 1].name
-        else:
-            seg_name = sp.segment.name
         candidates.append(
             dict(
                 i=i,
@@ -221,7 +241,7 @@ def build_plan(
                 visible=look_for is not None,
                 look_for=look_for,
                 target=target,
-                segment=seg_name,
+                segment=via[i],
             )
         )
 

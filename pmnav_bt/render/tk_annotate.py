@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import base64
 import math
+import shlex
 import tkinter as tk
 from pathlib import Path
 
@@ -389,7 +390,12 @@ def run(path: str | Path) -> None:
     import os
 
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        raise PmNavError("pmnav annotate needs a display, but DISPLAY is not set")
+        raise PmNavError(
+            "pmnav annotate opens a window, but DISPLAY is not set (no display): run it on "
+            "a desktop, over ssh -X, or in a virtual display: xvfb-run -a pmnav annotate "
+            f"{shlex.quote(str(path))} (package xvfb; to see and use the window there, "
+            "docs/real-maps.md section 4)"
+        )
     try:
         root = tk.Tk()
     except tk.TclError as err:

@@ -151,3 +151,28 @@ def test_check_opening_fails_when_a_wall_fills_the_way(make_rig, pm):
         r.set(target=r.ctx.planner.plan(r.pm, "start", "room13").steps[0])
         assert r.run(CheckOpening("ForkChoice", r.ctx))[-1] == status
         assert r.ctx.grounder.calls == ["surfaces"]
+
+
+@pytest.mark.parametrize("share", [0.2, 0.8])
+def test_whether_a_sign_is_in_reach_is_weighed_in_the_worker(make_rig, share):
+    """The belief's share with a sign in reach takes tens of ms on a large belief: the leaf
+    asks the worker and says RUNNING until the answer comes (then SUCCESS under half)."""
+    import threading
+
+    from pmnav_bt.behaviours.belief import NO_SIGN_SHARE, NoSignInReach
+
+    asked: list[str] = []
+
+    class Belief:
+        ref = EAST
+
+        def sign_in_reach(self, pose):
+            asked.append(threading.current_thread().name)
+            return share
+
+    r = make_rig(EAST)
+    r.set(belief=Belief())
+    leaf = NoSignInReach("NoSignInReach", r.ctx)
+    r.expect(r.run(leaf), Status.SUCCESS if share < NO_SIGN_SHARE else Status.FAILURE)
+    assert len(asked) == 1 and asked[0].startswith("pmnav-worker")
+    assert leaf.feedback_message == f"{share:.0%} of the belief puts a sign in reach"

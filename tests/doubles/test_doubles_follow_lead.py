@@ -6,7 +6,8 @@ again, what it is told). A status is asserted per tick where the tick matters.""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+import threading
+from dataclasses import dataclass, field, replace
 
 import pytest
 from py_trees.common import Status
@@ -54,8 +55,14 @@ class ScriptedBelief:
         self.asked_again.append((pose.x, heading))
         return self.turned
 
+    threads: list[str] = field(default_factory=list)  # where each ray was weighed
+
+    def fork(self):
+        return self  # one double: what the drive tells it is recorded in one place
+
     def observe_ray(self, seen_from, free, axis, doors):
         self.rays.append(seen_from.x)
+        self.threads.append(threading.current_thread().name)
 
     def rescale_due(self, gain):
         return False
@@ -160,8 +167,9 @@ def test_a_sign_read_ahead_cuts_the_distance_short(make_rig, monkeypatch):
 
 
 def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(make_rig, monkeypatch):
-    """Depth shows a wall 0.6 m ahead 2 m into the drive: stop in that tick, SUCCESS,
-    and the belief notes the drive's heading blocked."""
+    """Depth shows a wall 0.6 m ahead 2 m into the drive: stop in that tick, SUCCESS
+    (a tick later when that look's ray is being weighed in the worker), and the belief
+    notes the drive's heading blocked."""
     belief = ScriptedBelief(Lead(heading=0.0, distance=6.0))
 
     def wall_at_6(p, n):
@@ -170,7 +178,9 @@ def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(make_rig, monkeyp
     r = rig_with(make_rig, monkeypatch, wall_at_6, belief)
     seen = run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
     assert (seen[-1][0], seen[-1][2]) == (Status.SUCCESS, (0.0, 0.0))
-    assert seen[-2][1] == "LocalizeDrive" and seen[-2][2][0] > 0.0  # driving until then
+    drove = max(i for i, x in enumerate(seen) if x[2][0] > 0.0)  # driving until then
+    assert seen[drove][1] == "LocalizeDrive" and seen[drove + 1][2] == (0.0, 0.0)
+    assert len(seen) - 1 - (drove + 1) <= 1  # at rest for at most the ray's tick
     assert r.get("drive_end") == DriveEnd.WALL
     assert belief.pending_blocked == pytest.approx(0.0)
     assert 6.0 <= r.base.pose().x < 7.2  # a wall look a second
@@ -306,3 +316,38 @@ def test_an_interrupted_drive_stops_the_body(make_rig, monkeypatch):
     assert r.base.velocity_command[0] > 0.0
     tree.stop(Status.INVALID)
     assert r.base.velocity_command == (0.0, 0.0)
+
+
+def test_the_drive_weighs_its_rays_in_the_worker(make_rig, monkeypatch):
+    """Weighing every hypothesis with a ray takes 10-20 ms: never in a tick."""
+    belief = ScriptedBelief(Lead(heading=0.0, distance=4.5))
+    r = rig_with(make_rig, monkeypatch, belief=belief)
+    run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
+    assert belief.threads and all(t.startswith("pmnav-worker") for t in belief.threads)
+
+
+@dataclass
+class ForkingBelief(ScriptedBelief):
+    """A belief the drive forks to weigh a ray on, as the real one (each fork its own rays)."""
+
+    def fork(self):
+        return replace(self, rays=list(self.rays), threads=list(self.threads))
+
+
+def test_a_ray_from_the_look_that_ends_the_drive_is_in_the_belief_after_it(make_rig, monkeypatch):
+    """The look that shows the wall ahead also tells the belief the floor ahead: the drive
+    ends when that ray is weighed in (a tick at rest), and the belief the next look reads
+    has it, with the way noted blocked."""
+    monkeypatch.setattr(follow_lead, "RAY_SPACING_M", 0.0)  # a ray from every look
+    belief = ForkingBelief(Lead(heading=0.0, distance=6.0))
+
+    def wall_at_6(p, n):
+        return look(p, free=0.6 if p.x >= 6.0 else 20.0)
+
+    r = rig_with(make_rig, monkeypatch, wall_at_6, belief)
+    seen = run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
+    assert seen[-2][1:] == ("LocalizeDrive", (0.0, 0.0))  # stopped, waiting for the ray
+    assert r.get("drive_end") == DriveEnd.WALL
+    after = r.get("belief")
+    assert after is not belief and belief.rays == []  # weighed on forks, not in place
+    assert after.rays[-1] >= 6.0 and after.pending_blocked == pytest.approx(0.0)

@@ -217,3 +217,44 @@ def test_a_pose_start_is_typed_radians_and_matches_the_typed_text(fig2_map):
     text = planner.plan(fig2_map, "22,0,90", "room17")
     assert typed.initial_action is text.initial_action is Action.TURN_RIGHT
     assert typed.nodes == text.nodes
+
+
+def _two_signs_at_one_spot(end=(20.0, 0.0)):
+    """A straight corridor with two signs at one point of its wall (and a room near the
+    start): the map links both to one point of the centre line, a 0 m segment apart."""
+    from pmnav_bt.map.building import building_from_data
+
+    ux, uy = end[0] / math.hypot(*end), end[1] / math.hypot(*end)
+    at = lambda s, off: [s * ux - off * uy, s * uy + off * ux]  # noqa: E731
+    return parse_building(
+        building_from_data(
+            {
+                "schema_version": 1,
+                "name": "two_signs",
+                "waypoints": [
+                    {"id": "start", "kind": "start", "pos": [0, 0]},
+                    {"id": "end1", "kind": "end", "pos": list(end)},
+                ],
+                "edges": [["start", "end1"]],
+                "rooms": [{"id": "room1", "door": at(2.0, 1.2), "sign": "101"}],
+                "landmarks": [
+                    {"id": "signa", "kind": "sign", "pos": at(10.0, 1.2), "sign": "Exit A"},
+                    {"id": "signb", "kind": "sign", "pos": at(10.0, 1.2), "sign": "Exit B"},
+                ],
+            }
+        )
+    )
+
+
+@pytest.mark.parametrize("end", [(20.0, 0.0), (-20.0, 0.0), (0.0, -20.0)])
+def test_two_landmarks_at_one_spot_are_one_place_on_a_straight_route(end):
+    pm = _two_signs_at_one_spot(end)
+    zero = [s for s in pm.segments if s.length < 1e-9]
+    assert len(zero) == 1  # the map keeps both landmarks, a 0 m segment apart
+    assert zero[0].heading == pytest.approx(math.atan2(end[1], end[0]))  # along its corridor
+    for gap in (2.0, 8.0):  # a short gap asks for every landmark on the way
+        p = GraphPlanner(max_gap=gap).plan(pm, "end1", "room1")
+        assert all(s.distance > 1e-6 for s in p.steps), [s.text() for s in p.steps]
+        actions = [s.action for s in p.steps]
+        assert actions == [Action.GO_STRAIGHT] * (len(actions) - 1) + [Action.ARRIVE]
+        assert sum(s.distance for s in p.steps) == pytest.approx(p.length) == pytest.approx(18.0)

@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 from pmnav_bt.experiments.sim_cli import PoseError, app
 from pmnav_bt.map.building import WaypointKind
 from pmnav_bt.map.catalogue import builtin_buildings, load_building
+from pmnav_bt.map.landmark_kinds import landmark_shape
 from pmnav_bt.seams import CameraIntrinsics
 from pmnav_bt.sim.render import draw_top_down, linearise_depth, render_camera
 from pmnav_bt.sim.textures import make_sign, sign_lines
@@ -275,10 +276,11 @@ def test_obstacle_footprints_are_landmarks_and_obstacles_not_walls(world):
     # ... but none is a whole wall: walls are left to the free-space polygon.
     assert all(fp.area < 3.0 for fp in prints)
     for lm in world.building.landmarks:
-        if lm.kind in ("reception_desk", "stairs"):  # solid and low: the body meets them
-            item = world.landmarks[lm.id]
-            inside = np.add(item.centre, 0.3 * np.asarray(item.normal))  # 30 cm out of the wall
-            assert min(fp.distance(Point(*inside)) for fp in prints) < 1e-6, lm.id
+        item = world.landmarks[lm.id]
+        inside = np.add(item.centre, 0.3 * np.asarray(item.normal))  # 30 cm out of the wall
+        # Solid kinds (desks, stairs) stand in the corridor, low: the body meets them.
+        met = min(fp.distance(Point(*inside)) for fp in prints) < 1e-6
+        assert met == landmark_shape(lm.kind).solid, lm.id
     body = world.add_obstacle(*world.start_pose().xy(), 0.5)
     try:
         assert len(world.obstacle_footprints(COLLISION_HEIGHT)) == len(prints) + 1
@@ -286,3 +288,47 @@ def test_obstacle_footprints_are_landmarks_and_obstacles_not_walls(world):
         world.remove_obstacle(body)
     assert len(world.obstacle_footprints(COLLISION_HEIGHT)) == len(prints)
     assert len(world.obstacle_footprints(0.0)) == 0  # nothing starts below the floor
+
+
+def test_the_simulator_warns_of_what_validate_warns_of(caplog):
+    """One placer hangs the simulator's items and checks the file for validate: a door on
+    a wall too short for it (the dead end of a corridor 1 m wide), two signs at one spot."""
+    from pmnav_bt.map.building import building_from_data
+    from pmnav_bt.map.wall_items import wall_item_warnings
+
+    b = building_from_data(
+        {
+            "schema_version": 1,
+            "name": "tight",
+            "corridor_width": 1.0,
+            "waypoints": [
+                {"id": "start", "kind": "start", "pos": [0.0, 0.0]},
+                {"id": "end1", "kind": "end", "pos": [20.0, 0.0]},
+            ],
+            "edges": [["start", "end1"]],
+            "rooms": [{"id": "room1", "door": [20.5, 0.0], "sign": "101"}],
+            "landmarks": [
+                {"id": f"sign{k}", "kind": "sign", "pos": [10.0, 0.5], "sign": "Exit"}
+                for k in "ab"
+            ],
+        }
+    )
+    warned = {w.message for w in wall_item_warnings(b)}
+    assert len(warned) == 2
+    with caplog.at_level("WARNING", logger="pmnav_bt.sim.world"), SimWorld(b, ceiling=False):
+        pass
+    logged = {r.getMessage() for r in caplog.records if r.name == "pmnav_bt.sim.world"}
+    assert warned <= logged
+
+
+def test_cli_show_takes_a_config_file(tmp_path):
+    cfg = tmp_path / "run.yaml"
+    cfg.write_text("world: {preset: realistic, people_per_100m: 0.0}\n")
+    def show(out, *more):
+        args = ["show", "straight_office", "--out", str(out), "--width", "32", "--height", "24"]
+        res = CliRunner().invoke(app, [*args, *more])
+        assert res.exit_code == 0, res.output
+        return (out / "straight_office_view_rgb.png").read_bytes()
+
+    # the realistic world looks different from the clean one
+    assert show(tmp_path / "cfg", "--config", str(cfg)) != show(tmp_path / "clean")

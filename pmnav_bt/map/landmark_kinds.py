@@ -1,0 +1,105 @@
+"""The landmark kinds a building file may name, and what each is in a world.
+
+A landmark's ``kind`` is free text (``kind: elevator``), matched without regard to case.
+Three shapes have bodies of their own: the simulator builds a lift's doors, a flight of
+steps, a reception counter, each with its name plate (``sign``) beside or above it.
+Every other kind (``sign``, ``exit``, ``fire_extinguisher`` ...) is a name plate on the
+wall. ``SHAPES`` is the one list: the simulator builds from it, ``pmnav validate`` checks
+what fits on a wall by it, and docs/building-format.md ("Landmark kinds") names every
+kind in it (a test holds the two together).
+
+A shape is *solid* when it stands out into the corridor (stairs 0.45 m, a desk 0.7 m):
+the robot must drive round it, and its footprint is taken off the floor the evaluation
+measures shortest paths (SPL) on. A flush one (a plate, the lift's doors at 6 cm) only
+marks the wall.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from pmnav_bt.map.signage import HISTORICAL_PLATE_M
+
+FLUSH_M = 0.1  # a body standing out of its wall less than this is flush with it
+PLATE_BACKING_M = 0.02  # a plate's backing board is 1 cm wider than its face each side
+
+ELEVATOR_WIDTH_M = 1.6  # the lift's doors, both leaves
+ELEVATOR_FRAME_M = 0.12  # its frame each side
+ELEVATOR_PANEL_M = 0.3  # the call-button panel beside it
+ELEVATOR_DEPTH_M = 0.06  # the frame's depth out of the wall
+STAIRS_LENGTH_M = 1.8  # six steps along the wall
+STAIRS_DEPTH_M = 0.45  # out into the corridor
+DESK_LENGTH_M = 1.8
+DESK_DEPTH_M = 0.6  # the desk; its counter top overhangs 0.05 m each way
+DESK_TOP_M = 0.1  # how much longer and deeper the counter top is than the desk
+
+
+@dataclass(frozen=True)
+class LandmarkShape:
+    """What a group of landmark kinds is in a world: how much wall it takes, how far it
+    stands out of the wall, and what the simulator builds."""
+
+    name: str
+    kinds: tuple[str, ...]  # the names a file may give it (lower case); () for any other
+    span_m: float  # along the wall, its name plate beside it not counted
+    depth_m: float  # out of the wall into the corridor
+    looks: str  # what the simulator builds, for the docs
+
+    @property
+    def solid(self) -> bool:
+        """True when it stands in the corridor: the robot must go round it."""
+        return self.depth_m >= FLUSH_M
+
+
+ELEVATOR = LandmarkShape(
+    "elevator",
+    ("elevator", "lift"),
+    ELEVATOR_WIDTH_M + 2 * ELEVATOR_FRAME_M + ELEVATOR_PANEL_M,
+    ELEVATOR_DEPTH_M,
+    "steel double doors in a frame, a call-button panel, the name plate beside them",
+)
+STAIRS = LandmarkShape(
+    "stairs",
+    ("stairs", "stair", "staircase", "stairway"),
+    STAIRS_LENGTH_M,
+    STAIRS_DEPTH_M,
+    "six steps against the wall, the name plate on the wall above them",
+)
+DESK = LandmarkShape(
+    "desk",
+    ("reception_desk", "reception", "desk", "counter", "information_desk"),
+    DESK_LENGTH_M + DESK_TOP_M,
+    DESK_DEPTH_M + DESK_TOP_M,
+    "a desk with a counter top against the wall, the name plate on the wall above it",
+)
+PLATE = LandmarkShape(
+    "name plate",
+    (),
+    HISTORICAL_PLATE_M + PLATE_BACKING_M,
+    0.0,
+    "its name plate on the wall: 0.8 m wide with the file's signage, or a one-line plate "
+    "as wide as its text in the building's style",
+)
+SHAPES: tuple[LandmarkShape, ...] = (ELEVATOR, STAIRS, DESK, PLATE)
+
+
+def landmark_shape(kind: str) -> LandmarkShape:
+    """The shape of a landmark of ``kind`` (any case); a name plate for a kind not listed."""
+    k = kind.lower()
+    return next((s for s in SHAPES if k in s.kinds), PLATE)
+
+
+def known_kinds() -> list[str]:
+    """Every kind with a body of its own, in the order of ``SHAPES``."""
+    return [k for s in SHAPES for k in s.kinds]
+
+
+def kinds_table() -> str:
+    """The Markdown table of ``SHAPES`` in docs/building-format.md ("Landmark kinds")."""
+    rows = ["| kinds | in the simulator | along the wall | out of the wall | solid |"]
+    rows.append("|---|---|---|---|---|")
+    for s in SHAPES:
+        kinds = ", ".join(f"`{k}`" for k in s.kinds) if s.kinds else "any other"
+        solid = "yes" if s.solid else "no"
+        rows.append(f"| {kinds} | {s.looks} | {s.span_m:.2f} m | {s.depth_m:.2f} m | {solid} |")
+    return "\n".join(rows) + "\n"
