@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import cv2
+import networkx as nx
 import numpy as np
 
 from pmnav_bt.loading import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE
@@ -20,10 +21,15 @@ from pmnav_bt.map.rmf_read import RmfLevel
 
 RESOLUTION_M = 0.05  # metres per grid cell, coarser only where the level is too large
 MARGIN_M = 2.0  # unknown border round the level
+SIDE_M = 0.35  # a door's two sides are looked at this far from it
+PASSAGE_DOORS = 3  # a part behind a door with this many doors is a corridor, not a room
 
 
-def level_grid(level: RmfLevel) -> FloorPlanImage:
-    """The level's walls, doors and floors rasterised (grey levels of map_saver)."""
+def level_grid(level: RmfLevel, open_doors: frozenset[int] = frozenset()) -> FloorPlanImage:
+    """The level's walls, doors and floors rasterised (grey levels of map_saver).
+
+    The doors whose indices are in ``open_doors`` (passages) are left open.
+    """
     pts = [level.xy] + [np.array([d.pos for d in level.lift_doors]).reshape(-1, 2)]
     allp = np.vstack(pts)
     lo, hi = allp.min(axis=0) - MARGIN_M, allp.max(axis=0) + MARGIN_M
@@ -41,7 +47,8 @@ def level_grid(level: RmfLevel) -> FloorPlanImage:
     px = plan.world_to_pixel(level.xy)
     walls = np.zeros((h, w), np.uint8)
     thick = max(2, round(WALL_M / res))
-    for link in level.walls + level.doors:
+    doors = [d for i, d in enumerate(level.doors) if i not in open_doors]
+    for link in level.walls + doors:
         a, b = (tuple(int(round(v)) for v in px[k]) for k in (link.a, link.b))
         cv2.line(walls, a, b, 1, thick)
     inside = np.zeros((h, w), np.uint8)
@@ -59,3 +66,50 @@ def level_grid(level: RmfLevel) -> FloorPlanImage:
     plan.image[inside.astype(bool)] = FREE
     plan.image[walls.astype(bool)] = OCCUPIED
     return plan
+
+
+def passage_doors(level: RmfLevel, plan: FloorPlanImage) -> frozenset[int]:
+    """Doors a lane runs through from the largest free part into another part that has
+    ``PASSAGE_DOORS`` or more doors (a corridor behind a door, not a room), or into the
+    largest part again (a door across a corridor). These are left open, so the corridor
+    behind joins the network.
+    """
+    occ = (plan.occupancy() == 0).astype(np.uint8)
+    _, lab = cv2.connectedComponents(occ, connectivity=4)
+    sizes = np.bincount(lab.ravel())
+    sizes[0] = 0
+    main = int(np.argmax(sizes))
+    sides = []
+    for d in level.doors:
+        a, b = level.xy[d.a], level.xy[d.b]
+        mid, along = (a + b) / 2.0, b - a
+        n = np.array([-along[1], along[0]]) / max(float(np.linalg.norm(along)), 1e-9)
+        cells = plan.world_to_cell(np.array([mid + n * SIDE_M, mid - n * SIDE_M]))
+        ok = (cells >= 0).all(axis=1) & (cells[:, 0] < plan.width) & (cells[:, 1] < plan.height)
+        pair = zip(cells, ok, strict=True)
+        sides.append(tuple(int(lab[c[1], c[0]]) if k else 0 for c, k in pair))
+    doors_of = nx.Graph()  # part -> doors on its boundary
+    for i, (p, q) in enumerate(sides):
+        for part in {p, q} - {0}:
+            doors_of.add_edge(("part", part), i)
+    out = set()
+    for i, d in enumerate(level.doors):
+        p, q = sides[i]
+        if main not in (p, q) or 0 in (p, q) or not _lane_crosses(level, d):
+            continue
+        other = q if p == main else p
+        if other == main or doors_of.degree(("part", other)) >= PASSAGE_DOORS:
+            out.add(i)
+    return frozenset(out)
+
+
+def _lane_crosses(level: RmfLevel, door) -> bool:
+    r, s = level.xy[door.a], level.xy[door.b]
+    return any(_segments_cross(level.xy[ln.a], level.xy[ln.b], r, s) for ln in level.lanes)
+
+
+def _segments_cross(p, q, r, s) -> bool:
+    def side(a, b, c) -> float:
+        return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+    return side(p, q, r) * side(p, q, s) < 0 and side(r, s, p) * side(r, s, q) < 0

@@ -31,7 +31,7 @@ from pmnav_bt.map.building import DOOR_REACH_SLACK, SCHEMA_VERSION, Building, bu
 from pmnav_bt.map.floorplan import FloorPlanImage, load_image_plan, save_ros_map
 from pmnav_bt.map.grid import largest_component
 from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
-from pmnav_bt.map.rmf_grid import level_grid
+from pmnav_bt.map.rmf_grid import level_grid, passage_doors
 from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
 
 START_REACH_M = 3.0  # a dead end this near a charger or spawn point is the start
@@ -63,6 +63,9 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
     """
     lvl = read_level(path, level)
     plan = level_grid(lvl)
+    passages = passage_doors(lvl, plan)
+    if passages:
+        plan = level_grid(lvl, passages)
     free = largest_component(plan.occupancy() == 0)
     cor = lane_corridors(lvl, plan, free)
     if len(cor.edges) == 0:
@@ -95,6 +98,9 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             skipped.append(f"doors[{i}]: no name")
             continue
         door_names.add(d.name)
+        if i in passages:
+            skipped.append(f"door {d.name!r}: a passage between corridors (left open)")
+            continue
         centre = (lvl.xy[d.a] + lvl.xy[d.b]) / 2.0
         if reach(centre, f"door {d.name!r}"):
             rid = _unique_id(d.name, ids)
