@@ -13,7 +13,9 @@ their centre lines, and they also lead into rooms and to parking spots. The step
 3. **Centred and measured**: across each corridor, rays out to ``CAP_M`` on both sides
    find the walls; where both sides hit, the centre line moves to the middle and the
    width is the median wall-to-wall distance. Where one side is open (a hall), the line
-   stays and the width is twice the distance to the one wall.
+   stays and the width is twice the distance to the one wall; with no wall either side,
+   ``OPEN_WIDTH_M``. A dead end is carried on along its corridor while walls stand on
+   both sides ahead (a lane that stops at a parking spot half way down a corridor).
 4. **Key waypoints** at the least-squares crossing of their corridors' centre lines, so
    every waypoint is on every centre line that meets there.
 """
@@ -36,6 +38,9 @@ CAP_M = 4.0  # rays look this far for a wall on each side
 WALL_GAP_M = 0.15  # a cut lane stops this far short of the wall it meets
 MIN_EDGE_M = 0.8  # waypoints closer than this after centring are merged
 MIN_WIDTH_M = 0.6
+OPEN_WIDTH_M = 3.0  # the width of a lane across a hall with no wall within CAP_M either side
+EXTEND_M = 30.0  # a dead end is carried on at most this far
+WALLED = 0.5  # a stretch is corridor-shaped where this share has walls on both sides
 CROSSING_DEG = 20.0  # corridors meeting at more than this fix their waypoint by crossing
 
 
@@ -71,6 +76,7 @@ def lane_corridors(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray) -> C
                                                            g.nodes[v]["xy"])
     pos = _place(g, lines)
     g, pos = _merge_after(g, pos, widths)
+    _extend_dead_ends(g, pos, widths, plan, free)
     edges = [(u, v, round(widths[frozenset((u, v))], 2)) for u, v in g.edges]
     return Corridors({n: pos[n] for n in g.nodes}, edges, skipped, cuts)
 
@@ -214,14 +220,52 @@ def _centre(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray
     left, right = dist
     both = np.isfinite(left) & np.isfinite(right)
     mid = (a + b) / 2.0
-    if both.mean() >= 0.5:
+    if both.mean() >= WALLED:
         off = float(np.median((left[both] - right[both]) / 2.0))
         width = float(np.median(left[both] + right[both]))
     else:
         one = np.minimum(left, right)
         one = one[np.isfinite(one)]
-        off, width = 0.0, 2.0 * (float(np.median(one)) if len(one) else CAP_M)
+        off, width = 0.0, 2.0 * float(np.median(one)) if len(one) else OPEN_WIDTH_M
     return (mid + off * n, u), max(MIN_WIDTH_M, min(width, 2.0 * CAP_M))
+
+
+def _walled(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """The share of the line a-b with a wall within ``CAP_M`` on both sides."""
+    length = float(np.linalg.norm(b - a))
+    u = (b - a) / length
+    n = np.array([-u[1], u[0]])
+    s = np.linspace(0.0, length, max(3, int(length / 0.25)))
+    t = np.arange(plan.resolution / 2.0, CAP_M, plan.resolution / 2.0)
+    hit = []
+    for side in (1.0, -1.0):
+        pts = a + s[:, None, None] * u + side * t[None, :, None] * n
+        hit.append(~_inside(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(t)).all(axis=1))
+    return float((hit[0] & hit[1]).mean())
+
+
+def _extend_dead_ends(g: nx.Graph, pos: dict, widths: dict, plan, free) -> None:
+    """Carry each dead end on along its corridor while the free space ahead stays
+    corridor-shaped (walls on both sides): a lane that stops at a parking spot half way
+    down a corridor leaves the rest of the corridor, and its doors, unreached."""
+    for n in [n for n in g.nodes if g.degree(n) == 1]:
+        (m,) = g.neighbors(n)
+        u = pos[n] - pos[m]
+        u = u / max(float(np.linalg.norm(u)), 1e-9)
+        t = np.arange(plan.resolution, EXTEND_M, plan.resolution / 2.0)
+        ahead = _inside(plan, free, pos[n] + t[:, None] * u)
+        clear = float(t[int(np.argmin(ahead))]) if not ahead.all() else EXTEND_M
+        half = widths[frozenset((n, m))] / 2.0
+        reach = clear - max(half, 0.5)
+        if reach < MIN_EDGE_M:
+            continue
+        end = pos[n] + u * reach
+        if _walled(plan, free, pos[n], end) < WALLED:
+            continue
+        la = float(np.linalg.norm(pos[n] - pos[m]))
+        _, w = _centre(plan, free, pos[n], end)
+        widths[frozenset((n, m))] = (widths[frozenset((n, m))] * la + w * reach) / (la + reach)
+        pos[n] = end
 
 
 def _place(g: nx.Graph, lines: dict) -> dict:
