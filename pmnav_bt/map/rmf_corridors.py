@@ -34,7 +34,7 @@ from pmnav_bt.map.rmf_read import RmfLevel
 MERGE_M = 0.3  # lane ends closer than this are one node
 SPUR_M = 1.5  # dead-end corridors shorter than this are stubs, not corridors
 STRAIGHT_DEG = 12.0  # a node whose two corridors bend less than this is dropped
-CAP_M = 4.0  # rays look this far for a wall on each side
+CAP_M = 5.0  # rays look this far for a wall on each side
 WALL_GAP_M = 0.15  # a cut lane stops this far short of the wall it meets
 MIN_EDGE_M = 0.8  # waypoints closer than this after centring are merged
 MIN_WIDTH_M = 0.6
@@ -56,7 +56,7 @@ class Corridors:
 
 def lane_corridors(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray) -> Corridors:
     """The corridor network of ``level`` in ``free`` (the corridors' free cells of ``plan``)."""
-    g, skipped, cuts = _lanes_inside(level, plan, free)
+    g, skipped, cuts = _lanesinside(level, plan, free)
     g = _merge_close(g, MERGE_M)
     _prune_spurs(g, SPUR_M)
     _drop_straight(g)
@@ -84,7 +84,7 @@ def lane_corridors(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray) -> C
 # -- 1. lanes inside the free space -------------------------------------------------------
 
 
-def _inside(plan: FloorPlanImage, free: np.ndarray, pts: np.ndarray) -> np.ndarray:
+def inside(plan: FloorPlanImage, free: np.ndarray, pts: np.ndarray) -> np.ndarray:
     cell = plan.world_to_cell(pts)
     ok = (cell >= 0).all(axis=1) & (cell[:, 0] < plan.width) & (cell[:, 1] < plan.height)
     out = np.zeros(len(pts), bool)
@@ -92,7 +92,7 @@ def _inside(plan: FloorPlanImage, free: np.ndarray, pts: np.ndarray) -> np.ndarr
     return out
 
 
-def _lanes_inside(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray):
+def _lanesinside(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray):
     g = nx.Graph()
     skipped, cuts = [], 0
     nxt = len(level.xy)
@@ -103,7 +103,7 @@ def _lanes_inside(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray):
         if length < 1e-6:
             continue
         s = np.arange(0.0, length + step, step).clip(max=length)
-        ins = _inside(plan, free, a + np.outer(s / length, b - a))
+        ins = inside(plan, free, a + np.outer(s / length, b - a))
         if ins.all():
             _add(g, lane.a, a, lane.b, b)
             continue
@@ -213,7 +213,7 @@ def _centre(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray
     dist = []
     for side in (1.0, -1.0):
         pts = a + s[:, None, None] * u + side * t[None, :, None] * n
-        ok = _inside(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(t))
+        ok = inside(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(t))
         hit = ~ok.all(axis=1)
         first = np.where(hit, np.argmin(ok, axis=1), len(t) - 1)
         dist.append(np.where(hit, t[first], np.inf))
@@ -240,7 +240,7 @@ def _walled(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray
     hit = []
     for side in (1.0, -1.0):
         pts = a + s[:, None, None] * u + side * t[None, :, None] * n
-        hit.append(~_inside(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(t)).all(axis=1))
+        hit.append(~inside(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(t)).all(axis=1))
     return float((hit[0] & hit[1]).mean())
 
 
@@ -253,7 +253,7 @@ def _extend_dead_ends(g: nx.Graph, pos: dict, widths: dict, plan, free) -> None:
         u = pos[n] - pos[m]
         u = u / max(float(np.linalg.norm(u)), 1e-9)
         t = np.arange(plan.resolution, EXTEND_M, plan.resolution / 2.0)
-        ahead = _inside(plan, free, pos[n] + t[:, None] * u)
+        ahead = inside(plan, free, pos[n] + t[:, None] * u)
         clear = float(t[int(np.argmin(ahead))]) if not ahead.all() else EXTEND_M
         half = widths[frozenset((n, m))] / 2.0
         reach = clear - max(half, 0.5)

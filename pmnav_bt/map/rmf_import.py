@@ -33,6 +33,7 @@ from pmnav_bt.map.grid import largest_component
 from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
 from pmnav_bt.map.rmf_grid import level_grid, passage_doors
 from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
+from pmnav_bt.map.rmf_spurs import add_spur
 
 START_REACH_M = 3.0  # a dead end this near a charger or spawn point is the start
 MAX_ID = 64
@@ -53,6 +54,7 @@ class Imported:
     skipped: list[str]
     named_doors: int
     cut_lanes: int
+    spurs: int  # short corridors added to reach doors off the lanes
 
 
 def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> Imported:
@@ -74,37 +76,31 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             "the import needs the level's lanes to find its corridors"
         )
     skipped = list(cor.skipped)
+    doors = _doors(lvl, passages, skipped)
+    spurs = _add_spurs(cor, plan, free, doors)
     ids: set[str] = set()
     names = _waypoint_names(cor, lvl, skipped, ids)
     seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
     seg_b = np.array([cor.pos[v] for _, v, _ in cor.edges])
     half = np.array([w / 2.0 for _, _, w in cor.edges])
 
-    def reach(pt, what: str) -> bool:
+    def reach(pt, what: str, tail: str = "") -> bool:
         j, _, d = project_points_to_segments(np.asarray(pt, float)[None], seg_a, seg_b)
         limit = half[j[0]] + DOOR_REACH_SLACK
         if d[0] > limit:
             skipped.append(
                 f"{what}: not on a corridor ({d[0]:.2f} m from the nearest centre line; "
-                f"at most {limit:.2f} m)"
+                f"at most {limit:.2f} m{tail})"
             )
             return False
         return True
 
-    rooms, door_names = [], set()
-    named = [d for d in lvl.doors if d.name]
-    for i, d in enumerate(lvl.doors):
-        if not d.name:
-            skipped.append(f"doors[{i}]: no name")
-            continue
-        door_names.add(d.name)
-        if i in passages:
-            skipped.append(f"door {d.name!r}: a passage between corridors (left open)")
-            continue
-        centre = (lvl.xy[d.a] + lvl.xy[d.b]) / 2.0
-        if reach(centre, f"door {d.name!r}"):
+    rooms = []
+    for d, centre, _ in doors:
+        if reach(centre, f"door {d.name!r}", "; no straight spur along its wall reaches it"):
             rid = _unique_id(d.name, ids)
             rooms.append({"id": rid, "name": d.name, "door": _r(centre), "sign": _words(d.name)})
+    door_names = {d.name for d in lvl.doors if d.name}
     landmarks = []
     for i, name in enumerate(lvl.names):
         if not name:
@@ -147,7 +143,7 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
         "landmarks": landmarks,
     }
     b = building_from_data(data, str(out), None)
-    return Imported(data, b, plan, lvl, skipped, len(named), cor.cuts)
+    return Imported(data, b, plan, lvl, skipped, len(door_names), cor.cuts, spurs)
 
 
 def write_import(imp: Imported, out: str | Path) -> Path:
@@ -177,6 +173,40 @@ def drawing_plan(imp: Imported) -> FloorPlanImage | None:
     s = imp.level.scale
     # Pixel row r lies at y = -r * s; the bottom-left corner (row h) at y = -h * s.
     return load_image_plan(path, s, (-0.5 * s, -(h - 0.5) * s))
+
+
+# -- doors -------------------------------------------------------------------------------
+
+
+def _doors(lvl: RmfLevel, passages: frozenset[int], skipped: list[str]) -> list:
+    """(door, centre, direction along its wall) of each named door that may be a room."""
+    out = []
+    for i, d in enumerate(lvl.doors):
+        if not d.name:
+            skipped.append(f"doors[{i}]: no name")
+        elif i in passages:
+            skipped.append(f"door {d.name!r}: a passage between corridors (left open)")
+        else:
+            a, b = lvl.xy[d.a], lvl.xy[d.b]
+            out.append((d, (a + b) / 2.0, b - a))
+    return out
+
+
+def _add_spurs(cor: Corridors, plan: FloorPlanImage, free: np.ndarray, doors: list) -> int:
+    """Spurs to the doors beyond reach of every centre line, nearest first; how many."""
+
+    def gap(centre) -> float:
+        seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
+        seg_b = np.array([cor.pos[v] for _, v, _ in cor.edges])
+        j, _, d = project_points_to_segments(np.asarray(centre)[None], seg_a, seg_b)
+        return float(d[0] - cor.edges[j[0]][2] / 2.0 - DOOR_REACH_SLACK)
+
+    far = sorted((gap(c), k) for k, (_, c, _) in enumerate(doors))
+    added = 0
+    for g, k in far:
+        if g > 0 and gap(doors[k][1]) > 0:
+            added += add_spur(cor, plan, free, doors[k][1], doors[k][2])
+    return added
 
 
 # -- names -------------------------------------------------------------------------------

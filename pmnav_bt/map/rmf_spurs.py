@@ -1,0 +1,95 @@
+"""Short corridors to the doors the lanes pass by at a distance (``import-rmf``).
+
+A lane runs straight where a wall curves away from it (a clinic's consult rooms round a
+curved pod), or passes a side bay; the doors there open onto the corridors' free space
+but lie farther from every centre line than a door may (half the width + 1 m). For each
+such door a **spur** is added: a short corridor that runs along the door's wall, half a
+spur width in front of it, from where that line meets the network to just past the door.
+The door is then on the spur's wall, as a door on any corridor is, and the simulator
+hangs it on the same wall the RMF file draws. Doors are taken nearest first and a spur
+may start on an earlier one, so the spurs along a curved wall chain into a polyline.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pmnav_bt.map.floorplan import FloorPlanImage
+from pmnav_bt.map.rmf_corridors import MIN_EDGE_M, Corridors, inside
+
+SPUR_HALF_M = 0.9  # the spur's centre line runs this far in front of the door's wall
+SPUR_MAX_M = 8.0  # a door farther than this along its wall from the network gets no spur
+PAST_M = 0.6  # the spur ends this far past the door's centre
+
+
+def add_spur(
+    cor: Corridors, plan: FloorPlanImage, free: np.ndarray, door: np.ndarray, along: np.ndarray
+) -> bool:
+    """Add a spur to the door centred at ``door`` in a wall running along ``along``.
+
+    Returns False (and changes nothing) when no straight spur along the wall, in the free
+    space, reaches the network within ``SPUR_MAX_M``.
+    """
+    along = along / np.linalg.norm(along)
+    normal = np.array([-along[1], along[0]])
+    best = None
+    for side in (1.0, -1.0):
+        front = door + side * normal * SPUR_HALF_M
+        if not inside(plan, free, front[None])[0]:
+            continue
+        for way in (1.0, -1.0):
+            hit = _first_hit(cor, front, way * along)
+            if hit is None:
+                continue
+            dist, k, foot = hit
+            end = front - way * along * PAST_M
+            if not _clear(plan, free, foot, end):
+                continue
+            if best is None or dist < best[0]:
+                best = (dist, k, foot, end)
+    if best is None:
+        return False
+    _, k, foot, end = best
+    if np.linalg.norm(end - foot) < MIN_EDGE_M:
+        return False
+    node = _node_at(cor, k, foot)
+    new = max(cor.pos) + 1
+    cor.pos[new] = end
+    cor.edges.append((node, new, round(2.0 * SPUR_HALF_M, 2)))
+    return True
+
+
+def _first_hit(cor: Corridors, p: np.ndarray, d: np.ndarray):
+    """(distance, edge index, point) where the ray p + t d first meets a centre line."""
+    best = None
+    for k, (u, v, _) in enumerate(cor.edges):
+        a, b = cor.pos[u], cor.pos[v]
+        e = b - a
+        den = d[0] * (-e[1]) - d[1] * (-e[0])
+        if abs(den) < 1e-9:
+            continue
+        r = a - p
+        t = (r[0] * (-e[1]) - r[1] * (-e[0])) / den
+        s = (d[0] * r[1] - d[1] * r[0]) / den
+        if 0.0 < t <= SPUR_MAX_M and -1e-9 <= s <= 1.0 + 1e-9 and (best is None or t < best[0]):
+            best = (float(t), k, p + t * d)
+    return best
+
+
+def _clear(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> bool:
+    n = max(2, int(np.linalg.norm(b - a) / (plan.resolution / 2.0)))
+    return bool(inside(plan, free, a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).all())
+
+
+def _node_at(cor: Corridors, k: int, foot: np.ndarray) -> int:
+    """The node at ``foot`` on edge ``k``: an end of the edge when near, else a new one
+    that splits the edge in two."""
+    u, v, w = cor.edges[k]
+    for n in (u, v):
+        if np.linalg.norm(cor.pos[n] - foot) < MIN_EDGE_M:
+            return n
+    new = max(cor.pos) + 1
+    cor.pos[new] = np.asarray(foot, float)
+    cor.edges[k] = (u, new, w)
+    cor.edges.append((new, v, w))
+    return new
