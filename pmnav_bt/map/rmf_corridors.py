@@ -11,8 +11,9 @@ their centre lines, and they also lead into rooms and to parking spots. The step
    nodes that only continue a straight line are dropped; the largest connected part is
    kept, the others are listed as skipped.
 3. **Centred and measured**: across each corridor, rays out to ``CAP_M`` on both sides
-   find the walls; where both sides hit, the centre line moves to the middle and the
-   width is the median wall-to-wall distance. Where one side is open (a hall), the line
+   find the walls; where both sides hit, the centre line moves to the middle (unless the
+   middle runs into more obstacles than the lane, a hall's pillars) and the width is the
+   median wall-to-wall distance. Where one side is open (a hall), the line
    stays and the width is twice the distance to the one wall; with no wall either side,
    ``OPEN_WIDTH_M``. A dead end is carried on along its corridor while walls stand on
    both sides ahead (a lane that stops at a parking spot half way down a corridor).
@@ -29,6 +30,7 @@ import networkx as nx
 import numpy as np
 
 from pmnav_bt.map.floorplan import FloorPlanImage
+from pmnav_bt.map.grid import free_mask
 from pmnav_bt.map.rmf_read import RmfLevel
 
 MERGE_M = 0.3  # lane ends closer than this are one node
@@ -56,7 +58,7 @@ class Corridors:
 
 def lane_corridors(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray) -> Corridors:
     """The corridor network of ``level`` in ``free`` (the corridors' free cells of ``plan``)."""
-    g, skipped, cuts = _lanesinside(level, plan, free)
+    g, skipped, cuts = _lanes_inside(level, plan, free)
     g = _merge_close(g, MERGE_M)
     _prune_spurs(g, SPUR_M)
     _drop_straight(g)
@@ -70,13 +72,14 @@ def lane_corridors(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray) -> C
     if not parts or g.subgraph(parts[0]).number_of_edges() == 0:
         return Corridors({}, [], skipped, cuts)
     g = g.subgraph(parts[0]).copy()
+    walls = free_mask(plan)  # pillars and furniture filled in: widths are wall to wall
     lines, widths = {}, {}
     for u, v in g.edges:
-        lines[(u, v)], widths[frozenset((u, v))] = _centre(plan, free, g.nodes[u]["xy"],
-                                                           g.nodes[v]["xy"])
+        a, b = g.nodes[u]["xy"], g.nodes[v]["xy"]
+        lines[(u, v)], widths[frozenset((u, v))] = _centre(plan, free, walls, a, b)
     pos = _place(g, lines)
     g, pos = _merge_after(g, pos, widths)
-    _extend_dead_ends(g, pos, widths, plan, free)
+    _extend_dead_ends(g, pos, widths, plan, (free, walls))
     edges = [(u, v, round(widths[frozenset((u, v))], 2)) for u, v in g.edges]
     return Corridors({n: pos[n] for n in g.nodes}, edges, skipped, cuts)
 
@@ -92,7 +95,7 @@ def inside(plan: FloorPlanImage, free: np.ndarray, pts: np.ndarray) -> np.ndarra
     return out
 
 
-def _lanesinside(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray):
+def _lanes_inside(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray):
     g = nx.Graph()
     skipped, cuts = [], 0
     nxt = len(level.xy)
@@ -202,8 +205,12 @@ def _drop_straight(g: nx.Graph) -> None:
 # -- 3. centred and measured ----------------------------------------------------------------
 
 
-def _centre(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray):
-    """((point, unit direction) of the centred line, width) of the corridor along a-b."""
+def _centre(plan: FloorPlanImage, free, walls, a: np.ndarray, b: np.ndarray):
+    """((point, unit direction) of the centred line, width) of the corridor along a-b.
+
+    Rays look for walls in ``walls`` (the free space with small obstacles filled in); the
+    centred line must not run into more of ``free``'s obstacles than the lane does.
+    """
     length = float(np.linalg.norm(b - a))
     u = (b - a) / length
     n = np.array([-u[1], u[0]])
@@ -213,7 +220,7 @@ def _centre(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray
     dist = []
     for side in (1.0, -1.0):
         pts = a + s[:, None, None] * u + side * t[None, :, None] * n
-        ok = inside(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(t))
+        ok = inside(plan, walls, pts.reshape(-1, 2)).reshape(len(s), len(t))
         hit = ~ok.all(axis=1)
         first = np.where(hit, np.argmin(ok, axis=1), len(t) - 1)
         dist.append(np.where(hit, t[first], np.inf))
@@ -227,7 +234,15 @@ def _centre(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray
         one = np.minimum(left, right)
         one = one[np.isfinite(one)]
         off, width = 0.0, 2.0 * float(np.median(one)) if len(one) else OPEN_WIDTH_M
+    if off and _blocked(plan, free, a + off * n, b + off * n) > _blocked(plan, free, a, b):
+        off = 0.0  # the middle runs into a pillar the lane passes by: keep the lane
     return (mid + off * n, u), max(MIN_WIDTH_M, min(width, 2.0 * CAP_M))
+
+
+def _blocked(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """The share of the line a-b off the free space."""
+    n = max(2, int(np.linalg.norm(b - a) / (plan.resolution / 2.0)))
+    return 1.0 - float(inside(plan, free, a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).mean())
 
 
 def _walled(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
@@ -244,10 +259,11 @@ def _walled(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray
     return float((hit[0] & hit[1]).mean())
 
 
-def _extend_dead_ends(g: nx.Graph, pos: dict, widths: dict, plan, free) -> None:
+def _extend_dead_ends(g: nx.Graph, pos: dict, widths: dict, plan, masks) -> None:
     """Carry each dead end on along its corridor while the free space ahead stays
     corridor-shaped (walls on both sides): a lane that stops at a parking spot half way
     down a corridor leaves the rest of the corridor, and its doors, unreached."""
+    free, walls = masks
     for n in [n for n in g.nodes if g.degree(n) == 1]:
         (m,) = g.neighbors(n)
         u = pos[n] - pos[m]
@@ -260,10 +276,10 @@ def _extend_dead_ends(g: nx.Graph, pos: dict, widths: dict, plan, free) -> None:
         if reach < MIN_EDGE_M:
             continue
         end = pos[n] + u * reach
-        if _walled(plan, free, pos[n], end) < WALLED:
+        if _walled(plan, walls, pos[n], end) < WALLED:
             continue
         la = float(np.linalg.norm(pos[n] - pos[m]))
-        _, w = _centre(plan, free, pos[n], end)
+        _, w = _centre(plan, free, walls, pos[n], end)
         widths[frozenset((n, m))] = (widths[frozenset((n, m))] * la + w * reach) / (la + reach)
         pos[n] = end
 

@@ -23,6 +23,7 @@ RESOLUTION_M = 0.05  # metres per grid cell, coarser only where the level is too
 MARGIN_M = 2.0  # unknown border round the level
 SIDE_M = 0.35  # a door's two sides are looked at this far from it
 PASSAGE_DOORS = 3  # a part behind a door with this many doors is a corridor, not a room
+PASSAGE_LANE_M = 5.0  # ... and one where the lanes run on this far
 
 
 def level_grid(level: RmfLevel, open_doors: frozenset[int] = frozenset()) -> FloorPlanImage:
@@ -69,10 +70,12 @@ def level_grid(level: RmfLevel, open_doors: frozenset[int] = frozenset()) -> Flo
 
 
 def passage_doors(level: RmfLevel, plan: FloorPlanImage) -> frozenset[int]:
-    """Doors a lane runs through from the largest free part into another part that has
-    ``PASSAGE_DOORS`` or more doors (a corridor behind a door, not a room), or into the
-    largest part again (a door across a corridor). These are left open, so the corridor
-    behind joins the network.
+    """Doors a lane runs through from the largest free part into a corridor: into the
+    largest part again (a door across a corridor), or into a part where the lanes run on
+    for ``PASSAGE_LANE_M`` or more, or that has ``PASSAGE_DOORS`` or more doors (a corridor
+    behind a fire door, a clinic's back-of-house corridor). A lane into a room stops a few
+    metres in, at a parking spot. These doors are left open, so the corridor behind joins
+    the network; the other doors stay closed.
     """
     occ = (plan.occupancy() == 0).astype(np.uint8)
     _, lab = cv2.connectedComponents(occ, connectivity=4)
@@ -84,23 +87,43 @@ def passage_doors(level: RmfLevel, plan: FloorPlanImage) -> frozenset[int]:
         a, b = level.xy[d.a], level.xy[d.b]
         mid, along = (a + b) / 2.0, b - a
         n = np.array([-along[1], along[0]]) / max(float(np.linalg.norm(along)), 1e-9)
-        cells = plan.world_to_cell(np.array([mid + n * SIDE_M, mid - n * SIDE_M]))
-        ok = (cells >= 0).all(axis=1) & (cells[:, 0] < plan.width) & (cells[:, 1] < plan.height)
-        pair = zip(cells, ok, strict=True)
-        sides.append(tuple(int(lab[c[1], c[0]]) if k else 0 for c, k in pair))
+        sides.append(tuple(_labels(plan, lab, np.array([mid + n * SIDE_M, mid - n * SIDE_M]))))
     doors_of = nx.Graph()  # part -> doors on its boundary
     for i, (p, q) in enumerate(sides):
         for part in {p, q} - {0}:
             doors_of.add_edge(("part", part), i)
+    lane_m = _lane_length_per_part(level, plan, lab)
     out = set()
     for i, d in enumerate(level.doors):
         p, q = sides[i]
         if main not in (p, q) or 0 in (p, q) or not _lane_crosses(level, d):
             continue
         other = q if p == main else p
-        if other == main or doors_of.degree(("part", other)) >= PASSAGE_DOORS:
+        if (
+            other == main
+            or lane_m.get(other, 0.0) >= PASSAGE_LANE_M
+            or doors_of.degree(("part", other)) >= PASSAGE_DOORS
+        ):
             out.add(i)
     return frozenset(out)
+
+
+def _labels(plan: FloorPlanImage, lab: np.ndarray, pts: np.ndarray) -> list[int]:
+    cells = plan.world_to_cell(pts)
+    ok = (cells >= 0).all(axis=1) & (cells[:, 0] < plan.width) & (cells[:, 1] < plan.height)
+    return [int(lab[c[1], c[0]]) if k else 0 for c, k in zip(cells, ok, strict=True)]
+
+
+def _lane_length_per_part(level: RmfLevel, plan: FloorPlanImage, lab: np.ndarray) -> dict:
+    """Metres of lane inside each free part."""
+    step = plan.resolution
+    out: dict[int, float] = {}
+    for ln in level.lanes:
+        a, b = level.xy[ln.a], level.xy[ln.b]
+        n = max(2, int(np.linalg.norm(b - a) / step))
+        for part in _labels(plan, lab, a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)):
+            out[part] = out.get(part, 0.0) + float(np.linalg.norm(b - a)) / n
+    return out
 
 
 def _lane_crosses(level: RmfLevel, door) -> bool:

@@ -6,20 +6,24 @@ but lie farther from every centre line than a door may (half the width + 1 m). F
 such door a **spur** is added: a short corridor that runs along the door's wall, half a
 spur width in front of it, from where that line meets the network to just past the door.
 The door is then on the spur's wall, as a door on any corridor is, and the simulator
-hangs it on the same wall the RMF file draws. Doors are taken nearest first and a spur
-may start on an earlier one, so the spurs along a curved wall chain into a polyline.
+hangs it on the same wall the RMF file draws. Where no straight spur fits, a bent one
+goes from the nearest point of the network to just before the door, then along its
+wall. Doors are taken nearest first and a spur may start on an earlier one, so the
+spurs along a curved wall chain into a polyline.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from pmnav_bt.geometry import project_points_to_segments
 from pmnav_bt.map.floorplan import FloorPlanImage
 from pmnav_bt.map.rmf_corridors import MIN_EDGE_M, Corridors, inside
 
 SPUR_HALF_M = 0.9  # the spur's centre line runs this far in front of the door's wall
-SPUR_MAX_M = 8.0  # a door farther than this along its wall from the network gets no spur
+SPUR_MAX_M = 12.0  # a door farther than this along its wall from the network gets no spur
 PAST_M = 0.6  # the spur ends this far past the door's centre
+COLLINEAR_M = 0.1  # a ray this near an earlier spur's line continues that spur
 
 
 def add_spur(
@@ -48,7 +52,7 @@ def add_spur(
             if best is None or dist < best[0]:
                 best = (dist, k, foot, end)
     if best is None:
-        return False
+        return _add_bent_spur(cor, plan, free, door, along, normal)
     _, k, foot, end = best
     if np.linalg.norm(end - foot) < MIN_EDGE_M:
         return False
@@ -59,6 +63,30 @@ def add_spur(
     return True
 
 
+def _add_bent_spur(cor, plan, free, door, along, normal) -> bool:
+    """Where no straight spur fits: from the nearest point of the network straight to just
+    before the door (in front of its wall), then along the wall to just past it."""
+    seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
+    seg_b = np.array([cor.pos[v] for _, v, _ in cor.edges])
+    for side in (1.0, -1.0):
+        front = door + side * normal * SPUR_HALF_M
+        j, t, d = project_points_to_segments(front[None], seg_a, seg_b)
+        foot = seg_a[j[0]] + t[0] * (seg_b[j[0]] - seg_a[j[0]])
+        way = 1.0 if np.dot(front - foot, along) < 0 else -1.0  # the knee nearer the network
+        knee, end = front + way * along * PAST_M, front - way * along * PAST_M
+        if not (d[0] <= SPUR_MAX_M and inside(plan, free, front[None])[0]
+                and _clear(plan, free, foot, knee) and _clear(plan, free, knee, end)
+                and np.linalg.norm(knee - foot) >= MIN_EDGE_M):
+            continue
+        node = _node_at(cor, int(j[0]), foot)
+        k1 = max(cor.pos) + 1
+        cor.pos[k1], cor.pos[k1 + 1] = knee, end
+        w = round(2.0 * SPUR_HALF_M, 2)
+        cor.edges += [(node, k1, w), (k1, k1 + 1, w)]
+        return True
+    return False
+
+
 def _first_hit(cor: Corridors, p: np.ndarray, d: np.ndarray):
     """(distance, edge index, point) where the ray p + t d first meets a centre line."""
     best = None
@@ -66,7 +94,13 @@ def _first_hit(cor: Corridors, p: np.ndarray, d: np.ndarray):
         a, b = cor.pos[u], cor.pos[v]
         e = b - a
         den = d[0] * (-e[1]) - d[1] * (-e[0])
-        if abs(den) < 1e-9:
+        if abs(den) < 1e-9 * max(float(np.linalg.norm(e)), 1e-9):
+            # Along the line of an earlier spur: the hit is the spur's nearer end.
+            for q in (a, b):
+                t = float(np.dot(q - p, d))
+                off = float(np.linalg.norm(q - (p + t * d)))
+                if off < COLLINEAR_M and 0.0 < t <= SPUR_MAX_M and (best is None or t < best[0]):
+                    best = (t, k, q.copy())
             continue
         r = a - p
         t = (r[0] * (-e[1]) - r[1] * (-e[0])) / den
