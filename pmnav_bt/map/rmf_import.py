@@ -25,9 +25,15 @@ from pathlib import Path
 
 import numpy as np
 
-from pmnav_bt.errors import PmNavError
+from pmnav_bt.errors import BuildingFileError, PmNavError
 from pmnav_bt.geometry import project_points_to_segments
-from pmnav_bt.map.building import DOOR_REACH_SLACK, SCHEMA_VERSION, Building, building_from_data
+from pmnav_bt.map.building import (
+    DOOR_REACH_SLACK,
+    MAX_TEXT_CHARS,
+    SCHEMA_VERSION,
+    Building,
+    building_from_data,
+)
 from pmnav_bt.map.floorplan import FloorPlanImage, load_image_plan, save_ros_map
 from pmnav_bt.map.grid import largest_component
 from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
@@ -36,7 +42,8 @@ from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
 from pmnav_bt.map.rmf_spurs import add_spur
 
 START_REACH_M = 3.0  # a dead end this near a charger or spawn point is the start
-MAX_ID = 64
+MIN_DOOR_M = 0.3  # a door narrower than this is a drawing slip
+MAX_ID = 64  # the building format's id length
 
 
 class RmfImportError(PmNavError):
@@ -99,7 +106,9 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
     for d, centre, _ in doors:
         if reach(centre, f"door {d.name!r}", "; no straight spur along its wall reaches it"):
             rid = _unique_id(d.name, ids)
-            rooms.append({"id": rid, "name": d.name, "door": _r(centre), "sign": _words(d.name)})
+            rooms.append(
+                {"id": rid, "name": _text(d.name), "door": _r(centre), "sign": _words(d.name)}
+            )
     door_names = {d.name for d in lvl.doors if d.name}
     landmarks = []
     for i, name in enumerate(lvl.names):
@@ -112,14 +121,14 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
         elif reach(lvl.xy[i], f"vertex {name!r}"):
             lid = _unique_id(name, ids)
             landmarks.append(
-                {"id": lid, "kind": "sign", "name": name, "pos": _r(lvl.xy[i]),
+                {"id": lid, "kind": "sign", "name": _text(name), "pos": _r(lvl.xy[i]),
                  "sign": _words(name)}
             )
     for ld in lvl.lift_doors:
         if reach(ld.pos, f"lift {ld.lift!r} door {ld.door!r}"):
             lid = _unique_id(ld.lift, ids)
             landmarks.append(
-                {"id": lid, "kind": "elevator", "name": ld.lift, "pos": _r(ld.pos),
+                {"id": lid, "kind": "elevator", "name": _text(ld.lift), "pos": _r(ld.pos),
                  "sign": _words(ld.lift)}
             )
     ros_map = Path(out).stem + "_walls.yaml"
@@ -142,7 +151,13 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
         "rooms": rooms,
         "landmarks": landmarks,
     }
-    b = building_from_data(data, str(out), None)
+    try:
+        b = building_from_data(data, str(out), None)
+    except BuildingFileError as err:
+        raise RmfImportError(
+            f"{path}: level {lvl.name}: the imported building does not validate: "
+            f"{err.problems[0]}"
+        ) from None
     return Imported(data, b, plan, lvl, skipped, len(door_names), cor.cuts, spurs)
 
 
@@ -186,6 +201,8 @@ def _doors(lvl: RmfLevel, passages: frozenset[int], skipped: list[str]) -> list:
             skipped.append(f"doors[{i}]: no name")
         elif i in passages:
             skipped.append(f"door {d.name!r}: a passage between corridors (left open)")
+        elif np.linalg.norm(lvl.xy[d.b] - lvl.xy[d.a]) < MIN_DOOR_M:
+            skipped.append(f"door {d.name!r}: shorter than {MIN_DOOR_M} m, not a door")
         else:
             a, b = lvl.xy[d.a], lvl.xy[d.b]
             out.append((d, (a + b) / 2.0, b - a))
@@ -278,10 +295,14 @@ def _unique_id(name: str, ids: set) -> str:
     return rid
 
 
+def _text(name: str) -> str:
+    return name[:MAX_TEXT_CHARS]
+
+
 def _words(name: str) -> str:
     """An RMF name as a sign reads: 'L1_left_consult_rm_3' -> 'left consult rm 3'."""
     text = re.sub(r"^L\d+_", "", name).replace("_", " ").strip()
-    return (text or name)[:200]
+    return _text(text or name)
 
 
 def _r(p) -> list[float]:
