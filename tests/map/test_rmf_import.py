@@ -129,17 +129,6 @@ def test_a_door_in_a_side_bay_beyond_reach_gets_a_spur_along_its_wall(tmp_path):
 # -- the real RMF demo buildings ---------------------------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def rmf_maps():
-    from conftest import _shared_maps
-
-    d = _shared_maps()
-    if d is None or not (d / "rmf" / "clinic" / "clinic.building.yaml").is_file():
-        pytest.skip("the Open-RMF demo buildings are absent: set PMNAV_SHARED_MAPS to a maps/ "
-                    "folder holding rmf/clinic and rmf/office")
-    return d / "rmf"
-
-
 @pytest.mark.parametrize(
     "name,level", [("clinic", "L1"), ("clinic", "L2"), ("office", None)], ids=str
 )
