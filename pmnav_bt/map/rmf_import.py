@@ -104,7 +104,7 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
 
     rooms = []
     for d, centre, _ in doors:
-        if reach(centre, f"door {d.name!r}", "; no straight spur along its wall reaches it"):
+        if reach(centre, f"door {d.name!r}", "; no spur along the free space reaches it"):
             rid = _unique_id(d.name, ids)
             rooms.append(
                 {"id": rid, "name": _text(d.name), "door": _r(centre), "sign": _words(d.name)}
