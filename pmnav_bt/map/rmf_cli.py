@@ -25,7 +25,8 @@ def import_rmf_command(rmf: Path, out: Path, level: str | None, image: Path | No
         f"wrote {out} and {imp.data['floor_plan']['ros_map']} (level {imp.level.name}, "
         f"{imp.level.scale:.4f} m per drawing pixel): {len(b.waypoints)} key waypoints, "
         f"{len(b.edges)} corridors, {len(b.rooms)} rooms from {imp.named_doors} named doors, "
-        f"{len(b.landmarks)} landmarks, {len(imp.skipped)} item(s) skipped"
+        f"{len(b.landmarks)} landmarks ({imp.spurs} spur(s) to doors off the lanes, "
+        f"{imp.cut_lanes} lane(s) cut at a wall or door), {len(imp.skipped)} item(s) skipped"
     )
     if image is not None:
         from pmnav_bt.map.priori_map import parse_building

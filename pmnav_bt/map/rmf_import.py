@@ -86,7 +86,7 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
     doors = _doors(lvl, passages, skipped)
     spurs = _add_spurs(cor, plan, free, doors)
     ids: set[str] = set()
-    names = _waypoint_names(cor, lvl, skipped, ids)
+    names = _waypoint_names(cor, lvl, _entrances(lvl, plan), skipped, ids)
     seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
     seg_b = np.array([cor.pos[v] for _, v, _ in cor.edges])
     half = np.array([w / 2.0 for _, _, w in cor.edges])
@@ -209,6 +209,25 @@ def _doors(lvl: RmfLevel, passages: frozenset[int], skipped: list[str]) -> list:
     return out
 
 
+def _entrances(lvl: RmfLevel, plan: FloorPlanImage) -> list[np.ndarray]:
+    """The centres of the doors with free floor on one side and the outside (unknown
+    cells, beyond every floor) on the other."""
+    occ = plan.occupancy()
+    out = []
+    for d in lvl.doors:
+        a, b = lvl.xy[d.a], lvl.xy[d.b]
+        length = float(np.linalg.norm(b - a))
+        if length < MIN_DOOR_M:
+            continue
+        mid = (a + b) / 2.0
+        n = np.array([a[1] - b[1], b[0] - a[0]]) / length
+        cells = plan.world_to_cell(np.array([mid + n * 0.35, mid - n * 0.35]))
+        cells = np.clip(cells, 0, [plan.width - 1, plan.height - 1])
+        if sorted(int(occ[r, c]) for c, r in cells) == [-1, 0]:
+            out.append(mid)
+    return out
+
+
 def _add_spurs(cor: Corridors, plan: FloorPlanImage, free: np.ndarray, doors: list) -> int:
     """Spurs to the doors beyond reach of every centre line, nearest first; how many."""
 
@@ -233,8 +252,11 @@ def _is_start_point(params: dict) -> bool:
     return bool(param(params, "is_charger")) or bool(param(params, "spawn_robot_name"))
 
 
-def _waypoint_names(cor: Corridors, lvl: RmfLevel, skipped: list[str], ids: set) -> dict:
-    """start, endN, turnN, branchN; the start at the dead end nearest a charger or spawn."""
+def _waypoint_names(
+    cor: Corridors, lvl: RmfLevel, entrances: list, skipped: list[str], ids: set
+) -> dict:
+    """start, endN, turnN, branchN; the start at the dead end nearest a charger or spawn
+    point, else nearest an entrance (else any named door)."""
     deg = {n: 0 for n in cor.pos}
     for u, v, _ in cor.edges:
         deg[u] += 1
@@ -253,14 +275,15 @@ def _waypoint_names(cor: Corridors, lvl: RmfLevel, skipped: list[str], ids: set)
             f"{START_REACH_M:g} m (not the start)"
         )
     if start is None and ends:
-        outside = [
-            (lvl.xy[d.a] + lvl.xy[d.b]) / 2.0 for d in lvl.doors if d.name
-        ]
-        start = min(
-            ends, key=lambda n: min((np.linalg.norm(cor.pos[n] - p) for p in outside), default=0)
-        )
-        skipped.append("start: no charger or spawn point at a dead end; the dead end nearest "
-                       "a door is the start (check it)")
+        outside = entrances or [(lvl.xy[d.a] + lvl.xy[d.b]) / 2.0 for d in lvl.doors if d.name]
+        what = "an entrance (a door to the outside)" if entrances else "a named door"
+
+        def to_door(n) -> float:
+            return min((float(np.linalg.norm(cor.pos[n] - p)) for p in outside), default=0.0)
+
+        start = min(ends, key=to_door)
+        skipped.append(f"start: no charger or spawn point at a dead end; the dead end nearest "
+                       f"{what} is the start (check it)")
     order = sorted(cor.pos, key=lambda n: (-round(cor.pos[n][1], 1), round(cor.pos[n][0], 1)))
     names, counts = {}, {"end": 0, "turn": 0, "branch": 0}
     for n in order:

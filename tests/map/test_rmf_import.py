@@ -94,6 +94,20 @@ def test_a_level_that_is_not_there_names_the_levels(example, tmp_path, capsys):
     assert "no level 'L9'; the file has L1" in err
 
 
+def test_without_a_charger_the_start_is_the_dead_end_by_the_entrance(tmp_path):
+    data = example_rmf()
+    lvl = data["levels"]["L1"]
+    lvl["vertices"][10][4] = {}  # no charger
+    v = lvl["vertices"]
+    v += [[600, 120, 0, ""], [600, 140, 0, ""]]  # a door in the east end wall, to outside
+    lvl["walls"] = [w for w in lvl["walls"] if w[:2] != [3, 4]]
+    lvl["walls"] += [[3, len(v) - 2, {}], [len(v) - 1, 4, {}]]
+    lvl["doors"].append([len(v) - 2, len(v) - 1, {"name": [1, "entrance"]}])
+    imp = import_rmf(write_example_rmf(tmp_path, data), tmp_path / "out.yaml")
+    assert imp.building.waypoint("start").pos[0] > 25.0  # the east end, not the west
+    assert any("nearest an entrance" in s for s in imp.skipped)
+
+
 def test_a_door_across_the_corridor_with_a_lane_through_it_is_a_passage(tmp_path):
     data = example_rmf()
     lvl = data["levels"]["L1"]
