@@ -39,7 +39,7 @@ from pmnav_bt.map.grid import largest_component
 from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
 from pmnav_bt.map.rmf_grid import level_grid, passage_doors
 from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
-from pmnav_bt.map.rmf_spurs import add_spur
+from pmnav_bt.map.rmf_spurs import add_spur, turn_at_door
 
 START_REACH_M = 3.0  # a dead end this near a charger or spawn point is the start
 MIN_DOOR_M = 0.3  # a door narrower than this is a drawing slip
@@ -229,7 +229,8 @@ def _entrances(lvl: RmfLevel, plan: FloorPlanImage) -> list[np.ndarray]:
 
 
 def _add_spurs(cor: Corridors, plan: FloorPlanImage, free: np.ndarray, doors: list) -> int:
-    """Spurs to the doors beyond reach of every centre line, nearest first; how many."""
+    """Turns in front of the doors a dead end runs into, then spurs to the doors beyond
+    reach of every centre line, nearest first; how many of both."""
 
     def gap(centre) -> float:
         seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
@@ -237,8 +238,8 @@ def _add_spurs(cor: Corridors, plan: FloorPlanImage, free: np.ndarray, doors: li
         j, _, d = project_points_to_segments(np.asarray(centre)[None], seg_a, seg_b)
         return float(d[0] - cor.edges[j[0]][2] / 2.0 - DOOR_REACH_SLACK)
 
+    added = sum(turn_at_door(cor, plan, free, c, along) for _, c, along in doors)
     far = sorted((gap(c), k) for k, (_, c, _) in enumerate(doors))
-    added = 0
     for g, k in far:
         if g > 0 and gap(doors[k][1]) > 0:
             added += add_spur(cor, plan, free, doors[k][1], doors[k][2])

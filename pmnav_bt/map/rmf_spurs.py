@@ -24,6 +24,7 @@ SPUR_HALF_M = 0.9  # the spur's centre line runs this far in front of the door's
 SPUR_MAX_M = 12.0  # a door farther than this along its wall from the network gets no spur
 PAST_M = 0.6  # the spur ends this far past the door's centre
 COLLINEAR_M = 0.1  # a ray this near an earlier spur's line continues that spur
+END_ON_COS = 0.7  # a dead end within 45 deg of a door's normal runs into the door
 
 
 def add_spur(
@@ -60,6 +61,42 @@ def add_spur(
     new = max(cor.pos) + 1
     cor.pos[new] = end
     cor.edges.append((node, new, round(2.0 * SPUR_HALF_M, 2)))
+    return True
+
+
+def turn_at_door(
+    cor: Corridors, plan: FloorPlanImage, free: np.ndarray, door: np.ndarray, along: np.ndarray
+) -> bool:
+    """A dead end that runs into the door (a lane cut where it went through it) stops
+    half a spur width in front of the door's wall and turns along it to just past the
+    door, so the door is on a corridor's side wall, not at its end.
+    """
+    seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
+    seg_b = np.array([cor.pos[v] for _, v, _ in cor.edges])
+    j, t, dist = project_points_to_segments(door[None], seg_a, seg_b)
+    k, t = int(j[0]), float(t[0])
+    u, v, w = cor.edges[k]
+    end, other = (v, u) if t > 0.5 else (u, v)
+    degree = sum(n == end for e in cor.edges for n in e[:2])
+    along = along / np.linalg.norm(along)
+    normal = np.array([-along[1], along[0]])
+    axis = cor.pos[end] - cor.pos[other]
+    axis = axis / float(np.linalg.norm(axis))
+    if degree != 1 or min(t, 1.0 - t) > 1e-6 or abs(float(np.dot(axis, normal))) < END_ON_COS:
+        return False
+    if np.dot(normal, cor.pos[other] - door) < 0:
+        normal = -normal  # towards the corridor
+    front = door + normal * SPUR_HALF_M
+    stop = float(np.dot(cor.pos[other] - front, normal) / np.dot(axis, -normal))
+    knee = cor.pos[other] + axis * stop
+    way = along if np.dot(front - knee, along) >= 0 else -along
+    tip = front + way * PAST_M
+    if stop < MIN_EDGE_M or not _clear(plan, free, knee, tip):
+        return False
+    cor.pos[end] = knee
+    new = max(cor.pos) + 1
+    cor.pos[new] = tip
+    cor.edges.append((end, new, round(2.0 * SPUR_HALF_M, 2)))
     return True
 
 

@@ -106,6 +106,14 @@ def test_without_a_charger_the_start_is_the_dead_end_by_the_entrance(tmp_path):
     imp = import_rmf(write_example_rmf(tmp_path, data), tmp_path / "out.yaml")
     assert imp.building.waypoint("start").pos[0] > 25.0  # the east end, not the west
     assert any("nearest an entrance" in s for s in imp.skipped)
+    # The corridor ran into the entrance; it now turns in front of it, so the door is on
+    # the last piece's side wall (half a spur width out), not at its end.
+    room = next(r for r in imp.building.rooms if r.name == "entrance")
+    b = imp.building
+    last = next(e for e in b.edges if "start" in (e.a, e.b))
+    a, c = (np.array(b.waypoint(w).pos) for w in (last.a, last.b))
+    _, t, dist = project_points_to_segments(np.array([room.door]), a[None], c[None])
+    assert 0.0 < t[0] < 1.0 and dist[0] == pytest.approx(b.edge_width(last) / 2.0, abs=0.1)
 
 
 def test_a_door_across_the_corridor_with_a_lane_through_it_is_a_passage(tmp_path):
