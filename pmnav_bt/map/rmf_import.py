@@ -27,12 +27,14 @@ import numpy as np
 
 from pmnav_bt.errors import BuildingFileError, PmNavError
 from pmnav_bt.geometry import project_points_to_segments
+from pmnav_bt.loading import atomic_write_text, image_size
 from pmnav_bt.map.building import (
     DOOR_REACH_SLACK,
     MAX_TEXT_CHARS,
     SCHEMA_VERSION,
     Building,
     building_from_data,
+    dump_building,
 )
 from pmnav_bt.map.floorplan import FloorPlanImage, load_image_plan, save_ros_map
 from pmnav_bt.map.grid import largest_component
@@ -163,9 +165,6 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
 
 def write_import(imp: Imported, out: str | Path) -> Path:
     """Write the building file and its grid (``<stem>_walls.yaml`` + ``.pgm``) beside it."""
-    from pmnav_bt.loading import atomic_write_text
-    from pmnav_bt.map.building import dump_building
-
     out = Path(out)
     save_ros_map(imp.grid, out.parent / imp.data["floor_plan"]["ros_map"])
     head = [
@@ -182,12 +181,11 @@ def drawing_plan(imp: Imported) -> FloorPlanImage | None:
     path = Path(imp.level.source).parent / imp.level.drawing
     if not path.is_file():
         return None
-    from pmnav_bt.loading import image_size
-
     _, h = image_size(path)
     s = imp.level.scale
-    # Pixel row r lies at y = -r * s; the bottom-left corner (row h) at y = -h * s.
-    return load_image_plan(path, s, (-0.5 * s, -(h - 0.5) * s))
+    # RMF's pixel coordinates run from the drawing's top-left corner (0, 0), y down: its
+    # bottom-left corner (0, h) lies at map (0, -h * scale).
+    return load_image_plan(path, s, (0.0, -h * s))
 
 
 # -- doors -------------------------------------------------------------------------------

@@ -77,19 +77,11 @@ class RmfLevel:
     drawing: str | None  # the level's drawing, relative to the RMF file
     lift_doors: list[LiftDoor] = field(default_factory=list)
 
-    def pixel_to_map(self, px: float, py: float) -> tuple[float, float]:
-        return px * self.scale, -py * self.scale
-
 
 def param(params: dict[str, Any], key: str) -> Any:
     """The value of an RMF ``[type, value]`` parameter, or None when absent or malformed."""
     v = params.get(key) if isinstance(params, dict) else None
     return v[1] if isinstance(v, list) and len(v) == 2 else None
-
-
-def level_names(path: str | Path) -> list[str]:
-    """The level names of an RMF building, in file order."""
-    return list(_levels(load_yaml(path, "building"), str(path)))
 
 
 def read_level(path: str | Path, level: str | None = None) -> RmfLevel:
