@@ -188,6 +188,21 @@ def map_draft(
     )
 
 
+@app.command("map-import-rmf")
+def map_import_rmf(
+    rmf: Path = typer.Argument(..., help="An Open-RMF traffic-editor file (*.building.yaml)."),
+    out: Path = typer.Option(..., "-o", "--out", help="The building file to write (YAML)."),
+    level: str | None = typer.Option(None, help="The level to import (default: the first)."),
+    image: Path | None = typer.Option(
+        None, "--image", help="Draw the imported map over the level's drawing here (PNG)."
+    ),
+) -> None:
+    """Import one level of an Open-RMF building (also: 'pmnav map import-rmf FILE -o OUT')."""
+    from pmnav_bt.map.rmf_cli import import_rmf_command
+
+    import_rmf_command(rmf, out, level, image)
+
+
 @app.command()
 def annotate(file: Path = typer.Argument(..., help="The building file to edit (YAML).")) -> None:
     """Edit a building over its floor plan in a window (Tk): rooms, waypoints, corridors, signs."""
@@ -206,8 +221,8 @@ def _error_line(err: PmNavError) -> str:
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the app; user errors become one line on stderr and exit status 2."""
     args = list(sys.argv[1:] if argv is None else argv)
-    if args[:2] == ["map", "draft"]:  # 'pmnav map FILE' is a command, so draft is map-draft
-        args = ["map-draft", *args[2:]]
+    if args[:2] in (["map", "draft"], ["map", "import-rmf"]):  # 'pmnav map FILE' is a command
+        args = [f"map-{args[1]}", *args[2:]]
     run_cli(app, args, "pmnav", _error_line)
 
 

@@ -52,6 +52,16 @@ def hospital_grid():
     return path
 
 
+@pytest.fixture(scope="session")
+def rmf_maps():
+    """The folder of the Open-RMF demo buildings (rmf/clinic, rmf/office), or skip."""
+    d = _shared_maps()
+    if d is None or not (d / "rmf" / "clinic" / "clinic.building.yaml").is_file():
+        pytest.skip("the Open-RMF demo buildings are absent: set PMNAV_SHARED_MAPS to a maps/ "
+                    "folder holding rmf/clinic and rmf/office")
+    return d / "rmf"
+
+
 # -- the tick rig (tests/rig.py) ---------------------------------------------------------------
 
 
