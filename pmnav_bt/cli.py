@@ -18,6 +18,7 @@ import typer
 from pmnav_bt.cli_values import run_cli
 from pmnav_bt.errors import BuildingFileError, PmNavError
 from pmnav_bt.loading import check_output_file
+from pmnav_bt.map.updates_cli import map_updates
 from pmnav_bt.webview.cli import view
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
@@ -170,6 +171,7 @@ def annotate(file: Path = typer.Argument(..., help="The building file to edit (Y
 
 
 app.command("view")(view)
+app.command("map-updates")(map_updates)
 
 
 def _error_line(err: PmNavError) -> str:
@@ -179,8 +181,8 @@ def _error_line(err: PmNavError) -> str:
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the app; user errors become one line on stderr and exit status 2."""
     args = list(sys.argv[1:] if argv is None else argv)
-    if args[:2] == ["map", "draft"]:  # 'pmnav map FILE' is a command, so draft is map-draft
-        args = ["map-draft", *args[2:]]
+    if args[:2] in (["map", "draft"], ["map", "updates"]):  # 'pmnav map FILE' is a command,
+        args = [f"map-{args[1]}", *args[2:]]  # so 'map draft' is map-draft, and so on
     run_cli(app, args, "pmnav", _error_line)
 
 

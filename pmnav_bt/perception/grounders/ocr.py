@@ -36,10 +36,12 @@ from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMa
 
 @dataclass
 class _Read:
-    """One frame's signs, and the door derived from each room sign (None: not derived)."""
+    """One frame's signs, and the door derived from each room sign (None: not derived);
+    ``unmatched``: the plates read with trusted digits that named nothing of the map."""
 
     signs: list[Detection]
     doors: list[Detection | None]
+    unmatched: list[Detection]
 
 
 class OcrGrounder:
@@ -77,6 +79,13 @@ class OcrGrounder:
     def surfaces(self, obs: Observation) -> SurfaceMasks:
         return depth_geom.surfaces(obs)
 
+    # -- what a map check reads (perception.map_check.ReadsUnmatched) ---------------------
+
+    def unmatched_signs(self, obs: Observation) -> list[Detection]:
+        """The plates of the frame whose text names nothing of the map (``entity`` None,
+        ``point`` the plate's centre): read with the frame's signs, at no further cost."""
+        return list(self._read(obs).unmatched)
+
     # -- internals ----------------------------------------------------------------------
 
     def _read(self, obs: Observation) -> _Read:
@@ -84,10 +93,13 @@ class OcrGrounder:
             c = self._cache
             if c is not None and c[0] is obs.rgb and c[1] == obs.stamp:
                 return c[2]
-        signs, doors = [], []
+        signs, doors, unmatched = [], [], []
         for sign in self._read_text(obs):
-            m = self.matcher.match([(line.text, line.score) for line in sign.lines])
+            lines = [(line.text, line.score) for line in sign.lines]
+            m = self.matcher.match(lines)
             if m is None:
+                if self.matcher.trusted(lines):
+                    unmatched.append(_unmatched(obs, sign))
                 continue
             plate = depth_geom.plate_pose(obs, sign.box)
             det = Detection(
@@ -103,7 +115,7 @@ class OcrGrounder:
                 det = replace(det, point=door.point)
             signs.append(det)
             doors.append(door)
-        result = _Read(signs, doors)
+        result = _Read(signs, doors, unmatched)
         with self._lock:
             self._cache = (obs.rgb, obs.stamp, result)
         return result
@@ -139,6 +151,16 @@ class OcrGrounder:
             entity=sign.entity,
             point=tuple(float(v) for v in door.centre),  # type: ignore[arg-type]
         )
+
+
+def _unmatched(obs: Observation, sign: SignText) -> Detection:
+    plate = depth_geom.plate_pose(obs, sign.box)
+    return Detection(
+        label=sign.text,
+        box=sign.box,
+        score=float(sign.score),
+        point=None if plate is None else tuple(float(v) for v in plate.centre),  # type: ignore[arg-type]
+    )
 
 
 def reader_and_layout(g) -> tuple[SignReader, DoorLayout]:
