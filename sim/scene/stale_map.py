@@ -10,8 +10,9 @@ the episode's route (so the robot passes it and can see it):
   layout hides the change, as it would in a real building.
 - ``moved``: a landmark on the route stands ``MOVE_M`` further along its corridor.
 - ``closed``: a corridor segment of the route is closed by a barrier
-  (``scene.blocking``), only where another way to the goal remains (the episode stays
-  solvable).
+  (``scene.blocking``) at its middle, only where another way to the goal remains (the
+  episode stays solvable) and the segment is ``MIN_CLOSED_M`` long (the barrier stands in
+  a corridor, not at a junction).
 
 The robot is given the building file unchanged; :func:`stale_world` returns the building
 the world is built from, the segments to close and what changed (:class:`StaleChange`,
@@ -36,6 +37,8 @@ from pmnav_bt.sim.scene import scene_rng
 
 MOVE_M = (3.5, 5.0)  # how far a landmark moves along its corridor (> map_check.MOVED_M)
 CLEAR_OF_DOORS_M = 1.5  # a moved landmark stays this far from every door
+MIN_CLOSED_M = 6.0  # a closed segment is this long: its barrier (at the middle) stands in a
+# corridor, not at a junction, where a turn's corner check would take it for a wall
 # Names a room may be given: none is a name of a generated or built-in room type by
 # itself, so a renamed room never takes another room's name.
 NEW_NAMES = (
@@ -140,7 +143,7 @@ def _moved(pm: PrioriMap, rng, route: list[str], goal: str) -> StaleWorld | None
 def _closed(pm: PrioriMap, rng, route: list[str], goal: str) -> StaleWorld | None:
     options = []
     for u, v in zip(route, route[1:], strict=False):
-        if not pm.graph.has_edge(u, v):
+        if not pm.graph.has_edge(u, v) or pm.graph.edges[u, v]["length"] < MIN_CLOSED_M:
             continue
         g = pm.graph.copy()
         g.remove_edge(u, v)
