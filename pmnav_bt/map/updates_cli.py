@@ -5,8 +5,10 @@ It lists the updates (number, kind, where in the building's words, the evidence)
 applies the accepted ones (``--accept 1,3``, ``--accept all``, or one question each on a
 terminal) through the building editor, shows the change as a unified diff, checks the
 result loads, and writes it: to ``--out``, or over the building file after keeping the
-old one as ``FILE.bak`` (a built-in building is never written over). Never silent: with
-nothing accepted nothing is written, and every write is named.
+old one as ``FILE.bak`` (a built-in building is never written over). The file is written
+in the canonical layout, as ``pmnav annotate`` saves it (its comments stay in the backup),
+so the diff shown is of the building's data. Never silent: with nothing accepted nothing
+is written, and every write is named.
 """
 
 from __future__ import annotations
@@ -74,8 +76,9 @@ def map_updates(
         )
     old = read_text(path, "building")
     new_path = out if out is not None else path
+    was = dump_building(pm.building)  # the diff of the data, not of the file's layout
     typer.echo("".join(difflib.unified_diff(
-        old.splitlines(keepends=True), text.splitlines(keepends=True),
+        was.splitlines(keepends=True), text.splitlines(keepends=True),
         fromfile=str(path), tofile=str(new_path),
     )), nl=False)  # fmt: skip
     if out is None:

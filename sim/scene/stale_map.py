@@ -35,8 +35,12 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.map.signage import split_number
 from pmnav_bt.sim.scene import scene_rng
 
-MOVE_M = (3.5, 5.0)  # how far a landmark moves along its corridor (> map_check.MOVED_M)
-CLEAR_OF_DOORS_M = 1.5  # a moved landmark stays this far from every door
+# How far a landmark moves along its corridor: a move a robot can tell from the sign's own
+# offset (a lift's sign hangs up to 1.5 m beside it) and its pose error (about 1 m), that
+# is beyond map_check.MOVED_M (3 m) even seen from the sign's far side.
+MOVE_M = (5.0, 6.5)
+CLEAR_M = 2.5  # a moved landmark stays this far from every door and other landmark (a lift
+# is about 2 m wide: nearer, the world would hang it over another item)
 MIN_CLOSED_M = 6.0  # a closed segment is this long: its barrier (at the middle) stands in a
 # corridor, not at a junction, where a turn's corner check would take it for a wall
 # Names a room may be given: none is a name of a generated or built-in room type by
@@ -115,9 +119,10 @@ def _renamed(pm: PrioriMap, rng, route: list[str], goal: str) -> StaleWorld | No
 
 def _moved(pm: PrioriMap, rng, route: list[str], goal: str) -> StaleWorld | None:
     b = pm.building
-    doors = np.array([r.door for r in b.rooms], float).reshape(-1, 2)
     options = []
     for lm in b.landmarks:
+        others = [r.door for r in b.rooms] + [x.pos for x in b.landmarks if x.id != lm.id]
+        items = np.array(others, float).reshape(-1, 2)
         place = pm.places.get(lm.id)
         if place is None or place.node not in route:
             continue
@@ -128,7 +133,7 @@ def _moved(pm: PrioriMap, rng, route: list[str], goal: str) -> StaleWorld | None
             new = np.asarray(lm.pos, float) + sign * float(rng.uniform(*MOVE_M)) * along
             t = float((new - ends[0]) @ along)
             inside = 0.5 <= t <= float(np.linalg.norm(ends[1] - ends[0])) - 0.5
-            clear = not len(doors) or float(np.hypot(*(doors - new).T).min()) > CLEAR_OF_DOORS_M
+            clear = not len(items) or float(np.hypot(*(items - new).T).min()) > CLEAR_M
             if inside and clear:
                 options.append((lm, new))
     if not options:
