@@ -1,7 +1,7 @@
 """Wires a run's map-updates sink into its tree: the sign and landmark checks on what
-perception reads (``perception.map_check.MapCheck``, wrapped round the grounder) and the
-sink the leaves write other disagreements to (``Context.map_updates``: a corridor that
-stays blocked). The simulator run and the ROS node call :func:`watch_map` with the sink
+perception reads (``perception.map_check.MapCheck``, watching the grounder's reader) and
+the sink the leaves write other disagreements to (``Context.map_updates``: a corridor
+that stays blocked). The simulator run and the ROS node call :func:`watch_map` with the sink
 they write beside their output (``map.updates.UpdatesFile``).
 """
 
@@ -12,17 +12,20 @@ import py_trees
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.map.updates import MapUpdateSink
-from pmnav_bt.perception.map_check import MapCheck
+from pmnav_bt.perception.map_check import MapCheck, WatchesReads
 from pmnav_bt.tree_variants import TREE_VARIANTS
 
 
 def watch_map(ctx: Context, sink: MapUpdateSink) -> None:
-    """Send what ``ctx``'s tree sees that disagrees with its map to ``sink``. A variant
-    that does not read the priori-map (the map-less baseline) has nothing to disagree with."""
+    """Send what ``ctx``'s tree sees that disagrees with its map to ``sink`` (call before
+    anything wraps ``ctx.grounder``: the ROS node's back ends, kept from run to run, get
+    this run's watcher). A variant that does not read the priori-map (the map-less
+    baseline) has nothing to disagree with."""
     if not TREE_VARIANTS.spec(ctx.config.tree.variant).knows.plans:
         return
     ctx.map_updates = sink
-    ctx.grounder = MapCheck(ctx.grounder, ctx.pm, sink, _map_T_odom)
+    if isinstance(ctx.grounder, WatchesReads):  # a reader of plates (not the oracle)
+        ctx.grounder.watch_reads(MapCheck(ctx.pm, sink, _map_T_odom).frame)
 
 
 def _map_T_odom():

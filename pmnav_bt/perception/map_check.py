@@ -1,9 +1,9 @@
 """Notices, in what perception reads, where the world disagrees with the map.
 
-:class:`MapCheck` wraps a ``Grounder`` and passes every call through unchanged. Each frame
-whose signs it sees (a ``read_signs`` call, and a ``detect`` call where the grounder also
-reports the plates it could not match: :class:`ReadsUnmatched`, the ``ocr`` back end) is
-compared with the map:
+A grounder that reads plates (``ocr``, and ``gdino_sam`` through it) tells a watcher
+what each new frame showed: the signs it matched to the map and the plates it read but
+could not match (:class:`WatchesReads`). :class:`MapCheck` is such a watcher, and
+compares each frame with the map:
 
 - **a sign that reads differently** (``sign_text``): a plate that names nothing of the map
   but starts with the room number of one room's sign ("117 Quiet Room" where the map
@@ -13,10 +13,14 @@ compared with the map:
   ``MOVED_M`` from the map's place for it, by the pose estimate. Rooms are not judged so:
   directional signs ("Radiology ->") name rooms far from their doors.
 
+Watching the reader, not wrapping the ``Grounder``, sees every frame read, whoever asked
+(the tree's capture, the coarse direction and the refiner hold the grounder apiece), at
+no further cost. The oracle (``sim_gt``) reads the map's own texts and has no watcher.
+
 A disagreement is written to the run's ``MapUpdateSink`` once it has been seen in
 ``CONFIRM_READS`` frames (one misread is not a stale map), with the reads, the pose, the
 clock time and a crop of the plate; each (kind, subject) once per run. The checks run
-where the grounder runs (on the worker), never in a tick.
+where the reading runs (on the worker), never in a tick.
 """
 
 from __future__ import annotations
@@ -34,7 +38,7 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.map.updates import Evidence, MapUpdate, MapUpdateSink
 from pmnav_bt.perception.sign_match import SignMatcher, normalise
 from pmnav_bt.planning.resolve import entity_position, sign_text
-from pmnav_bt.seams import Detection, Entity, EntityKind, Grounder, Observation, SurfaceMasks
+from pmnav_bt.seams import Detection, Entity, EntityKind, Observation
 
 CONFIRM_READS = 2  # frames that must show a disagreement before it is written
 ATTRIBUTE_M = 1.5  # a plate without a number belongs to the room whose door is this near
@@ -49,11 +53,16 @@ CROP_PAD = 0.3  # of the box's size, on each side
 MapTOdom = Callable[[], "tuple[float, float, float] | None"]
 
 
-@runtime_checkable
-class ReadsUnmatched(Protocol):
-    """A grounder that also tells which plates of a frame it read but could not match."""
+ReadsObserver = Callable[[Observation, "list[Detection]", "list[Detection]"], None]
 
-    def unmatched_signs(self, obs: Observation) -> list[Detection]: ...
+
+@runtime_checkable
+class WatchesReads(Protocol):
+    """A grounder that tells ``observer(obs, matched, unmatched)`` what each new frame it
+    reads shows: the signs matched to the map, and the plates read that named nothing
+    of it (``entity`` None, ``point`` the plate's centre). None stops telling."""
+
+    def watch_reads(self, observer: ReadsObserver | None) -> None: ...
 
 
 @dataclass
@@ -66,15 +75,11 @@ class _Seen:
 
 
 class MapCheck:
-    """A Grounder that passes everything through and writes what disagrees with the map
-    (see the module docstring). ``map_T_odom()``: the tree's current map-from-odometry
+    """Writes what disagrees with the map (see the module docstring); give ``frame`` to a
+    grounder's ``watch_reads``. ``map_T_odom()``: the tree's current map-from-odometry
     transform (None before localization)."""
 
-    def __init__(
-        self, inner: Grounder, pm: PrioriMap, sink: MapUpdateSink, map_T_odom: MapTOdom
-    ) -> None:
-        self.inner = inner
-        self.needs_sim_labels = inner.needs_sim_labels
+    def __init__(self, pm: PrioriMap, sink: MapUpdateSink, map_T_odom: MapTOdom) -> None:
         self.pm = pm
         self.sink = sink
         self.map_T_odom = map_T_odom
@@ -82,28 +87,8 @@ class MapCheck:
         self._seen: dict[tuple[str, Entity, str], _Seen] = {}
         self._written: set[tuple[str, Entity]] = set()
 
-    # -- Grounder seam --------------------------------------------------------------------
-
-    def detect(self, obs: Observation, target: Entity) -> list[Detection]:
-        dets = self.inner.detect(obs, target)
-        if isinstance(self.inner, ReadsUnmatched):
-            self._check(obs, self.inner.read_signs(obs), self.inner.unmatched_signs(obs))
-        return dets
-
-    def read_signs(self, obs: Observation) -> list[Detection]:
-        dets = self.inner.read_signs(obs)
-        unmatched = (
-            self.inner.unmatched_signs(obs) if isinstance(self.inner, ReadsUnmatched) else []
-        )
-        self._check(obs, dets, unmatched)
-        return dets
-
-    def surfaces(self, obs: Observation) -> SurfaceMasks:
-        return self.inner.surfaces(obs)
-
-    # -- the checks -----------------------------------------------------------------------
-
-    def _check(self, obs: Observation, matched: list[Detection], unmatched: list[Detection]):
+    def frame(self, obs: Observation, matched: list[Detection], unmatched: list[Detection]):
+        """Compare one frame's reads with the map."""
         tf = self.map_T_odom()
         for d in unmatched:
             xy = self._map_xy(obs, d, tf)

@@ -36,12 +36,10 @@ from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMa
 
 @dataclass
 class _Read:
-    """One frame's signs, and the door derived from each room sign (None: not derived);
-    ``unmatched``: the plates read with trusted digits that named nothing of the map."""
+    """One frame's signs, and the door derived from each room sign (None: not derived)."""
 
     signs: list[Detection]
     doors: list[Detection | None]
-    unmatched: list[Detection]
 
 
 class OcrGrounder:
@@ -61,6 +59,7 @@ class OcrGrounder:
         self.layout = layout if layout is not None else DoorLayout()
         self._lock = threading.Lock()
         self._cache: tuple[np.ndarray, float, _Read] | None = None
+        self._observer = None
 
     # -- Grounder seam ------------------------------------------------------------------
 
@@ -79,12 +78,13 @@ class OcrGrounder:
     def surfaces(self, obs: Observation) -> SurfaceMasks:
         return depth_geom.surfaces(obs)
 
-    # -- what a map check reads (perception.map_check.ReadsUnmatched) ---------------------
+    # -- what a map check watches (perception.map_check.WatchesReads) ---------------------
 
-    def unmatched_signs(self, obs: Observation) -> list[Detection]:
-        """The plates of the frame whose text names nothing of the map (``entity`` None,
-        ``point`` the plate's centre): read with the frame's signs, at no further cost."""
-        return list(self._read(obs).unmatched)
+    def watch_reads(self, observer) -> None:
+        """Tell ``observer(obs, signs, unmatched)`` what each new frame read shows:
+        ``unmatched`` are the plates read with trusted digits that named nothing of the
+        map (``entity`` None, ``point`` the plate's centre). None stops telling."""
+        self._observer = observer
 
     # -- internals ----------------------------------------------------------------------
 
@@ -98,7 +98,7 @@ class OcrGrounder:
             lines = [(line.text, line.score) for line in sign.lines]
             m = self.matcher.match(lines)
             if m is None:
-                if self.matcher.trusted(lines):
+                if self._observer is not None and self.matcher.trusted(lines):
                     unmatched.append(_unmatched(obs, sign))
                 continue
             plate = depth_geom.plate_pose(obs, sign.box)
@@ -115,9 +115,11 @@ class OcrGrounder:
                 det = replace(det, point=door.point)
             signs.append(det)
             doors.append(door)
-        result = _Read(signs, doors, unmatched)
+        result = _Read(signs, doors)
         with self._lock:
             self._cache = (obs.rgb, obs.stamp, result)
+        if self._observer is not None:
+            self._observer(obs, list(signs), unmatched)
         return result
 
     def _read_text(self, obs: Observation) -> list[SignText]:
