@@ -107,3 +107,30 @@ def test_a_landmark_where_the_map_puts_it_is_no_update(fig2_map):
 def _observation():
     k = CameraIntrinsics.from_hfov(64, 48, 1.0)
     return Observation(np.zeros((48, 64, 3), np.uint8), Pose2D(0.0, 0.0, 0.0), 1.0, k)
+
+
+def _plate(text):
+    """A plate read 2 m straight ahead that names nothing of the map."""
+    return Detection(text, (10, 10, 60, 40), 0.9, point=(2.0, 0.0, 0.0))
+
+
+def test_a_plate_without_a_number_is_the_room_whose_door_it_hangs_by(fig2_map):
+    """room8's door is at (31, 1.2); the next door, room15's, 4.5 m from the plate."""
+    sink = _Sink()
+    check = MapCheck(fig2_map, sink, lambda: (29.8, 1.2, 0.0))  # the plate at (31.8, 1.2)
+    for _ in range(CONFIRM_READS):
+        check.frame(_observation(), [], [_plate("Quiet Room")])
+    ((update, _),) = sink.updates
+    assert (update.kind, update.subject, update.seen) == ("sign_text", "room8", "Quiet Room")
+    assert update.at == pytest.approx((31.8, 1.2), abs=0.01)
+
+
+def test_a_plate_without_a_number_far_from_doors_or_before_a_fix_names_no_room(fig2_map):
+    sink = _Sink()
+    # The plate at (26, 0): 2.3 m from room7's door (24, 1.2) and room15's (28, -1.2).
+    between = MapCheck(fig2_map, sink, lambda: (24.0, 0.0, 0.0))
+    unlocalized = MapCheck(fig2_map, sink, lambda: None)
+    for _ in range(3):
+        between.frame(_observation(), [], [_plate("Quiet Room")])
+        unlocalized.frame(_observation(), [], [_plate("Quiet Room")])
+    assert sink.updates == []
