@@ -72,6 +72,7 @@ class _Seen:
     reads: list[str] = field(default_factory=list)
     at: list[tuple[float, float]] = field(default_factory=list)
     crop: np.ndarray | None = None
+    stamps: set[float] = field(default_factory=set)  # a frame counts once
 
 
 class MapCheck:
@@ -113,6 +114,9 @@ class MapCheck:
             return
         key = (kind, entity, normalise(read))
         seen = self._seen.setdefault(key, _Seen())
+        if obs.stamp in seen.stamps:
+            return
+        seen.stamps.add(obs.stamp)
         seen.reads.append(read or d.label)
         if xy is not None:
             seen.at.append(xy)
