@@ -44,9 +44,10 @@ CONFIRM_READS = 2  # frames that must show a disagreement before it is written
 ATTRIBUTE_M = 1.5  # a plate without a number belongs to the room whose door is this near
 ATTRIBUTE_MARGIN_M = 0.75  # ... and the next door is this much farther
 # A landmark's sign seen this far from the landmark's place on the map: it has moved. Its
-# sign may hang 1.5 m beside it and the pose estimate is good to about 1 m (the tree's
-# own check of a sighting allows 2 m while tracking: search.Verify).
-MOVED_M = 2.5
+# sign may hang 1.5 m beside it and the pose estimate is good to about 1 m; the tree's
+# own check of a sighting against the map rejects one 2 m off while tracking
+# (search.Verify), so a sighting this far off is already out of the ordinary.
+MOVED_M = 2.0
 CROP_MAX_PX = 160  # the crop's longer side: enough to show the plate, small on disk
 CROP_PAD = 0.3  # of the box's size, on each side
 
