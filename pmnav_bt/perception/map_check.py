@@ -5,10 +5,10 @@ what each new frame showed: the signs it matched to the map and the plates it re
 could not match (:class:`WatchesReads`). :class:`MapCheck` is such a watcher, and
 compares each frame with the map:
 
-- **a sign that reads differently** (``sign_text``): a plate that names nothing of the map
-  but starts with the room number of one room's sign ("117 Quiet Room" where the map
-  says "117 Pharmacy"), or, with no number, hangs within ``ATTRIBUTE_M`` of one room's
-  door (by the pose estimate, once localized);
+- **a sign that reads differently** (``sign_text``): a plate that names nothing of the map,
+  with a name (``MIN_NAME_LETTERS``), that starts with the room number of one room's
+  sign ("117 Quiet Room" where the map says "117 Pharmacy"), or, with no number, hangs
+  within ``ATTRIBUTE_M`` of one room's door (by the pose estimate, once localized);
 - **a landmark not where the map puts it** (``moved``): a landmark's sign seen more than
   ``MOVED_M`` from the map's place for it, by the pose estimate. Rooms are not judged so:
   directional signs ("Radiology ->") name rooms far from their doors.
@@ -35,12 +35,14 @@ import numpy as np
 
 from pmnav_bt.geometry import se2_apply, se2_compose
 from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.map.signage import split_number
 from pmnav_bt.map.updates import Evidence, MapUpdate, MapUpdateSink
 from pmnav_bt.perception.sign_match import SignMatcher, normalise
 from pmnav_bt.planning.resolve import entity_position, sign_text
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation
 
 CONFIRM_READS = 2  # frames that must show a disagreement before it is written
+MIN_NAME_LETTERS = 3  # a read with fewer letters beside its number names nothing ("1.8")
 ATTRIBUTE_M = 1.5  # a plate without a number belongs to the room whose door is this near
 ATTRIBUTE_MARGIN_M = 0.75  # ... and the next door is this much farther
 # A landmark's sign seen this far from the landmark's place on the map: it has moved. Its
@@ -93,6 +95,8 @@ class MapCheck:
         """Compare one frame's reads with the map."""
         tf = self.map_T_odom()
         for d in unmatched:
+            if sum(c.isalpha() for c in split_number(d.label)[1]) < MIN_NAME_LETTERS:
+                continue  # digits and specks: a misread, not a sign with another name
             xy = self._map_xy(obs, d, tf)
             entity = self.matcher.numbered(d.label)
             if entity is None and xy is not None:

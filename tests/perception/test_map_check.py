@@ -137,3 +137,12 @@ def test_a_plate_without_a_number_far_from_doors_or_before_a_fix_names_no_room(f
         between.frame(_observation(float(k)), [], [_plate("Quiet Room")])
         unlocalized.frame(_observation(float(k)), [], [_plate("Quiet Room")])
     assert sink.updates == []
+
+
+def test_digits_and_specks_beside_a_door_are_a_misread_not_a_renamed_room(fig2_map):
+    """Read in a realistic run: "18", then "1.8", by room14's door."""
+    sink = _Sink()
+    check = MapCheck(fig2_map, sink, lambda: (29.8, 1.2, 0.0))  # by room8's door
+    for k, text in enumerate(["18", "1.8", "1.8 B", "108 x"]):
+        check.frame(_observation(float(k)), [], [_plate(text)])
+    assert sink.updates == []
