@@ -15,6 +15,7 @@ from pmnav_bt.config import Config
 from pmnav_bt.control import Limits, Odometer
 from pmnav_bt.geometry import se2_compose, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.map.updates import NO_MAP_UPDATES, MapUpdateSink
 from pmnav_bt.pose.odometry import CalibratedBase
 from pmnav_bt.seams import Base, CoarseDirection, Grounder, Planner, Pose2D, Refiner
 from pmnav_bt.tree_variants import DetourCheck
@@ -51,6 +52,7 @@ class Context:
     odometer: Odometer = field(default_factory=Odometer)
     trace: list[TraceEvent] = field(default_factory=list)
     budget_actions: int = 500
+    map_updates: MapUpdateSink = NO_MAP_UPDATES  # where disagreements with the map go
 
     def __post_init__(self) -> None:
         if not isinstance(self.base, CalibratedBase):

@@ -10,6 +10,7 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.errors import PlanningError, UnknownNameError
 from pmnav_bt.failures import Failure, FailureCode, root_cause
+from pmnav_bt.map.updates import corridor_blocked
 from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.seams import PlanConstraints
 
@@ -194,6 +195,10 @@ class NoteFailure(PmNavBehaviour):
             if seg in suspects:
                 blocked = frozenset(self.get("blocked_segments") or ()) | {seg}
                 self.bb.set("blocked_segments", blocked)
+                self.ctx.map_updates.record(
+                    corridor_blocked(self.ctx.pm, seg, self.ctx.now(), self.ctx.base.pose(),
+                                     est if self.get("map_T_odom") else None, str(failure))
+                )  # fmt: skip
             else:
                 self.bb.set("blocked_suspects", suspects | {seg})
         self.ctx.log("replan", str(failure) if failure else "")

@@ -47,6 +47,7 @@ import threading
 import time
 import traceback
 from dataclasses import dataclass, field, fields
+from pathlib import Path
 from typing import Any
 
 from pmnav_bt.errors import PmNavError
@@ -99,6 +100,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "odom_frame": ("odom", ""),
     "publish_tf": (True, "publish map -> odom on /tf (needs tf2_msgs)"),
     "tree_log": ("", "also write the tree snapshots (JSON lines) to this file"),
+    "map_updates_dir": (
+        "", "write what each run sees that disagrees with the map to DIR/<time>-run<N>"
+        ".map_updates.jsonl"
+    ),
     "view_port": (0, "serve the live web view (pmnav view) on this port; 0: none"),
     "view_host": ("127.0.0.1", "address of the web view; only loopback unless view_allow_remote"),
     "view_allow_remote": (False, "let view_host be an address other machines reach"),
@@ -491,6 +496,9 @@ class PmNavController:
 
     def execute(self, req: GoalRequest) -> dict:
         """Run the tree for one goal and publish its result."""
+        from pmnav_bt.map.updates import SUFFIX as UPDATES_SUFFIX
+        from pmnav_bt.map.updates import UpdatesFile
+        from pmnav_bt.trees.map_watch import watch_map
         from pmnav_bt.trees.runner import make_context, run_tree
         from pmnav_bt.trees.view_record import ViewRecorder
 
@@ -506,6 +514,9 @@ class PmNavController:
         ctx = make_context(
             self.base, self.pm, cfg, seed=int(p["seed"]), budget=budget, backends=self.backends
         )
+        if p["map_updates_dir"]:  # reviewed later with 'pmnav map updates FILE'
+            name = f"{time.strftime('%Y%m%d-%H%M%S')}-run{run.id}{UPDATES_SUFFIX}"
+            watch_map(ctx, UpdatesFile(Path(p["map_updates_dir"]) / name, p["building"]))
         viz = _Viz(self, ctx)
         tee = open(p["tree_log"], "a", encoding="utf-8") if p["tree_log"] else None  # noqa: SIM115
         writer = _SnapshotWriter(self.pub_tree, self.pub_structure, tee, self.view_writer)

@@ -50,4 +50,8 @@ def check_parameters(params: dict[str, Any]) -> dict[str, Any]:
         from pmnav_bt.loading import check_output_file
 
         check_output_file(params["tree_log"], "parameter 'tree_log'")
+    if params.get("map_updates_dir"):
+        from pmnav_bt.loading import check_output_dir
+
+        check_output_dir(params["map_updates_dir"], "parameter 'map_updates_dir'")
     return params

@@ -18,6 +18,7 @@ import typer
 from pmnav_bt.cli_values import run_cli
 from pmnav_bt.errors import BuildingFileError, PmNavError
 from pmnav_bt.loading import check_output_file
+from pmnav_bt.map.updates_cli import map_updates
 from pmnav_bt.webview.cli import view
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
@@ -212,6 +213,7 @@ def annotate(file: Path = typer.Argument(..., help="The building file to edit (Y
 
 
 app.command("view")(view)
+app.command("map-updates")(map_updates)
 
 
 def _error_line(err: PmNavError) -> str:
@@ -221,7 +223,8 @@ def _error_line(err: PmNavError) -> str:
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run the app; user errors become one line on stderr and exit status 2."""
     args = list(sys.argv[1:] if argv is None else argv)
-    if args[:2] in (["map", "draft"], ["map", "import-rmf"]):  # 'pmnav map FILE' is a command
+    sub = ("draft", "import-rmf", "updates")  # 'pmnav map FILE' is a command, so
+    if args[:1] == ["map"] and args[1:2] and args[1] in sub:  # 'map draft' is map-draft
         args = [f"map-{args[1]}", *args[2:]]
     run_cli(app, args, "pmnav", _error_line)
 

@@ -399,6 +399,15 @@ class WorldConfig(_Section):
     camera_exposure_time: float = Field(
         0.0, ge=0.0, le=0.2, description="s the shutter is open (motion blur while turning)"
     )
+    stale_map: float = Field(
+        0.0, ge=0.0, le=1.0, description="probability that the world differs from the map the "
+        "robot gets by one change on the route (sim/scene/stale_map.py; 0 in both presets)",
+    )
+    stale_kinds: list[Literal["renamed", "moved", "closed"]] = Field(
+        ["renamed", "moved", "closed"], min_length=1, max_length=3,
+        description="the changes a stale map may have: a room renamed, a landmark moved, a "
+        "corridor closed (where another way remains)",
+    )
 
     @model_validator(mode="before")
     @classmethod

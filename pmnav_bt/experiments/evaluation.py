@@ -31,6 +31,7 @@ class EpisodeRun:
     result: EpisodeResult
     plot: Path | None = None
     tree_log: Path | None = None
+    map_updates: Path | None = None  # what the run saw that disagrees with the map
 
 
 def custom_episode(building: str, goal: str, start: str | None = None, seed: int = 0) -> Episode:
@@ -96,6 +97,8 @@ def run_episode(
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     ``also_log``: a second sink for the tree log's lines (the live web view, ``--view``).
     """
+    from pmnav_bt.map.updates import SUFFIX as UPDATES_SUFFIX
+    from pmnav_bt.map.updates import UpdatesFile
     from pmnav_bt.sim.episodes import (
         episode_map,
         goal_door_in_world,
@@ -105,7 +108,9 @@ def run_episode(
     from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.robot import COLLISION_HEIGHT
     from pmnav_bt.sim.scene.blocking import block_segment
+    from pmnav_bt.sim.scene.stale_map import stale_world
     from pmnav_bt.sim.world import SimWorld
+    from pmnav_bt.trees.map_watch import watch_map
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
     from pmnav_bt.trees.view_record import ViewRecorder
 
@@ -114,10 +119,11 @@ def run_episode(
     folder = file.parent
     sim = config.sim
     t0 = time.perf_counter()
+    stale = stale_world(pm, config.world, episode.seed, episode.route, episode.goal)
     with SimWorld(
-        b, walls=sim.walls, base_dir=folder, scene=config.world, seed=episode.seed
+        stale.building, walls=sim.walls, base_dir=folder, scene=config.world, seed=episode.seed
     ) as world:
-        for ref in episode.blocked:  # a way closed on purpose is part of the building as built
+        for ref in (*episode.blocked, *stale.closed):  # closed ways: the building as built
             block_segment(world, pm, ref)
         # SPL's shortest path: in the building as built (landmarks, not added obstacles).
         footprints = world.obstacle_footprints(COLLISION_HEIGHT)
@@ -130,6 +136,11 @@ def run_episode(
         inner, base = simulated_robot(world, sim, episode.start_pose, episode.seed)
         budget = action_budget(config, episode.route_length)
         ctx = make_context(base, pm, config, seed=episode.seed, budget=budget, deferred_work=True)
+        updates = None
+        if out_dir is not None:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            updates = out_dir / f"{safe_filename(episode.id)}{UPDATES_SUFFIX}"
+            watch_map(ctx, UpdatesFile(updates, _building_ref(file, b.name)))
         truth: list[tuple[float, float, float]] = []
 
         def record(tree) -> None:
@@ -169,7 +180,7 @@ def run_episode(
     if out_dir is not None and plot:
         plot_path = out_dir / f"{safe_filename(episode.id)}.trajectory.png"
         _plot(pm, ctx.trace, truth, plot_path, result, config, outcome, folder)
-    return EpisodeRun(result, plot_path, log_path)
+    return EpisodeRun(result, plot_path, log_path, updates)
 
 
 def _building_ref(file: Path, name: str) -> str:

@@ -230,6 +230,7 @@ def run(
         if res.failure_reason:
             typer.echo(f"reason: {res.failure_reason}")
         typer.echo(f"tree log: {r.tree_log}\ntrajectory plot: {r.plot}")
+        typer.echo(f"map updates: {r.map_updates} (review: pmnav map updates FILE)")
         hold()
     if not res.success:
         raise typer.Exit(1)

@@ -22,6 +22,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from pmnav_bt.map.building import Building
+from pmnav_bt.map.signage import split_number
 from pmnav_bt.seams import Entity
 
 MIN_SIMILARITY = 0.78  # difflib ratio for a fuzzy word match
@@ -90,6 +91,7 @@ class SignMatcher:
     def __init__(self, building: Building):
         self.keys: list[tuple[str, Entity]] = []
         self._numbers: dict[Entity, str] = {}
+        self._sign_numbers: dict[str, list[Entity]] = {}  # "117" -> entities whose signs start so
         for r in building.rooms:
             self._add(Entity.room(r.id), r.sign_text, r.name, *r.aliases)
         for lm in building.landmarks:
@@ -97,6 +99,9 @@ class SignMatcher:
 
     def _add(self, entity: Entity, sign: str, *names: str) -> None:
         texts = [sign, *names]
+        number = split_number(sign)[0].casefold()
+        if number:
+            self._sign_numbers.setdefault(number, []).append(entity)
         num = sign_number(sign)
         if num is not None:
             self._numbers[entity] = digits(num)
@@ -113,6 +118,20 @@ class SignMatcher:
         """The first key registered for ``entity`` (its sign text, normalised)."""
         return next(k for k, e in self.keys if e == entity)
 
+    @staticmethod
+    def trusted(lines: Sequence[tuple[str, float]]) -> bool:
+        """False when a line shows digits read with a low recogniser score."""
+        return not any(digits(normalise(fix_numbers(t))) and s < MIN_DIGIT_SCORE for t, s in lines)
+
+    def numbered(self, text: str) -> Entity | None:
+        """The one entity whose sign starts with the room number ``text`` starts with, when
+        ``text`` also has a name: for a reading that matched nothing, the room whose sign
+        reads differently from the map ("117 Quiet Room" where the map says "117
+        Pharmacy"). None without a number, a name, or a single owner of the number."""
+        number, name = split_number(fix_numbers(text))
+        owners = self._sign_numbers.get(number.casefold(), []) if number and name else []
+        return owners[0] if len(owners) == 1 else None
+
     def match(self, lines: Sequence[tuple[str, float]]) -> Match | None:
         """The entity that the lines of one sign (text, recogniser score) name, or None.
 
@@ -120,7 +139,7 @@ class SignMatcher:
         the lines without digits are, and the digits read must then be a part of the
         matched sign's number.
         """
-        if any(digits(normalise(fix_numbers(t))) and s < MIN_DIGIT_SCORE for t, s in lines):
+        if not self.trusted(lines):
             return None  # digits we do not trust: never guess a number
         whole = self._match_whole(" ".join(t for t, _ in lines))
         if whole is not None or len(lines) < 2:

@@ -237,3 +237,28 @@ def test_note_failure_after_a_planning_failure_blocks_nothing_new(make_rig):
     assert rig.tick(NoteFailure("NoteFailure", rig.ctx)) == Status.SUCCESS
     assert rig.get("blocked_segments") == frozenset({3})
     assert rig.get("blocked_suspects") is None
+
+
+def test_a_corridor_found_blocked_for_good_is_written_as_a_map_update(make_rig):
+    rig = make_rig(SOUTH_AT_20)
+    written = []
+
+    class Sink:
+        def record(self, update, crop=None):
+            written.append(update)
+
+    rig.ctx.map_updates = Sink()
+    rig.set(
+        map_T_odom=EAST_AT_12,
+        failure=Failure(FailureCode.BLOCKED, "obstacle 0.4 m ahead"),
+        target=rig.plan("12,0,0", "room17").steps[0],
+    )
+    note = NoteFailure("NoteFailure", rig.ctx)
+    rig.tick(note)
+    assert written == []  # suspected only
+    rig.tick(note)
+    (update,) = written
+    assert (update.kind, update.subject_kind, update.subject) == ("corridor_blocked", "segment",
+                                                                  "seg11")  # fmt: skip
+    assert update.evidence.reads == ("BLOCKED: obstacle 0.4 m ahead",)
+    assert update.at == pytest.approx((12.0, 0.0), abs=0.01)

@@ -109,6 +109,10 @@ class GdinoSamGrounder:
     def read_signs(self, obs: Observation) -> list[Detection]:
         return self.signs.read_signs(obs)
 
+    def watch_reads(self, observer) -> None:
+        """The sign reader's frames (``perception.map_check.WatchesReads``)."""
+        self.signs.watch_reads(observer)
+
     def surfaces(self, obs: Observation) -> SurfaceMasks:
         return depth_geom.surfaces(obs)
 

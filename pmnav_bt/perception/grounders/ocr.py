@@ -59,6 +59,7 @@ class OcrGrounder:
         self.layout = layout if layout is not None else DoorLayout()
         self._lock = threading.Lock()
         self._cache: tuple[np.ndarray, float, _Read] | None = None
+        self._observer = None
 
     # -- Grounder seam ------------------------------------------------------------------
 
@@ -77,6 +78,14 @@ class OcrGrounder:
     def surfaces(self, obs: Observation) -> SurfaceMasks:
         return depth_geom.surfaces(obs)
 
+    # -- what a map check watches (perception.map_check.WatchesReads) ---------------------
+
+    def watch_reads(self, observer) -> None:
+        """Tell ``observer(obs, signs, unmatched)`` what each new frame read shows:
+        ``unmatched`` are the plates read with trusted digits that named nothing of the
+        map (``entity`` None, ``point`` the plate's centre). None stops telling."""
+        self._observer = observer
+
     # -- internals ----------------------------------------------------------------------
 
     def _read(self, obs: Observation) -> _Read:
@@ -84,10 +93,13 @@ class OcrGrounder:
             c = self._cache
             if c is not None and c[0] is obs.rgb and c[1] == obs.stamp:
                 return c[2]
-        signs, doors = [], []
+        signs, doors, unmatched = [], [], []
         for sign in self._read_text(obs):
-            m = self.matcher.match([(line.text, line.score) for line in sign.lines])
+            lines = [(line.text, line.score) for line in sign.lines]
+            m = self.matcher.match(lines)
             if m is None:
+                if self._observer is not None and self.matcher.trusted(lines):
+                    unmatched.append(_unmatched(obs, sign))
                 continue
             plate = depth_geom.plate_pose(obs, sign.box)
             det = Detection(
@@ -106,6 +118,8 @@ class OcrGrounder:
         result = _Read(signs, doors)
         with self._lock:
             self._cache = (obs.rgb, obs.stamp, result)
+        if self._observer is not None:
+            self._observer(obs, list(signs), unmatched)
         return result
 
     def _read_text(self, obs: Observation) -> list[SignText]:
@@ -139,6 +153,16 @@ class OcrGrounder:
             entity=sign.entity,
             point=tuple(float(v) for v in door.centre),  # type: ignore[arg-type]
         )
+
+
+def _unmatched(obs: Observation, sign: SignText) -> Detection:
+    plate = depth_geom.plate_pose(obs, sign.box)
+    return Detection(
+        label=sign.text,
+        box=sign.box,
+        score=float(sign.score),
+        point=None if plate is None else tuple(float(v) for v in plate.centre),  # type: ignore[arg-type]
+    )
 
 
 def reader_and_layout(g) -> tuple[SignReader, DoorLayout]:
