@@ -304,16 +304,29 @@ class DriveAlongCorridor(_LooksAtWalls):
     """
 
     READS = ("belief", "corridor_drive")
-    WRITES = ("corridor_drive", "drive_end")
-    JOBS = ("_look", "_rethink_job")
+    WRITES = ("corridor_drive", "drive_end", "belief")
+    JOBS = ("_look", "_rethink_job", "_ray_job")
 
     def initialise(self) -> None:
         super().initialise()
         self._rethink_job = None
+        self._ray_job = None  # the belief with the last view ahead weighed in (worker)
         self._best_t = self.ctx.now()
         self._stopped = False
+        self._ended = False
 
     def update(self) -> Status:
+        """The drive (``_drive``); its end waits for the view ahead still being weighed
+        into the belief (one tick in simulation), so that no drive loses its last ray."""
+        self._take_ray()
+        if not self._ended:
+            status = self._drive()
+            if status != Status.SUCCESS:
+                return status
+            self._ended = True
+        return Status.RUNNING if self._ray_job is not None else Status.SUCCESS
+
+    def _drive(self) -> Status:
         if self._stopped:  # the tick at rest after stopping for a corner or a block
             return Status.SUCCESS
         base, now, drive = self.ctx.base, self.ctx.now(), self.drive
@@ -390,10 +403,11 @@ class DriveAlongCorridor(_LooksAtWalls):
         doors seen along the walls (None: not looked for) to the belief every
         ``RAY_SPACING_M`` of the drive. Not after the odometry's distance gain
         has changed until the next look moves the belief to it (in the worker: too slow for
-        a tick): a ray would mix two gains."""
+        a tick): a ray would mix two gains. The ray is weighed in the worker, on a fork of
+        the belief that replaces it when done (``_take_ray``)."""
         belief: CorridorBelief | None = self.get("belief")
-        if belief is None or look.free is None or self._rethink_job is not None:
-            return  # (not while the lead is worked out again on the belief, in the worker)
+        if belief is None or look.free is None or self._rethink_job or self._ray_job:
+            return  # (not while the worker has the belief: the lead, or the last ray)
         base, drive, seen_from = self.ctx.base, self.drive, look.seen_from
         if isinstance(base, CalibratedBase) and belief.rescale_due(base.distance_gain):
             return
@@ -401,7 +415,27 @@ class DriveAlongCorridor(_LooksAtWalls):
         if math.hypot(seen_from.x - x, seen_from.y - y) < RAY_SPACING_M:
             return
         drive.last_ray = (seen_from.x, seen_from.y)
-        belief.observe_ray(seen_from, min(look.free, 50.0), axis, look.doors)
+        free, doors = min(look.free, 50.0), look.doors
+
+        def weigh(cancelled) -> CorridorBelief:  # every hypothesis: too slow for a tick
+            b = belief.fork()
+            b.observe_ray(seen_from, free, axis, doors)
+            return b
+
+        self._ray_job = self.ctx.worker.submit(weigh)
+
+    def _take_ray(self) -> None:
+        """The belief with the last view ahead weighed in, once the worker has it, in
+        place of the one it was forked from (a way blocked since is kept)."""
+        if self._ray_job is None or not self._ray_job.done():
+            return
+        job, self._ray_job = self._ray_job, None
+        try:
+            weighed = job.result()
+        except Exception:  # noqa: BLE001 - a lost ray: the belief goes on without it
+            return
+        weighed.pending_blocked = self.get("belief").pending_blocked
+        self.bb.set("belief", weighed)
 
     def _rethink(self, pose: Pose2D) -> bool:
         """Whether the lead, worked out again (worker) every ``RETHINK_EVERY_M`` of the drive
@@ -417,7 +451,7 @@ class DriveAlongCorridor(_LooksAtWalls):
                 return False
         drive = self.drive
         moved = math.hypot(pose.x - drive.thought_at[0], pose.y - drive.thought_at[1])
-        if belief is not None and moved >= RETHINK_EVERY_M:
+        if belief is not None and moved >= RETHINK_EVERY_M and self._ray_job is None:
             drive.thought_at = (pose.x, pose.y)
             heading, most = drive.heading, drive.max_distance
             self._rethink_job = self.ctx.worker.submit(

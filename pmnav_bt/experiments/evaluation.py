@@ -96,6 +96,7 @@ def run_episode(
     ``setup_world(world)`` may change the world first (add an obstacle, for example).
     ``also_log``: a second sink for the tree log's lines (the live web view, ``--view``).
     """
+    from pmnav_bt.pose.evidence.floor_model import building_grid
     from pmnav_bt.sim.episodes import (
         episode_map,
         goal_door_in_world,
@@ -129,7 +130,10 @@ def run_episode(
             setup_world(world)
         inner, base = simulated_robot(world, sim, episode.start_pose, episode.seed)
         budget = action_budget(config, episode.route_length)
-        ctx = make_context(base, pm, config, seed=episode.seed, budget=budget, deferred_work=True)
+        grid = building_grid(b, folder)
+        ctx = make_context(
+            base, pm, config, seed=episode.seed, budget=budget, deferred_work=True, grid=grid
+        )
         truth: list[tuple[float, float, float]] = []
 
         def record(tree) -> None:

@@ -33,6 +33,7 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose import lead as leads
 from pmnav_bt.pose import telling
 from pmnav_bt.pose.evidence import Evidence
+from pmnav_bt.pose.evidence.floor_model import CORRIDORS, WallSource
 from pmnav_bt.pose.evidence.prior import weigh_prior
 from pmnav_bt.pose.evidence.signs import PLACE_SIGMA_M, SIGHT_SIGMA_M
 from pmnav_bt.pose.glimpse import Glimpse
@@ -79,6 +80,9 @@ class CorridorBelief:
     # The odometry's distance gain (``CalibratedBase``) the positions held were driven
     # under: when it changes, they are scaled about the reference (``rescale``).
     gain: float = 1.0
+    # The walls depth is weighed against (``evidence.floor_model``): the corridor
+    # rectangles, or the building's grid as a likelihood field.
+    walls: WallSource = CORRIDORS
     # The odometry straightened by the walls (None before the first glimpse), and the
     # walls' axis in it at the last glimpse (None: not measured, or not taken).
     _odo: Straightened | None = field(default=None, init=False, repr=False)
@@ -90,7 +94,7 @@ class CorridorBelief:
         self.goal = Visibility.of(
             self.pm, self.read_range if self.lead_range is None else self.lead_range
         )
-        self.evidence = Evidence.of(self.pm, self.vis, self.recall)
+        self.evidence = Evidence.of(self.pm, self.vis, self.recall, self.walls)
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs
@@ -166,7 +170,7 @@ class CorridorBelief:
         for g in self.glimpses:
             self.evidence.look(self.logw, g, tfs, self.ref)
         for r in self.rays:
-            self.evidence.drive_view(self.logw, r, tfs)
+            self.evidence.drive_view(self.logw, r, tfs, self.ref)
 
     # -- updates --------------------------------------------------------------------------
 
@@ -235,7 +239,7 @@ class CorridorBelief:
         if doors is not None:
             seen = tuple(tuple(self.straighten(xy)) for xy in doors)
             ray = replace(ray, doors=seen, door_views=(yaw,))
-        self.evidence.drive_view(self.logw, ray, self.map_T_odoms())
+        self.evidence.drive_view(self.logw, ray, self.map_T_odoms(), self.ref)
         self.rays.append(ray)
 
     def rescale(self, gain: float) -> None:
