@@ -6,6 +6,7 @@ again, what it is told). A status is asserted per tick where the tick matters.""
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass, field
 
 import pytest
@@ -46,6 +47,7 @@ class ScriptedBelief:
     pending_blocked: float | None = None
     asked_again: list[tuple[float, float]] = field(default_factory=list)  # (x, heading)
     rays: list[float] = field(default_factory=list)
+    in_tick: list[bool] = field(default_factory=list)  # each ray: weighed on the tick's thread
 
     def lead(self, pose, most):
         return self.lead_
@@ -56,6 +58,10 @@ class ScriptedBelief:
 
     def observe_ray(self, seen_from, free, axis, doors):
         self.rays.append(seen_from.x)
+        self.in_tick.append(threading.current_thread() is threading.main_thread())
+
+    def fork(self):  # the drive weighs a ray on a fork, in the worker
+        return self
 
     def rescale_due(self, gain):
         return False
@@ -160,7 +166,8 @@ def test_a_sign_read_ahead_cuts_the_distance_short(make_rig, monkeypatch):
 
 
 def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(make_rig, monkeypatch):
-    """Depth shows a wall 0.6 m ahead 2 m into the drive: stop in that tick, SUCCESS,
+    """Depth shows a wall 0.6 m ahead 2 m into the drive: stop in that tick, SUCCESS once
+    the view ahead taken there is weighed into the belief (in the worker: the next tick),
     and the belief notes the drive's heading blocked."""
     belief = ScriptedBelief(Lead(heading=0.0, distance=6.0))
 
@@ -170,8 +177,10 @@ def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(make_rig, monkeyp
     r = rig_with(make_rig, monkeypatch, wall_at_6, belief)
     seen = run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
     assert (seen[-1][0], seen[-1][2]) == (Status.SUCCESS, (0.0, 0.0))
-    assert seen[-2][1] == "LocalizeDrive" and seen[-2][2][0] > 0.0  # driving until then
+    assert seen[-2][1] == "LocalizeDrive" and seen[-2][2] == (0.0, 0.0)  # stopped, the
+    assert seen[-3][1] == "LocalizeDrive" and seen[-3][2][0] > 0.0  # ray weighed: then on
     assert r.get("drive_end") == DriveEnd.WALL
+    assert belief.rays[-1] >= 6.0  # the view at the wall was told
     assert belief.pending_blocked == pytest.approx(0.0)
     assert 6.0 <= r.base.pose().x < 7.2  # a wall look a second
 
@@ -296,6 +305,16 @@ def test_the_drive_tells_the_belief_the_floor_ahead_every_metre(make_rig, monkey
     run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
     steps = [b - a for a, b in zip([EAST.x, *belief.rays], belief.rays, strict=False)]
     assert len(belief.rays) >= 3 and all(s >= 1.0 for s in steps), belief.rays
+
+
+def test_the_view_ahead_is_weighed_in_the_worker_not_in_the_tick(make_rig, monkeypatch):
+    """Weighing a ray reweighs every hypothesis (milliseconds against a grid): the tick
+    hands it to the worker, and the belief the worker returns replaces the old one."""
+    belief = ScriptedBelief(Lead(heading=0.0, distance=4.5))
+    r = rig_with(make_rig, monkeypatch, belief=belief)
+    run(r, follow_lead_subtree(r.ctx, max_distance=8.0))
+    assert belief.rays and not any(belief.in_tick)
+    assert r.get("belief") is belief  # (the scripted fork is the belief itself)
 
 
 def test_an_interrupted_drive_stops_the_body(make_rig, monkeypatch):

@@ -58,13 +58,14 @@ class Evidence:
         of ``tfs``: where it was (inside a wall?), a blocked drive, depth along each view,
         the doors seen along the walls and the signs read (``ref``: the reference, from
         which the odometry's drift grows)."""
-        sigma = sight_sigma(math.hypot(g.odom.x - ref.x, g.odom.y - ref.y))
+        travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
+        sigma = sight_sigma(travelled)
         here = apply_many(tfs, (g.odom.x, g.odom.y))
         self.floor.stand(logw, here)
         if g.blocked is not None:  # the corridor must end (or turn) just ahead
             logw += self.floor.blocked_log(tfs, (g.odom.x, g.odom.y), g.blocked)
         for yaw, free in g.free:
-            self.floor.depth_ray(logw, tfs, here, g.odom, yaw, free, sigma, True)
+            self.floor.depth_ray(logw, tfs, here, g.odom, yaw, free, travelled, True)
         self.doors.weigh(
             logw, self.floor, g.doors, g.door_views, tfs, here,
             P_DOOR_MISS, P_DOOR_SPURIOUS, sigma,
@@ -75,10 +76,10 @@ class Evidence:
     def drive_view(self, logw: np.ndarray, r: Glimpse, tfs: np.ndarray, ref: Pose2D) -> None:
         """Add the view ahead while driving ``r`` (``CorridorBelief.observe_ray``): its free
         floor and the doors seen in it, each weaker than at a look round."""
-        sigma = sight_sigma(math.hypot(r.odom.x - ref.x, r.odom.y - ref.y))
+        travelled = math.hypot(r.odom.x - ref.x, r.odom.y - ref.y)
         here = apply_many(tfs, (r.odom.x, r.odom.y))
         for yaw, free in r.free:
-            self.floor.depth_ray(logw, tfs, here, r.odom, yaw, free, sigma, False)
+            self.floor.depth_ray(logw, tfs, here, r.odom, yaw, free, travelled, False)
         self.doors.weigh(
             logw, self.floor, r.doors, r.door_views, tfs, here,
             P_DRIVE_DOOR_MISS, P_DRIVE_DOOR_SPURIOUS, SIGHT_SIGMA_M,

@@ -89,12 +89,12 @@ class CorridorFloor:
         odom: Pose2D,
         yaw: float,
         free: float,
-        sigma: float,
+        travelled: float,
         at_look: bool,
     ) -> None:
         """At a look round, a wall close ahead (``wall_ahead``) and the free floor
         (``free_floor``, ``P_DEPTH``); while driving, the free floor only
-        (``P_DRIVE_RAY``). ``sigma`` is not used: the corridors' slack is fixed."""
+        (``P_DRIVE_RAY``). ``travelled`` is not used: the corridors' slack is fixed."""
         if at_look:
             self.wall_ahead(logw, tfs, odom, yaw, free)
         self.free_floor(logw, tfs, here, odom, yaw, free, P_DEPTH if at_look else P_DRIVE_RAY)

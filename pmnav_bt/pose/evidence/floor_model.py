@@ -59,13 +59,13 @@ class FloorModel(Protocol):
         odom: Pose2D,
         yaw: float,
         free: float,
-        sigma: float,
+        travelled: float,
         at_look: bool,
     ) -> None:
         """The free floor seen in depth along ``yaw`` from ``odom`` (``free`` m to the first
         thing standing on it): at a look round (``at_look``) or one view ahead while
-        driving (weaker: the same wall is seen again every metre). ``sigma``: how far (m)
-        the true hypothesis may put a point seen from here off its place."""
+        driving (weaker: the same wall is seen again every metre). ``travelled``: how far
+        (m, odometry) ``odom`` is from the belief's reference, from which drift grows."""
 
     def clear(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """(K,) whether the line of sight from each ``a`` to each ``b`` ((K, 2) map) stays

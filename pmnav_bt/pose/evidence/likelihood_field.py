@@ -49,13 +49,14 @@ from pmnav_bt.pose.evidence.floor import (
     P_THROUGH_WALL,
     RAY_SLACK_M,
 )
+from pmnav_bt.pose.evidence.signs import DRIFT_PER_M
 from pmnav_bt.pose.visibility import Visibility
 from pmnav_bt.seams import Pose2D
 
 # The spread (m) of a depth return about the nearest wall under the true hypothesis, at
 # the reference: hypotheses stand every 0.5 m along the centre lines (a quarter-metre
 # off, at most), the centre line is found in depth to a decimetre or two, depth is good
-# to a few centimetres. It grows with the odometry's drift (``sight_sigma`` is passed in).
+# to a few centimetres. It grows with the odometry's drift (``signs.DRIFT_PER_M``).
 FIELD_SIGMA_M = 0.3
 # A return no wall explains: clutter, people, a door the grid shows shut. At a look
 # round, 72 returns (six views, twelve bearings) that see the same walls in neighbouring
@@ -174,7 +175,7 @@ class GridFloor:
         odom: Pose2D,
         yaw: float,
         free: float,
-        sigma: float,
+        travelled: float,
         at_look: bool,
     ) -> None:
         """The floor seen along ``yaw`` through a wall, and the return's distance to the
@@ -183,13 +184,13 @@ class GridFloor:
         way = np.stack([np.cos(a), np.sin(a)], 1)
         reach = min(free, MAX_RAY_M)
         dist, facing = self.field.march(here, way, reach)
-        beyond = np.where(np.isinf(dist), 0.0, (reach - dist) * facing)
+        beyond = _beyond(reach, dist, facing)
         p_floor = P_DEPTH if at_look else P_DRIVE_RAY
         logw += np.where(beyond > RAY_SLACK_M, math.log(p_floor), 0.0)
         if free < MAX_RAY_M:
             d = self.field.surface(here + free * way)
             z = P_UNEXPLAINED if at_look else P_DRIVE_UNEXPLAINED
-            sigma = max(sigma, FIELD_SIGMA_M)
+            sigma = math.hypot(FIELD_SIGMA_M, DRIFT_PER_M * travelled)
             logw += np.log((1.0 - z) * np.exp(-0.5 * (d / sigma) ** 2) + z)
 
     def clear(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -199,11 +200,18 @@ class GridFloor:
         length = np.hypot(d[:, 0], d[:, 1])
         way = d / np.maximum(length, 1e-9)[:, None]
         dist, facing = self.field.march(a, way, length)
-        beyond = np.where(np.isinf(dist), 0.0, (length - dist) * facing)
-        return beyond <= RAY_SLACK_M
+        return _beyond(length, dist, facing) <= RAY_SLACK_M
 
     def reach(self, xy: np.ndarray, angles: np.ndarray, most: float) -> np.ndarray:
         """How far the floor runs from ``xy`` along each of ``angles``, to ``most``."""
         way = np.stack([np.cos(angles), np.sin(angles)], 1)
         dist, _ = self.field.march(np.broadcast_to(xy, way.shape), way, most)
         return np.minimum(dist, most)
+
+
+def _beyond(reach, dist: np.ndarray, facing: np.ndarray) -> np.ndarray:
+    """How far (m) past the wall a ray met at ``dist`` its end at ``reach`` lies, measured
+    across that wall (``facing``: |cos| of the ray against the wall's normal); 0 where the
+    ray met none (``dist`` inf)."""
+    met = np.isfinite(dist)
+    return np.where(met, (reach - np.where(met, dist, reach)) * facing, 0.0)
