@@ -7,7 +7,8 @@ own:
   corridor centre line, facing along or across it) and their motion update (odometry
   straightened by the walls);
 - ``pose.evidence``: what reweights them, one kind of evidence a module (signs read,
-  missed and misread; the corridors' floor in depth; doors along the walls; a prior);
+  missed and misread; the floor in depth, against the corridor rectangles or the
+  building's grid; doors along the walls; a prior);
 - ``pose.lead`` and ``pose.telling``: where to drive or look next.
 
 Every glimpse (a panorama: the signs read there and where each was seen, in odometry)
