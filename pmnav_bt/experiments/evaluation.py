@@ -130,7 +130,9 @@ def run_episode(
             setup_world(world)
         inner, base = simulated_robot(world, sim, episode.start_pose, episode.seed)
         budget = action_budget(config, episode.route_length)
-        grid = building_grid(b, folder)
+        # The building's grid is the robot's map of its walls where the world is built
+        # from it; with the annotated walls the world is the rectangles, and so is its map.
+        grid = building_grid(b, folder) if sim.walls == "grid" else None
         ctx = make_context(
             base, pm, config, seed=episode.seed, budget=budget, deferred_work=True, grid=grid
         )

@@ -136,7 +136,8 @@ def run_localization(
     pose = Pose2D(start.x, start.y, start.yaw)
     with SimWorld(b, walls=config.sim.walls, base_dir=folder) as world:
         inner, base = simulated_robot(world, config.sim, pose, start.seed)
-        grid = building_grid(b, folder)
+        # The grid is the map of the walls where the world is built from it (evaluation).
+        grid = building_grid(b, folder) if config.sim.walls == "grid" else None
         ctx = make_context(base, pm, config, seed=start.seed, deferred_work=True, grid=grid)
         py_trees.blackboard.Blackboard.clear()
         tree = py_trees.trees.BehaviourTree(active_localize_subtree(ctx))

@@ -134,7 +134,8 @@ def wall_source(name: str | None, grid: FloorPlanImage | None) -> WallSource:
     if grid is None:
         raise ConfigError(
             f"tree.localization_walls: {name!r} needs the building's occupancy grid "
-            "(floor_plan.ros_map), and this building has none; use 'corridors' or unset it"
+            "(floor_plan.ros_map; in the simulator, with sim.walls=grid), and there is none; "
+            "use 'corridors' or unset it"
         )
     from pmnav_bt.pose.evidence.likelihood_field import LikelihoodField
 

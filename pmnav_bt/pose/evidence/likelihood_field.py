@@ -92,12 +92,14 @@ class LikelihoodField:
         to_free = distance_transform_edt(~free) * res  # wall cells: to the nearest free one
         # Cell centres are half a cell from the surface between them.
         signed = np.where(free, to_wall - res / 2.0, res / 2.0 - to_free).astype(np.float32)
-        gy, gx = np.gradient(signed)  # rows run down the image: map y is -row
+        gy, gx = np.gradient(signed)  # rows run down the image: the grid's y is -row
         norm = np.hypot(gx, gy)
         norm[norm == 0.0] = 1.0
+        c, s = math.cos(plan.origin[2]), math.sin(plan.origin[2])  # the grid's axes in the map
+        ux, uy = gx / norm, -gy / norm
         block = cv2.dilate((~free).astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
-        return cls(plan, signed, (gx / norm).astype(np.float32), (-gy / norm).astype(np.float32),
-                   block)  # fmt: skip
+        nx, ny = (c * ux - s * uy).astype(np.float32), (s * ux + c * uy).astype(np.float32)
+        return cls(plan, signed, nx, ny, block)
 
     def cells(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(rows, cols) of the padded arrays holding map points ``xy`` (..., 2); points
