@@ -38,7 +38,7 @@ from pmnav_bt.pose.evidence.floor_model import CORRIDORS, WallSource
 from pmnav_bt.pose.evidence.prior import weigh_prior
 from pmnav_bt.pose.evidence.signs import PLACE_SIGMA_M, SIGHT_SIGMA_M
 from pmnav_bt.pose.glimpse import Glimpse
-from pmnav_bt.pose.hypotheses import FIX_MASS, Hypotheses, Straightened
+from pmnav_bt.pose.hypotheses import FIX_MASS, Hypotheses, Straightened, apply_many
 from pmnav_bt.pose.landmark_fix import sign_shift
 from pmnav_bt.pose.lead import Lead
 from pmnav_bt.pose.visibility import Visibility, entity_xy
@@ -50,6 +50,9 @@ HYPOTHESIS_SIGMA_M = 0.5  # a hypothesis is a lattice point: no surer of the pla
 MIN_BLIND_GLIMPSES = 4  # glimpses before a fix from the corridors' shape alone
 BLIND_SPREAD_M = 0.75  # ... and how tight the belief must be for it
 RESCALE_MIN = 0.002  # a change of the odometry's distance gain smaller than this waits
+# A fix the signs refined is not taken over the hypothesis when the depth held fits it
+# worse by more than this (log): two clear contradictions (a ray through a wall, 0.1 each).
+WALLS_REFUTE = -2.0 * math.log(0.1)
 
 
 @dataclass
@@ -336,7 +339,7 @@ class CorridorBelief:
             return None
         w = self.weights()[idx]
         i = idx[int(np.argmax(w))]
-        tf = tuple(self.map_T_odoms()[i])
+        tf = hyp = tuple(self.map_T_odoms()[i])
         spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
         src, dst, placed = [], [], []
         for g in self.glimpses:
@@ -366,8 +369,27 @@ class CorridorBelief:
                 return None  # one cluster, not sure where in it (a lone elevator plate)
             shift = shift * (s2 / (s2 + sure**2))
             tf = (tf[0] + float(shift[0]), tf[1] + float(shift[1]), tf[2])
+        if self._walls_refute(tf, hyp):  # the signs moved it where depth says it is not
+            tf, res = hyp, 0.0
         tf = self.to_odom((float(tf[0]), float(tf[1]), float(tf[2])))
         return tf, math.hypot(spread, res)
+
+    def _walls_refute(self, tf, hyp) -> bool:
+        """Whether the depth everything held saw (the free floor and returns of every look
+        and drive view) fits the fix ``tf`` worse than the hypothesis ``hyp`` it was
+        refined from, by more than ``WALLS_REFUTE`` (straightened frame, both): a plate
+        read a metre or two from where the map puts its door (beside it, or its depth
+        off) moves a fix along the corridor that the walls in view had placed."""
+        tfs = np.array([tf, hyp], dtype=float)
+        logw = np.zeros(2)
+        floor = self.evidence.floor
+        for views, at_look in ((self.glimpses, True), (self.rays, False)):
+            for g in views:
+                here = apply_many(tfs, (g.odom.x, g.odom.y))
+                travelled = math.hypot(g.odom.x - self.ref.x, g.odom.y - self.ref.y)
+                for yaw, free in g.free:
+                    floor.depth_ray(logw, tfs, here, g.odom, yaw, free, travelled, at_look)
+        return bool(logw[1] - logw[0] > WALLS_REFUTE)
 
     # -- where next (pose.lead, pose.telling) ---------------------------------------------
 
