@@ -163,3 +163,26 @@ def test_a_building_grid_is_its_ros_map_only():
         pytest.skip("the hospital example is not here")
     plan = building_grid(load_building(HOSPITAL_MAP.parent / "building.yaml"), HOSPITAL_MAP.parent)
     assert plan is not None and plan.resolution == pytest.approx(0.05)
+
+
+def test_a_plate_read_two_metres_from_its_door_does_not_move_a_fix_the_walls_placed(hospital):
+    """examples/hospital, grid walls, Table 3 minimal #2: facing south at (-5.98, -23.46),
+    room19's plate is read 2.2 m north of where the map puts its door. The sign alone
+    would move the fix 2 m along the corridor; the walls in view say the robot is where
+    the belief's hypothesis puts it, and the fix stays there."""
+    from pmnav_bt.map.catalogue import load_building
+    from pmnav_bt.map.priori_map import parse_building
+    from pmnav_bt.pose.belief import CorridorBelief
+    from pmnav_bt.pose.glimpse import Glimpse
+    from pmnav_bt.seams import Entity
+
+    plan, field = hospital
+    pm = parse_building(load_building(HOSPITAL_MAP.parent / "building.yaml"))
+    truth = (-5.98, -23.46, -math.pi / 2)
+    rays = tuple((truth[2] + a, f) for a, f in look_round(plan.occupancy() != 0, plan, truth))
+    odom = Pose2D(*truth)  # odometry starts out as the map here
+    seen = {Entity.room("room19"): (-7.58, -20.77)}
+    belief = CorridorBelief(pm, walls=wall_source("grid", plan))
+    belief.observe(Glimpse(odom, seen, free=rays), axis_odom=truth[2])
+    tf, _ = belief.fix()
+    assert math.dist(tf[:2], (0.0, 0.0)) < 0.5 and abs(tf[2]) < math.radians(5.0)
