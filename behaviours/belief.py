@@ -222,6 +222,7 @@ def _new_belief(ctx, goal, prior) -> CorridorBelief:
         recall=sign_recall(cfg, pm.building),
         lead_range=sign_lead_range(cfg),
         target=_goal_xy(pm, goal),
+        walls=ctx.walls,
     )
     belief.prior = prior
     return belief

@@ -16,6 +16,7 @@ from pmnav_bt.control import Limits, Odometer
 from pmnav_bt.geometry import se2_compose, wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.map.updates import NO_MAP_UPDATES, MapUpdateSink
+from pmnav_bt.pose.evidence.floor_model import CORRIDORS, WallSource
 from pmnav_bt.pose.odometry import CalibratedBase
 from pmnav_bt.seams import Base, CoarseDirection, Grounder, Planner, Pose2D, Refiner
 from pmnav_bt.tree_variants import DetourCheck
@@ -49,6 +50,8 @@ class Context:
     planner: Planner | None  # None: the map-less baseline
     worker: Worker
     detour_check: DetourCheck | None  # None: no walls known beyond what depth shows
+    # The walls the localization belief weighs depth against (``pose.evidence.floor_model``).
+    walls: WallSource = CORRIDORS
     odometer: Odometer = field(default_factory=Odometer)
     trace: list[TraceEvent] = field(default_factory=list)
     budget_actions: int = 500
@@ -64,11 +67,12 @@ class Context:
     @classmethod
     def wired(
         cls, base: Base, pm: Any, config: Config, backends: Any, budget: int | None,
-        deferred_work: bool, *, detour_check: DetourCheck | None,
+        deferred_work: bool, *, detour_check: DetourCheck | None, walls: WallSource = CORRIDORS,
     ) -> Context:  # fmt: skip
         """The back ends ``backends`` (a ``backends.Backends``) wired to ``base`` and ``pm``,
         with a fresh Worker and the config's action budget unless ``budget`` is given;
-        ``detour_check``: see ``DetourCheck`` (the tree variant decides it)."""
+        ``detour_check``: see ``DetourCheck`` (the tree variant decides it); ``walls``: the
+        localization's wall model."""
         return cls(
             base=base,
             pm=pm,
@@ -79,6 +83,7 @@ class Context:
             planner=backends.planner,
             worker=Worker(deferred=deferred_work),
             detour_check=detour_check,
+            walls=walls,
             budget_actions=budget if budget is not None else config.tree.budget_actions,
         )
 

@@ -228,8 +228,9 @@ class PmNavController:
         from pmnav_bt.config import load_config
         from pmnav_bt.hardware import qos
         from pmnav_bt.hardware.create3 import Create3Base
-        from pmnav_bt.map.catalogue import load_building
+        from pmnav_bt.map.catalogue import load_building, resolve_building_path
         from pmnav_bt.map.priori_map import parse_building
+        from pmnav_bt.pose.evidence.floor_model import building_grid
 
         # the tree imported now, not at the first goal: a long import holds the GIL and
         # would starve the executor (odometry "stale")
@@ -245,6 +246,8 @@ class PmNavController:
         self.config = load_config(p["config"] or None, overrides, label="parameter 'overrides'")
         self.building = load_building(p["building"])
         self.pm = parse_building(self.building)
+        # Its occupancy grid, where it has one: the walls the localization weighs depth on.
+        self.grid = building_grid(self.building, resolve_building_path(p["building"]).parent)
         # The back ends, built once on what the tree variant may read (an unknown variant
         # is refused now, not at the first goal); a back end that reads the simulator's
         # labels is refused (one line, from the registry) unless the simulated Create 3
@@ -512,8 +515,9 @@ class PmNavController:
         t0 = self.base.clock.now()
         budget = int(p["budget"]) or None
         ctx = make_context(
-            self.base, self.pm, cfg, seed=int(p["seed"]), budget=budget, backends=self.backends
-        )
+            self.base, self.pm, cfg, seed=int(p["seed"]), budget=budget, backends=self.backends,
+            grid=self.grid,
+        )  # fmt: skip
         if p["map_updates_dir"]:  # reviewed later with 'pmnav map updates FILE'
             name = f"{time.strftime('%Y%m%d-%H%M%S')}-run{run.id}{UPDATES_SUFFIX}"
             watch_map(ctx, UpdatesFile(Path(p["map_updates_dir"]) / name, p["building"]))

@@ -239,6 +239,22 @@ class TreeConfig(_Section):
         description="localization: doors seen along the walls (door_sightings) weigh the "
         "corridor belief, from 12 m, where signs are read from 3.5 m",
     )
+    localization_walls: str | None = Field(
+        None,
+        description="localization: the walls the corridor belief weighs depth against, by "
+        "name (pmnav_bt/pose/evidence/floor_model.py): corridors (the building file's "
+        "corridor rectangles) or grid (the building's floor_plan.ros_map as a likelihood "
+        "field, as AMCL's); unset: grid where the building has one (the real walls: lobbies, "
+        "alcoves and corridors wider than drawn), else corridors",
+    )
+
+    @field_validator("localization_walls")
+    @classmethod
+    def _registered_walls(cls, name: str | None) -> str | None:
+        from pmnav_bt.pose.evidence.floor_model import WALL_MODELS
+
+        return None if name is None else _named(WALL_MODELS, name)
+
     localization_attempts: int = Field(
         10, ge=1, le=100, description="localization tries (panoramas) before giving up"
     )

@@ -11,7 +11,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 import py_trees
 
@@ -22,10 +22,14 @@ from pmnav_bt.config import Config
 from pmnav_bt.eval.task import action_budget as task_action_budget
 from pmnav_bt.failures import Failure, FailureCode, failure_from, root_cause
 from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.pose.evidence.floor_model import wall_source
 from pmnav_bt.seams import Base
 from pmnav_bt.tree_variants import TREE_VARIANTS
 from pmnav_bt.trees.snapshots import SnapshotLogger
 from pmnav_bt.trees.view_record import ViewRecorder
+
+if TYPE_CHECKING:
+    from pmnav_bt.map.floorplan import FloorPlanImage
 
 
 @dataclass
@@ -73,6 +77,7 @@ def make_context(
     *,
     on_robot: bool = False,
     backends: Backends | None = None,
+    grid: FloorPlanImage | None = None,
 ) -> Context:
     """The Context of the tree variant ``config.tree.variant`` (``pmnav_bt.tree_variants``): what
     it may read of ``pm`` (the whole priori-map, or the sign vocabulary only), the back
@@ -82,7 +87,9 @@ def make_context(
     ``deferred_work``: background jobs start between ticks (simulation; see Worker).
     ``on_robot``: the observations carry no simulator labels (back ends that need them are
     refused). ``backends``: ready-made back ends instead (tests, test doubles); a variant
-    that plans nothing drops their planner.
+    that plans nothing drops their planner. ``grid``: the building's occupancy grid (its
+    ``floor_plan.ros_map``; None: it has none), for the localization's wall model
+    (``tree.localization_walls``, ``pose.evidence.floor_model.wall_source``).
     """
     knows = TREE_VARIANTS.spec(config.tree.variant).knows
     known = knows.known(pm)
@@ -93,6 +100,7 @@ def make_context(
     return Context.wired(
         base, known, config, backends, budget, deferred_work,
         detour_check=knows.detour_check(known),
+        walls=wall_source(config.tree.localization_walls, grid),
     )  # fmt: skip
 
 

@@ -55,7 +55,8 @@ class BeliefWatch:
                 self._flush_drive()
                 n, how = len(self.steps), "the pose is known (green)"
                 if self._last is None:
-                    self._last, how = CorridorBelief(ctx.pm), "two signs read at once"
+                    self._last = CorridorBelief(ctx.pm, walls=ctx.walls)
+                    how = "two signs read at once"
                 self.steps.append(BeliefStep(f"{n}. fixed: {how}", self._last, odom, truth,
                                              tuple(tf)))  # fmt: skip
                 self._last = None

@@ -99,6 +99,7 @@ def run_episode(
     """
     from pmnav_bt.map.updates import SUFFIX as UPDATES_SUFFIX
     from pmnav_bt.map.updates import UpdatesFile
+    from pmnav_bt.pose.evidence.floor_model import building_grid
     from pmnav_bt.sim.episodes import (
         episode_map,
         goal_door_in_world,
@@ -135,7 +136,12 @@ def run_episode(
             setup_world(world)
         inner, base = simulated_robot(world, sim, episode.start_pose, episode.seed)
         budget = action_budget(config, episode.route_length)
-        ctx = make_context(base, pm, config, seed=episode.seed, budget=budget, deferred_work=True)
+        # The building's grid is the robot's map of its walls where the world is built
+        # from it; with the annotated walls the world is the rectangles, and so is its map.
+        grid = building_grid(b, folder) if sim.walls == "grid" else None
+        ctx = make_context(
+            base, pm, config, seed=episode.seed, budget=budget, deferred_work=True, grid=grid
+        )
         updates = None
         if out_dir is not None:
             out_dir.mkdir(parents=True, exist_ok=True)

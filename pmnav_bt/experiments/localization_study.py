@@ -120,8 +120,9 @@ def run_localization(
     import py_trees
 
     from pmnav_bt.behaviours.common import NAMESPACE
-    from pmnav_bt.map.catalogue import load_building
+    from pmnav_bt.map.catalogue import load_building, resolve_building_path
     from pmnav_bt.map.priori_map import parse_building
+    from pmnav_bt.pose.evidence.floor_model import building_grid
     from pmnav_bt.seams import Pose2D
     from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.world import SimWorld
@@ -130,11 +131,14 @@ def run_localization(
 
     t0 = time.perf_counter()
     b = load_building(start.building)
+    folder = resolve_building_path(start.building).parent
     pm = parse_building(b)
     pose = Pose2D(start.x, start.y, start.yaw)
-    with SimWorld(b) as world:
+    with SimWorld(b, walls=config.sim.walls, base_dir=folder) as world:
         inner, base = simulated_robot(world, config.sim, pose, start.seed)
-        ctx = make_context(base, pm, config, seed=start.seed, deferred_work=True)
+        # The grid is the map of the walls where the world is built from it (evaluation).
+        grid = building_grid(b, folder) if config.sim.walls == "grid" else None
+        ctx = make_context(base, pm, config, seed=start.seed, deferred_work=True, grid=grid)
         py_trees.blackboard.Blackboard.clear()
         tree = py_trees.trees.BehaviourTree(active_localize_subtree(ctx))
         period = 1.0 / config.tree.tick_hz

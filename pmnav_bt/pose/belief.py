@@ -7,7 +7,8 @@ own:
   corridor centre line, facing along or across it) and their motion update (odometry
   straightened by the walls);
 - ``pose.evidence``: what reweights them, one kind of evidence a module (signs read,
-  missed and misread; the corridors' floor in depth; doors along the walls; a prior);
+  missed and misread; the floor in depth, against the corridor rectangles or the
+  building's grid; doors along the walls; a prior);
 - ``pose.lead`` and ``pose.telling``: where to drive or look next.
 
 Every glimpse (a panorama: the signs read there and where each was seen, in odometry)
@@ -33,10 +34,11 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose import lead as leads
 from pmnav_bt.pose import telling
 from pmnav_bt.pose.evidence import Evidence
+from pmnav_bt.pose.evidence.floor_model import CORRIDORS, WallSource
 from pmnav_bt.pose.evidence.prior import weigh_prior
 from pmnav_bt.pose.evidence.signs import PLACE_SIGMA_M, SIGHT_SIGMA_M
 from pmnav_bt.pose.glimpse import Glimpse
-from pmnav_bt.pose.hypotheses import FIX_MASS, Hypotheses, Straightened
+from pmnav_bt.pose.hypotheses import FIX_MASS, Hypotheses, Straightened, apply_many
 from pmnav_bt.pose.landmark_fix import sign_shift
 from pmnav_bt.pose.lead import Lead
 from pmnav_bt.pose.visibility import Visibility, entity_xy
@@ -48,6 +50,9 @@ HYPOTHESIS_SIGMA_M = 0.5  # a hypothesis is a lattice point: no surer of the pla
 MIN_BLIND_GLIMPSES = 4  # glimpses before a fix from the corridors' shape alone
 BLIND_SPREAD_M = 0.75  # ... and how tight the belief must be for it
 RESCALE_MIN = 0.002  # a change of the odometry's distance gain smaller than this waits
+# A fix the signs refined is not taken over the hypothesis when the depth held fits it
+# worse by more than this (log): two clear contradictions (a ray through a wall, 0.1 each).
+WALLS_REFUTE = -2.0 * math.log(0.1)
 
 
 @dataclass
@@ -79,6 +84,9 @@ class CorridorBelief:
     # The odometry's distance gain (``CalibratedBase``) the positions held were driven
     # under: when it changes, they are scaled about the reference (``rescale``).
     gain: float = 1.0
+    # The walls depth is weighed against (``evidence.floor_model``): the corridor
+    # rectangles, or the building's grid as a likelihood field.
+    walls: WallSource = CORRIDORS
     # The odometry straightened by the walls (None before the first glimpse), and the
     # walls' axis in it at the last glimpse (None: not measured, or not taken).
     _odo: Straightened | None = field(default=None, init=False, repr=False)
@@ -90,7 +98,7 @@ class CorridorBelief:
         self.goal = Visibility.of(
             self.pm, self.read_range if self.lead_range is None else self.lead_range
         )
-        self.evidence = Evidence.of(self.pm, self.vis, self.recall)
+        self.evidence = Evidence.of(self.pm, self.vis, self.recall, self.walls)
         self._build()
 
     def __repr__(self) -> str:  # short, for tree logs
@@ -166,7 +174,7 @@ class CorridorBelief:
         for g in self.glimpses:
             self.evidence.look(self.logw, g, tfs, self.ref)
         for r in self.rays:
-            self.evidence.drive_view(self.logw, r, tfs)
+            self.evidence.drive_view(self.logw, r, tfs, self.ref)
 
     # -- updates --------------------------------------------------------------------------
 
@@ -235,7 +243,7 @@ class CorridorBelief:
         if doors is not None:
             seen = tuple(tuple(self.straighten(xy)) for xy in doors)
             ray = replace(ray, doors=seen, door_views=(yaw,))
-        self.evidence.drive_view(self.logw, ray, self.map_T_odoms())
+        self.evidence.drive_view(self.logw, ray, self.map_T_odoms(), self.ref)
         self.rays.append(ray)
 
     def rescale(self, gain: float) -> None:
@@ -331,7 +339,7 @@ class CorridorBelief:
             return None
         w = self.weights()[idx]
         i = idx[int(np.argmax(w))]
-        tf = tuple(self.map_T_odoms()[i])
+        tf = hyp = tuple(self.map_T_odoms()[i])
         spread = float(np.sqrt((w * ((self.xy[idx] - self.xy[i]) ** 2).sum(1)).sum() / w.sum()))
         src, dst, placed = [], [], []
         for g in self.glimpses:
@@ -361,8 +369,27 @@ class CorridorBelief:
                 return None  # one cluster, not sure where in it (a lone elevator plate)
             shift = shift * (s2 / (s2 + sure**2))
             tf = (tf[0] + float(shift[0]), tf[1] + float(shift[1]), tf[2])
+        if self._walls_refute(tf, hyp):  # the signs moved it where depth says it is not
+            tf, res = hyp, 0.0
         tf = self.to_odom((float(tf[0]), float(tf[1]), float(tf[2])))
         return tf, math.hypot(spread, res)
+
+    def _walls_refute(self, tf, hyp) -> bool:
+        """Whether the depth everything held saw (the free floor and returns of every look
+        and drive view) fits the fix ``tf`` worse than the hypothesis ``hyp`` it was
+        refined from, by more than ``WALLS_REFUTE`` (straightened frame, both): a plate
+        read a metre or two from where the map puts its door (beside it, or its depth
+        off) moves a fix along the corridor that the walls in view had placed."""
+        tfs = np.array([tf, hyp], dtype=float)
+        logw = np.zeros(2)
+        floor = self.evidence.floor
+        for views, at_look in ((self.glimpses, True), (self.rays, False)):
+            for g in views:
+                here = apply_many(tfs, (g.odom.x, g.odom.y))
+                travelled = math.hypot(g.odom.x - self.ref.x, g.odom.y - self.ref.y)
+                for yaw, free in g.free:
+                    floor.depth_ray(logw, tfs, here, g.odom, yaw, free, travelled, at_look)
+        return bool(logw[1] - logw[0] > WALLS_REFUTE)
 
     # -- where next (pose.lead, pose.telling) ---------------------------------------------
 

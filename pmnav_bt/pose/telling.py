@@ -16,7 +16,6 @@ import math
 
 import networkx as nx
 import numpy as np
-import shapely
 
 from pmnav_bt.geometry import se2_apply, se2_inverse, wrap_angle
 from pmnav_bt.pose.belief_view import BeliefView
@@ -199,11 +198,6 @@ def look_tells(b: BeliefView, odom: Pose2D) -> bool:
 
 
 def floor_round(b: BeliefView, xy: np.ndarray, heading: float) -> np.ndarray:
-    """The free floor (m, to ``MAX_RAY_M``) the map has round ``xy`` (map) along
+    """The free floor (m, to ``MAX_RAY_M``) the wall model has round ``xy`` (map) along
     ``LOOK_BEARINGS`` from ``heading``: what a look round from there shows in depth."""
-    a = heading + LOOK_BEARINGS
-    ends = np.asarray(xy) + MAX_RAY_M * np.stack([np.cos(a), np.sin(a)], 1)
-    rays = shapely.linestrings(np.stack([np.broadcast_to(xy, ends.shape), ends], 1))
-    hits = shapely.intersection(rays, b.vis.walls)
-    d = shapely.distance(shapely.Point(xy), hits)
-    return np.where(np.isnan(d), MAX_RAY_M, np.minimum(d, MAX_RAY_M))
+    return b.evidence.floor.reach(np.asarray(xy, float), heading + LOOK_BEARINGS, MAX_RAY_M)

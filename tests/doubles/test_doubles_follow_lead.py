@@ -182,6 +182,7 @@ def test_a_wall_ahead_ends_the_drive_and_notes_the_way_blocked(make_rig, monkeyp
     assert seen[drove][1] == "LocalizeDrive" and seen[drove + 1][2] == (0.0, 0.0)
     assert len(seen) - 1 - (drove + 1) <= 1  # at rest for at most the ray's tick
     assert r.get("drive_end") == DriveEnd.WALL
+    assert belief.rays[-1] >= 6.0  # the view at the wall was told
     assert belief.pending_blocked == pytest.approx(0.0)
     assert 6.0 <= r.base.pose().x < 7.2  # a wall look a second
 

@@ -7,9 +7,10 @@ calls them: the sums are kept bit for bit as they were).
 - ``signs``: the signs read at a look round, where each was seen; signs the map says are
   readable but were not read (missed); signs read where the map says none can be
   (misread or spurious).
-- ``floor``: where the map's corridors are: the robot inside a wall (off the corridors),
-  a drive blocked where the corridor goes on, walls close ahead and free floor along each
-  view in depth (at a look round and along a drive).
+- ``floor``: where the walls are (a ``floor_model.FloorModel``, by name: the corridor
+  rectangles, ``floor.py``, or the building's grid as a likelihood field,
+  ``likelihood_field.py``): the robot inside a wall, a drive blocked where the floor goes
+  on, and the free floor along each view in depth (at a look round and along a drive).
 - ``doors``: doors seen along the walls, or map doors in view not seen.
 - ``prior``: an earlier estimate of the pose.
 """
@@ -29,7 +30,7 @@ from pmnav_bt.pose.evidence.doors import (
     P_DRIVE_DOOR_SPURIOUS,
     MapDoors,
 )
-from pmnav_bt.pose.evidence.floor import P_DEPTH, P_DRIVE_RAY, Floor
+from pmnav_bt.pose.evidence.floor_model import CORRIDORS, FloorModel, WallSource
 from pmnav_bt.pose.evidence.signs import SIGHT_SIGMA_M, Recall, Signs, sight_sigma
 from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.hypotheses import apply_many
@@ -42,40 +43,44 @@ class Evidence:
     """Every kind of evidence, built once per map: ``signs``, ``floor`` and ``doors``."""
 
     signs: Signs
-    floor: Floor
+    floor: FloorModel
     doors: MapDoors
 
     @classmethod
-    def of(cls, pm: PrioriMap, vis: Visibility, recall: Recall | None) -> Evidence:
-        return cls(Signs.of(pm, vis, recall), Floor.of(pm, vis), MapDoors.of(vis))
+    def of(
+        cls, pm: PrioriMap, vis: Visibility, recall: Recall | None, walls: WallSource = CORRIDORS
+    ) -> Evidence:
+        """``walls``: the wall model depth is weighed against (``floor_model``)."""
+        return cls(Signs.of(pm, vis, recall), walls.floor(pm, vis), MapDoors.of(vis))
 
     def look(self, logw: np.ndarray, g: Glimpse, tfs: np.ndarray, ref: Pose2D) -> None:
         """Add a look round ``g`` (straightened odometry) to ``logw`` under each hypothesis
         of ``tfs``: where it was (inside a wall?), a blocked drive, depth along each view,
         the doors seen along the walls and the signs read (``ref``: the reference, from
         which the odometry's drift grows)."""
-        sigma = sight_sigma(math.hypot(g.odom.x - ref.x, g.odom.y - ref.y))
+        travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
+        sigma = sight_sigma(travelled)
         here = apply_many(tfs, (g.odom.x, g.odom.y))
-        near, off = self.floor.vis.nearest_many(here)
-        self.floor.off_corridor(logw, near, off)
+        self.floor.stand(logw, here)
         if g.blocked is not None:  # the corridor must end (or turn) just ahead
             logw += self.floor.blocked_log(tfs, (g.odom.x, g.odom.y), g.blocked)
         for yaw, free in g.free:
-            self.floor.wall_ahead(logw, tfs, g.odom, yaw, free)
-            self.floor.free_floor(logw, tfs, here, g.odom, yaw, free, P_DEPTH)
+            self.floor.depth_ray(logw, tfs, here, g.odom, yaw, free, travelled, True)
         self.doors.weigh(
-            logw, self.floor.area, g.doors, g.door_views, tfs, here,
+            logw, self.floor, g.doors, g.door_views, tfs, here,
             P_DOOR_MISS, P_DOOR_SPURIOUS, sigma,
         )  # fmt: skip
+        near, _ = self.signs.vis.nearest_many(here)
         self.signs.weigh(logw, g.seen, g.named, tfs, here, near, sigma)
 
-    def drive_view(self, logw: np.ndarray, r: Glimpse, tfs: np.ndarray) -> None:
+    def drive_view(self, logw: np.ndarray, r: Glimpse, tfs: np.ndarray, ref: Pose2D) -> None:
         """Add the view ahead while driving ``r`` (``CorridorBelief.observe_ray``): its free
         floor and the doors seen in it, each weaker than at a look round."""
+        travelled = math.hypot(r.odom.x - ref.x, r.odom.y - ref.y)
         here = apply_many(tfs, (r.odom.x, r.odom.y))
         for yaw, free in r.free:
-            self.floor.free_floor(logw, tfs, here, r.odom, yaw, free, P_DRIVE_RAY)
+            self.floor.depth_ray(logw, tfs, here, r.odom, yaw, free, travelled, False)
         self.doors.weigh(
-            logw, self.floor.area, r.doors, r.door_views, tfs, here,
+            logw, self.floor, r.doors, r.door_views, tfs, here,
             P_DRIVE_DOOR_MISS, P_DRIVE_DOOR_SPURIOUS, SIGHT_SIGMA_M,
         )  # fmt: skip

@@ -19,8 +19,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import shapely
 
+from pmnav_bt.pose.evidence.floor_model import FloorModel
 from pmnav_bt.pose.hypotheses import apply_many
 from pmnav_bt.pose.visibility import Visibility
 from pmnav_bt.seams import EntityKind
@@ -59,7 +59,7 @@ class MapDoors:
     def weigh(
         self,
         logw: np.ndarray,
-        floor: shapely.Geometry,
+        floor: FloorModel,
         doors: tuple[tuple[float, float], ...],
         door_views: tuple[float, ...],
         tfs: np.ndarray,
@@ -70,7 +70,7 @@ class MapDoors:
     ) -> None:
         """Add to ``logw`` the doors seen (``doors``, odometry) in the views that looked
         for them (``door_views``, odometry yaws) from ``here`` (where each hypothesis of
-        ``tfs`` puts the robot); ``floor``: the corridor floor, for the line of sight;
+        ``tfs`` puts the robot); ``floor``: the wall model, for the line of sight;
         ``sigma``: how far (m) a door's seen place may be off (at least
         ``DOOR_MATCH_M`` / 1.5)."""
         if not door_views or self.xy.shape[0] == 0:
@@ -104,6 +104,5 @@ class MapDoors:
         if not in_view.any():
             return
         hi, di = hi[in_view], di[in_view]
-        lines = shapely.linestrings(np.stack([here[hi], self.front[di]], 1))
-        clear = shapely.covers(floor, lines)
+        clear = floor.clear(here[hi], self.front[di])
         np.add.at(logw, hi[clear], math.log(p_miss))

@@ -1,7 +1,8 @@
 """The corridors' floor as evidence: where the robot can be and what depth sees from there.
 
-The map's corridors (``Visibility.corridors``) say where there is floor. A hypothesis is
-less likely when, under it,
+The ``corridors`` wall model (``floor_model``): the map's corridors
+(``Visibility.corridors``) say where there is floor. A hypothesis is less likely when,
+under it,
 
 - the robot stands inside a wall (``off_corridor``): beyond its corridor's half-width by
   more than ``OFF_CORRIDOR_M`` (the hypothesis is a lattice point on the centre line, the
@@ -40,18 +41,23 @@ P_DEPTH = 0.1  # a hypothesis that disagrees with one such depth reading
 P_DRIVE_RAY = 0.5
 
 
+def corridor_floor(pm: PrioriMap, vis: Visibility, _field=None) -> CorridorFloor:
+    """The ``corridors`` wall model's factory (``floor_model``; it needs no grid)."""
+    return CorridorFloor.of(pm, vis)
+
+
 @dataclass(frozen=True)
-class Floor:
-    """The corridors as depth evidence sees them: ``vis`` (the lattice), ``area`` (the
-    corridor floor with ``RAY_SLACK_M`` of tolerance) and ``half_width`` (per lattice
-    point, its corridor's half-width)."""
+class CorridorFloor:
+    """The corridors as depth evidence sees them (a ``floor_model.FloorModel``): ``vis``
+    (the lattice), ``area`` (the corridor floor with ``RAY_SLACK_M`` of tolerance) and
+    ``half_width`` (per lattice point, its corridor's half-width)."""
 
     vis: Visibility
     area: shapely.Geometry
     half_width: np.ndarray
 
     @classmethod
-    def of(cls, pm: PrioriMap, vis: Visibility) -> Floor:
+    def of(cls, pm: PrioriMap, vis: Visibility) -> CorridorFloor:
         area = shapely.buffer(vis.corridors, RAY_SLACK_M)  # a little tolerance
         half_width = np.array(
             [pm.segments[p.segment - 1].width / 2.0 for p in vis.lattice_points]
@@ -59,9 +65,10 @@ class Floor:
         shapely.prepare(area)
         return cls(vis, area, half_width)
 
-    def off_corridor(self, logw: np.ndarray, near: np.ndarray, off: np.ndarray) -> None:
-        """A hypothesis that puts the robot inside a wall (``off`` m from its nearest
-        lattice point ``near``) is unlikely."""
+    def stand(self, logw: np.ndarray, here: np.ndarray) -> None:
+        """A hypothesis that puts the robot inside a wall (more than ``OFF_CORRIDOR_M``
+        beyond its corridor's half-width from its nearest lattice point) is unlikely."""
+        near, off = self.vis.nearest_many(here)
         half = self.half_width[near]
         logw += np.where(off > half + OFF_CORRIDOR_M, math.log(P_THROUGH_WALL), 0.0)
 
@@ -73,6 +80,37 @@ class Floor:
         probe = apply_many(tfs, (xy[0] + d * math.cos(blocked), xy[1] + d * math.sin(blocked)))
         pn, poff = self.vis.nearest_many(probe)
         return np.where(poff <= self.half_width[pn], math.log(P_THROUGH_WALL), 0.0)
+
+    def depth_ray(
+        self,
+        logw: np.ndarray,
+        tfs: np.ndarray,
+        here: np.ndarray,
+        odom: Pose2D,
+        yaw: float,
+        free: float,
+        travelled: float,
+        at_look: bool,
+    ) -> None:
+        """At a look round, a wall close ahead (``wall_ahead``) and the free floor
+        (``free_floor``, ``P_DEPTH``); while driving, the free floor only
+        (``P_DRIVE_RAY``). ``travelled`` is not used: the corridors' slack is fixed."""
+        if at_look:
+            self.wall_ahead(logw, tfs, odom, yaw, free)
+        self.free_floor(logw, tfs, here, odom, yaw, free, P_DEPTH if at_look else P_DRIVE_RAY)
+
+    def clear(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Whether each line from ``a`` to ``b`` stays on the corridor floor (with slack)."""
+        return shapely.covers(self.area, shapely.linestrings(np.stack([a, b], 1)))
+
+    def reach(self, xy: np.ndarray, angles: np.ndarray, most: float) -> np.ndarray:
+        """How far the corridor floor runs from ``xy`` along each of ``angles``, to
+        ``most``: where each ray first meets the corridors' outline."""
+        ends = np.asarray(xy) + most * np.stack([np.cos(angles), np.sin(angles)], 1)
+        rays = shapely.linestrings(np.stack([np.broadcast_to(xy, ends.shape), ends], 1))
+        hits = shapely.intersection(rays, self.vis.walls)
+        d = shapely.distance(shapely.Point(xy), hits)
+        return np.where(np.isnan(d), most, np.minimum(d, most))
 
     def wall_ahead(
         self, logw: np.ndarray, tfs: np.ndarray, odom: Pose2D, yaw: float, free: float
