@@ -35,7 +35,7 @@ KEYS = (
     "avoid_landmarks",  # frozenset[str]: landmark IDs that failed and are not used again
     "blocked_segments",  # frozenset[int]: segments found blocked (twice)
     "blocked_suspects",  # frozenset[int]: segments found blocked once
-    "blocked_ways",  # dict[int, Failure]: segments seen shut, with the failure that said so
+    "blocked_ways",  # dict[int, BlockedWay]: segments seen shut: where, and the failure
     "way_shut",  # WayShut | None: the shut way the last drive gave up on (way_ahead.py)
     "replans",  # int
     "failure",  # Failure: why the last thing failed (its ``cause``: the failure recovered from)

@@ -13,6 +13,7 @@ from pmnav_bt.failures import Failure, FailureCode, root_cause
 from pmnav_bt.map.wording import corridor_words
 from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.seams import PlanConstraints
+from pmnav_bt.way_ahead import BlockedWay
 
 
 class MakePlan(PmNavBehaviour):
@@ -38,6 +39,7 @@ class MakePlan(PmNavBehaviour):
         constraints = PlanConstraints(
             avoid_landmarks=frozenset(self.get("avoid_landmarks") or ()),
             blocked_segments=frozenset(self.get("blocked_segments") or ()),
+            blocked_at=frozenset(w.point for w in (self.get("blocked_ways") or {}).values()),
         )
         planner, pm = self.ctx.planner, self.ctx.pm
         self._job = self.ctx.worker.submit(lambda c: planner.plan(pm, start, goal, constraints))
@@ -65,10 +67,10 @@ class MakePlan(PmNavBehaviour):
             ways = self.get("blocked_ways") or {}
             pm = self.ctx.pm
             why = [
-                ways[i].message if i in ways else f"{corridor_words(pm.segment(i))} blocked"
+                ways[i].failure.message if i in ways else f"{corridor_words(pm.segment(i))} blocked"
                 for i in sorted(self.get("blocked_segments"))
             ]
-            door = any(f.code == FailureCode.DOOR_CLOSED for f in ways.values())
+            door = any(w.failure.code == FailureCode.DOOR_CLOSED for w in ways.values())
             code = FailureCode.DOOR_CLOSED if door else FailureCode.BLOCKED
             return Failure(code, f"no way round: {'; '.join(why)}")
         if isinstance(err, UnknownNameError) and not _names_a_room(self.ctx, self.get("goal")):
@@ -209,7 +211,8 @@ class NoteFailure(PmNavBehaviour):
         self.bb.set("way_shut", None)
         if failure is not None and failure.code in WAY_SHUT and shut is not None:
             if not shut.moving:
-                self._mark_blocked(self.ctx.pm.locate(*shut.point).segment.index, failure)
+                seg = self.ctx.pm.locate(*shut.point).segment.index
+                self._mark_blocked(seg, BlockedWay(shut.point, failure))
         elif failure is not None and failure.code == FailureCode.BLOCKED and t is not None:
             est = map_pose(self.get("map_T_odom"), self.ctx.base.pose())
             ahead = (est.x + 0.6 * math.cos(est.yaw), est.y + 0.6 * math.sin(est.yaw))
@@ -223,8 +226,8 @@ class NoteFailure(PmNavBehaviour):
         self.feedback_message = f"replan after {failure}"
         return Status.SUCCESS
 
-    def _mark_blocked(self, seg: int, why: Failure | None) -> None:
-        """Route round segment ``seg`` from now on; ``why``: the failure that saw it shut."""
+    def _mark_blocked(self, seg: int, why: BlockedWay | None) -> None:
+        """Route round segment ``seg`` from now on; ``why``: where and how it was seen shut."""
         self.bb.set("blocked_segments", frozenset(self.get("blocked_segments") or ()) | {seg})
         if why is not None:
             self.bb.set("blocked_ways", {**(self.get("blocked_ways") or {}), seg: why})

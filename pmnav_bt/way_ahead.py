@@ -31,6 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
+from pmnav_bt.failures import Failure
 from pmnav_bt.seams import Observation
 
 PATIENCE_S = 10.0
@@ -96,3 +97,13 @@ class WayShut:
     point: tuple[float, float]
     seconds: float
     moving: bool
+
+
+@dataclass(frozen=True)
+class BlockedWay:
+    """A corridor marked blocked for the run: where it was seen shut (map ``point``: the
+    plan leaves a segment the robot is on by the end on its side) and the ``failure``
+    that said so (its words are the run's reason when no way round is left)."""
+
+    point: tuple[float, float]
+    failure: Failure
