@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from building_kit import with_landmark
 from rig import build_rig
 
 from pmnav_bt.failures import FailureCode
@@ -67,7 +68,7 @@ def test_a_corridor_that_stays_shut_is_gone_round_after_one_replan(make_rig):
 def test_a_closed_fire_door_with_no_way_round_ends_the_run_naming_it(building, clean_blackboard):
     # the ring shut on both sides of branch1 (a closed fire door, a barrier): no way round
     door = Landmark(id="fd_east", kind="fire_door", name="FD-E", pos=(BARRIER_X, 0.0))
-    fire = parse_building(building.model_copy(update={"landmarks": (*building.landmarks, door)}))
+    fire = parse_building(with_landmark(building, door))
     rig = build_rig("doubles", fire, START, overrides=("tree.replans=2",))
     try:
         rig.body.obstacles = barrier(BARRIER_X) + barrier(22.0)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from building_kit import with_landmark
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.motion import DriveTo
@@ -108,9 +109,8 @@ def test_a_way_that_stays_shut_fails_naming_the_corridor(make_rig):
 
 def test_a_closed_fire_door_fails_with_its_own_code_and_place(make_rig, building):
     door = Landmark(id="firedoor1", kind="fire_door", name="FD-2", pos=(7.0, 0.0))
-    fire = building.model_copy(update={"landmarks": (*building.landmarks, door)})
     rig = make_rig(START)
-    rig.ctx.pm = parse_building(fire)
+    rig.ctx.pm = parse_building(with_landmark(building, door))
     rig.body.obstacles = barrier(7.0)
     seen, _ = drive(rig)
     rig.expect(seen, Status.FAILURE)
