@@ -35,6 +35,8 @@ KEYS = (
     "avoid_landmarks",  # frozenset[str]: landmark IDs that failed and are not used again
     "blocked_segments",  # frozenset[int]: segments found blocked (twice)
     "blocked_suspects",  # frozenset[int]: segments found blocked once
+    "blocked_ways",  # dict[int, BlockedWay]: segments seen shut: where, and the failure
+    "way_shut",  # WayShut | None: the shut way the last drive gave up on (way_ahead.py)
     "replans",  # int
     "failure",  # Failure: why the last thing failed (its ``cause``: the failure recovered from)
     "recovering_from",  # Failure | None: what the recovery under way started from

@@ -2,9 +2,12 @@
 
 All drive on the estimated map pose (``map_T_odom`` composed with odometry) with
 velocity commands, and watch for obstacles: the base reporting a collision, no
-progress for a while, or depth showing something on the floor ahead. Something on
-the floor with open floor beside it (a pillar, a trolley on the centre line) is driven
-round (``detour``); only what fills the corridor blocks the drive.
+progress for a while, or depth showing something on the floor ahead. A drive that
+sees something in its way stops and holds (``pmnav_bt/way_ahead.py``): it goes on when
+the way clears, drives round what stood still with open floor beside it (a pillar, a
+trolley on the centre line; ``detour``), waits for what moves (a person) up to a
+patience and passes it where there is room, and gives up only on what keeps the way
+shut, saying where in the building's words (``pmnav_bt/map/wording.py``).
 """
 
 from __future__ import annotations
@@ -21,10 +24,13 @@ from pmnav_bt.behaviours.pose import keep_on_axis, measure_walls
 from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
+from pmnav_bt.map.wording import shut_way_words
 from pmnav_bt.perception.corner import is_corner, is_opening, mask_ratios
 from pmnav_bt.perception.geometry import free_distance
+from pmnav_bt.perception.movers import moved
 from pmnav_bt.seams import MotionStatus
 from pmnav_bt.tree_variants import DetourCheck
+from pmnav_bt.way_ahead import Hold, Verdict, WayShut, judge
 
 NO_PROGRESS_S = 10.0  # clock seconds without getting 0.1 m closer -> blocked
 WATCH_PERIOD_S = 1.0  # clock seconds between obstacle checks from depth
@@ -43,21 +49,29 @@ OBSTACLE_RANGE = 2.0
 DETOUR_BEARINGS = tuple(math.radians(a) for a in (10.0, 15.0, 20.0, 25.0, 30.0))
 DETOUR_PAST_M = 0.6
 DETOUR_MARGIN_M = 0.3
+DETOUR_HALF_WIDTH_M = 0.25  # the floor kept free either side of a detour's line
 DETOUR_VIEW_MARGIN = math.radians(5.0)  # a bearing this close to the image border is not seen
 MAX_DETOURS = 2
+MOVER_REACH_M = 0.5  # what moved this far beyond the thing in the way counts (it stepped back)
+# Something that moves (a person) is passed this much wider and farther than clutter: a
+# person steps and turns (0.3 m of personal space), and is never brushed past.
+PERSON_SPACE_M = 0.3
 
 
 class DriveTo(PmNavBehaviour):
     """Drive to a map point; subclasses choose the point and may refine it on the way.
 
     Every watch frame's corridor wall keeps the estimate's heading and position across
-    the corridor true (``keep_on_axis``). Reads ``map_T_odom``, ``target``; writes
-    ``map_T_odom``, ``pose_tracker``. FAILURE (BLOCKED) on repeated collisions, no
-    progress, or an obstacle closer than the goal.
+    the corridor true (``keep_on_axis``). Something in the way closer than the goal
+    stops the drive and holds it (``way_ahead.judge``: go on, go round, wait, give up).
+    Reads ``map_T_odom``, ``target``; writes ``map_T_odom``, ``pose_tracker``,
+    ``way_shut`` (a ``WayShut`` when it gave up on a shut way, else None). FAILURE:
+    BLOCKED on repeated collisions, no progress, or a way that stayed shut for the
+    patience; DOOR_CLOSED when what shut it stands where the map has a fire door.
     """
 
     READS = ("map_T_odom", "target", "plan", "pose_tracker")
-    WRITES = ("map_T_odom", "pose_tracker")
+    WRITES = ("map_T_odom", "pose_tracker", "way_shut")
     JOBS = ("_watch_job",)
     STOPS_BASE = True
 
@@ -84,6 +98,9 @@ class DriveTo(PmNavBehaviour):
         self._watch_t = -math.inf
         self._detour: tuple[float, float] | None = None  # a point round an obstacle
         self._detours = 0
+        self._hold: Hold | None = None  # stopped for something in the way
+        self._last_frame = None  # the last watch frame (what moved since)
+        self.bb.set("way_shut", None)
 
     def aim_at(self, goal: tuple[float, float]) -> None:
         """Drive to ``goal`` from here on, progress watched afresh (a route's next leg)."""
@@ -116,6 +133,9 @@ class DriveTo(PmNavBehaviour):
         if watched is not None:
             base.stop()
             return watched
+        if self._hold is not None:  # stopped until the way ahead is judged again
+            base.set_velocity(0.0, 0.0)
+            return Status.RUNNING
         est = self.estimate()
         aim = self._aim()
         dist = math.hypot(aim[0] - est.x, aim[1] - est.y)
@@ -149,6 +169,8 @@ class DriveTo(PmNavBehaviour):
                 self._watch_t = now
                 base, goal, target = self.ctx.base, self._aim(), self.get("target")
                 tf, clear = self.get("map_T_odom"), self.ctx.detour_check
+                before = self._last_frame
+                moving = self._hold is not None and self._hold.moving
 
                 def watch(cancelled):
                     obs = base.observe()
@@ -158,7 +180,11 @@ class DriveTo(PmNavBehaviour):
                     found["ahead"] = ahead = _toward_goal(obs, est, goal)
                     blocked = _closer_than_goal(ahead, est, goal)
                     if blocked is not None:
-                        found["detour"] = detour(obs, est, goal, blocked, clear)
+                        if before is not None:
+                            way = wrap_angle(heading((est.x, est.y), goal) - est.yaw)
+                            found["moved"] = moved(before, obs, way, blocked + MOVER_REACH_M)
+                        space = PERSON_SPACE_M if moving or found.get("moved") else 0.0
+                        found["detour"] = detour(obs, est, goal, blocked, clear, space)
                     return obs, blocked, found
 
                 self._watch_job = self.ctx.worker.submit(watch)
@@ -170,6 +196,7 @@ class DriveTo(PmNavBehaviour):
         if status is not None:
             return status
         obs, free, found = watched
+        self._last_frame = obs
         if found.get("walls") is not None:
             keep_on_axis(self, obs.pose, found["walls"])
         self.on_watch(found, obs)
@@ -177,34 +204,87 @@ class DriveTo(PmNavBehaviour):
         if ahead is not None and self.arrived_at_wall(ahead):
             self.feedback_message = f"at the wall beyond the waypoint ({ahead:.1f} m ahead)"
             return Status.SUCCESS
-        if free is not None:
-            self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free)
-            point = found.get("detour")
-            if point is not None and self._detours < MAX_DETOURS:
-                self._detour, self._detours = point, self._detours + 1
+        if free is None:
+            if self._hold is not None:
+                held = self._hold.held_for(now)
+                self.ctx.log("way_clear", "", waited=held)
+                self._hold = None
                 self._progress_afresh()
-                self.ctx.log("detour", "", x=point[0], y=point[1], obstacle=free)
-                return None
-            return self.fail(FailureCode.BLOCKED, f"obstacle {free:.1f} m ahead")
-        return None
+            return None
+        return self._held_up(now, obs, free, found)
+
+    def _held_up(self, now: float, obs, free: float, found: dict) -> Status | None:
+        """Something ``free`` m ahead in the way: hold, and judge what to do
+        (``way_ahead.judge``); FAILURE when the way stayed shut."""
+        self.ctx.base.stop()
+        point = found.get("detour") if self._detours < MAX_DETOURS else None
+        if self._hold is None:
+            self._hold = Hold(now, free, obs, point, moving=bool(found.get("moved")))
+            self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free, moving=self._hold.moving)
+        else:
+            self._hold.seen(obs, free, point, found.get("moved"))
+        hold = self._hold
+        point = hold.room
+        verdict = judge(hold, now, clear=False, room_beside=point is not None)
+        if verdict == Verdict.WAIT:
+            what = "someone moving" if hold.moving else "something"
+            self.feedback_message = (
+                f"waiting: {what} {free:.1f} m ahead for {hold.held_for(now):.0f} s"
+            )
+            return None
+        if verdict == Verdict.GO_ROUND:
+            self._hold = None
+            self._detour, self._detours = point, self._detours + 1
+            self._progress_afresh()
+            self.ctx.log("detour", "", x=point[0], y=point[1], obstacle=free, moving=hold.moving)
+            return None
+        return self._give_up(hold, now)
+
+    def _give_up(self, hold: Hold, now: float) -> Status:
+        """The way stayed shut for the patience: say where, in the building's words."""
+        est = self.estimate()
+        aim = self._aim()
+        a = heading((est.x, est.y), aim)
+        point = (est.x + hold.free * math.cos(a), est.y + hold.free * math.sin(a))
+        seconds = hold.held_for(now)
+        self.bb.set("way_shut", WayShut(point, seconds, hold.moving))
+        self._hold = None
+        where, door = shut_way_words(self.ctx.pm, point)
+        if hold.moving:
+            return self.fail(
+                FailureCode.BLOCKED,
+                f"someone stayed in the way in {where} for {seconds:.0f} s, "
+                f"{hold.free:.1f} m ahead, with no room to pass",
+            )
+        if door is not None:
+            return self.fail(
+                FailureCode.DOOR_CLOSED, f"{door} closed ({where}, shut for {seconds:.0f} s)"
+            )
+        return self.fail(
+            FailureCode.BLOCKED,
+            f"{where} blocked for {seconds:.0f} s ({hold.free:.1f} m ahead)",
+        )
 
 
-def detour(obs, est, goal, free: float, clear: DetourCheck | None) -> tuple[float, float] | None:
+def detour(
+    obs, est, goal, free: float, clear: DetourCheck | None, space: float = 0.0
+) -> tuple[float, float] | None:
     """A map point round an obstacle ``free`` m ahead on the way from ``est`` to ``goal``:
     along the nearest bearing off that way (``DETOUR_BEARINGS``, the more open side first)
     with the floor free ``DETOUR_PAST_M`` beyond the obstacle's near face, that far past it
     and, where the variant knows the walls (``clear``: PM-Nav's map corridors), at least
-    ``DETOUR_MARGIN_M`` from them; None when there is none (the corridor is shut)."""
+    ``DETOUR_MARGIN_M`` from them; None when there is none (the corridor is shut).
+    ``space``: metres more on each side of the way and beyond (a person's space)."""
     way = wrap_angle(heading((est.x, est.y), goal) - est.yaw)
     in_view = abs(obs.intrinsics.pixel_bearing(0.0)) - DETOUR_VIEW_MARGIN
-    past = free + DETOUR_PAST_M
+    past = free + DETOUR_PAST_M + space
     for off in DETOUR_BEARINGS:
         reach = past / math.cos(off)
         sides = []
         for b in (way + off, way - off):
             if abs(b) > in_view:
                 continue
-            open_m = free_distance(obs, b)
+            open_m = free_distance(obs, b, half_width=DETOUR_HALF_WIDTH_M + space)
             if open_m >= reach + DETOUR_MARGIN_M:
                 sides.append((open_m, b))
         for _, b in sorted(sides, reverse=True):

@@ -22,6 +22,7 @@ class FailureCode(str, Enum):
     PLANNING_FAILED = "PLANNING_FAILED"  # no route from the estimated pose to the goal
     TARGET_NOT_FOUND = "TARGET_NOT_FOUND"  # a plan landmark was not found after re-search/replan
     BLOCKED = "BLOCKED"  # the way is physically blocked
+    DOOR_CLOSED = "DOOR_CLOSED"  # a door across the route (a fire door) is closed
     BUDGET_EXCEEDED = "BUDGET_EXCEEDED"  # the action budget ran out
     TIMEOUT = "TIMEOUT"  # a step took longer than its clock budget
     SENSOR_TIMEOUT = "SENSOR_TIMEOUT"  # no camera frames or odometry

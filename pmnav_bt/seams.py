@@ -395,10 +395,13 @@ class PixelGoalPolicy(Protocol):
 
 @dataclass(frozen=True)
 class PlanConstraints:
-    """What a replan must avoid: landmarks that failed, corridor segments found blocked."""
+    """What a replan must avoid: landmarks that failed, corridor segments found blocked;
+    ``blocked_at``: map points where a way was seen shut (a start on the segment of one
+    leaves it only by the end on its own side)."""
 
     avoid_landmarks: frozenset[str] = frozenset()
     blocked_segments: frozenset[int] = frozenset()
+    blocked_at: frozenset[tuple[float, float]] = frozenset()
 
 
 # A plan start: an estimated map pose (inside the loop), or a map node / segment / room

@@ -18,6 +18,7 @@ from py_trees.decorators import FailureIsSuccess, Repeat, Retry
 from pmnav_bt.behaviours.capture import CaptureViews, nearest_first, search_centre, search_yaws
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.decorators import ClockTimeout
+from pmnav_bt.behaviours.hidden_sign import LOOK_AGAIN_AFTER_S, SignHidden
 from pmnav_bt.behaviours.motion import (
     Approach,
     Arrive,
@@ -37,6 +38,7 @@ from pmnav_bt.behaviours.planning import (
 )
 from pmnav_bt.behaviours.policy_approach import PolicyApproach
 from pmnav_bt.behaviours.pose import CorrectHeading, SnapToCorridor
+from pmnav_bt.behaviours.recovery import Wait
 from pmnav_bt.behaviours.search import (
     CoarseDirection,
     FineDirection,
@@ -102,9 +104,23 @@ def step_subtree(ctx: Context, refine: bool = True) -> py_trees.behaviour.Behavi
     )
     research = sequence(
         "MoveOnAndResearch",
-        # On up to level with the target (its node): a sign hangs beside its door,
-        # maybe on the far side, readable (not just visible) only from about there.
-        MoveToward("MoveOn", ctx, keep=0.0, distance=research_distance),
+        Selector(
+            "WaitOrMoveOn",
+            memory=True,
+            children=[
+                # A sign hidden behind someone is looked for again after a moment, from
+                # here: it was hidden, not absent.
+                sequence(
+                    "LookAgainLater",
+                    SignHidden("SignHidden", ctx),
+                    Wait("WaitForTheView", ctx, LOOK_AGAIN_AFTER_S),
+                ),
+                # On up to level with the target (its node): a sign hangs beside its
+                # door, maybe on the far side, readable (not just visible) only from
+                # about there.
+                MoveToward("MoveOn", ctx, keep=0.0, distance=research_distance),
+            ],
+        ),
         AlwaysFail(name="SearchAgain"),
     )
     visible = sequence(

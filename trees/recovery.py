@@ -1,6 +1,6 @@
 """Recoveries as an explicit subtree (like Nav2's), chosen by the failure that triggered
-them: BLOCKED backs off the wall and turns onto the corridor axis, TARGET_NOT_FOUND turns
-round to look back, TIMEOUT waits; any other failure needs none."""
+them: BLOCKED and DOOR_CLOSED back off the wall and turn onto the corridor axis,
+TARGET_NOT_FOUND turns round to look back, TIMEOUT waits; any other failure needs none."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ def recovery_subtree(ctx: Context, name: str = "Recovery") -> py_trees.behaviour
         "BackOffWall",
         memory=True,
         children=[
-            FailureIs("WasBlocked", ctx, FailureCode.BLOCKED),
+            FailureIs("WasBlocked", ctx, FailureCode.BLOCKED, FailureCode.DOOR_CLOSED),
             BackUp("BackUp", ctx),
             FaceCorridor("FaceCorridor", ctx),
         ],

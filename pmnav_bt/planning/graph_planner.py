@@ -57,7 +57,9 @@ class GraphPlanner:
             graph = nx.subgraph_view(
                 pm.graph, filter_edge=lambda u, v: graph_segment(pm, u, v) not in blocked
             )
-        nodes, length, start_xy = shortest_route(pm, sp, pm.places[goal_id].node, graph)
+        nodes, length, start_xy = shortest_route(
+            pm, sp, pm.places[goal_id].node, graph, constraints.blocked_at
+        )
         return build_plan(
             pm,
             sp,
@@ -82,15 +84,23 @@ def graph_segment(pm: PrioriMap, u: str, v: str) -> int:
 
 
 def shortest_route(
-    pm: PrioriMap, sp: StartPoint, goal_node: str, graph: nx.Graph | None = None
+    pm: PrioriMap,
+    sp: StartPoint,
+    goal_node: str,
+    graph: nx.Graph | None = None,
+    blocked_at: frozenset[tuple[float, float]] = frozenset(),
 ) -> tuple[list[str], float, np.ndarray]:
-    """Nodes from the start point to the goal node, the route length, and the start point."""
+    """Nodes from the start point to the goal node, the route length, and the start point;
+    never past a point of ``blocked_at`` on the start's own segment."""
     graph = pm.graph if graph is None else graph
     seg = sp.segment
     a_xy, b_xy = pm.node_xy(seg.a), pm.node_xy(seg.b)
     start_xy = a_xy + sp.t * (b_xy - a_xy)
+    shut = _shut_ends(pm, sp, blocked_at)
     best: tuple[float, list[str]] | None = None
     for end, lead in ((seg.a, sp.t * seg.length), (seg.b, (1.0 - sp.t) * seg.length)):
+        if end in shut:
+            continue
         try:
             d, path = nx.bidirectional_dijkstra(graph, end, goal_node, weight="length")
         except nx.NetworkXNoPath:
@@ -108,6 +118,20 @@ def shortest_route(
     nodes = best[1]
     length = _route_length(pm, start_xy, nodes)
     return nodes, length, start_xy
+
+
+def _shut_ends(
+    pm: PrioriMap, sp: StartPoint, blocked_at: frozenset[tuple[float, float]]
+) -> set[str]:
+    """The ends of the start's segment that a point of ``blocked_at`` on it (within half
+    its width of the centre line) lies between the start and."""
+    seg, shut = sp.segment, set()
+    for point in blocked_at:
+        at = pm.locate(*point)
+        if at.segment.index != seg.index or at.offset > seg.width / 2.0:
+            continue
+        shut.add(seg.b if at.t > sp.t else seg.a)
+    return shut
 
 
 def _route_length(pm: PrioriMap, start_xy: np.ndarray, nodes: list[str]) -> float:

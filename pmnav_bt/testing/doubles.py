@@ -1,7 +1,9 @@
 """Test doubles for every seam, so behaviour and tree logic runs without pybullet or ROS.
 
 - ``FakeClock`` + ``FakeBase``: a kinematic unicycle that integrates its velocity command
-  when the clock advances; frames are blank (no depth), scripted faults and errors.
+  when the clock advances; frames are blank (no depth unless ``obstacles`` stand about:
+  ``FakeObstacle``, upright cylinders, still or walking, drawn in depth), scripted faults
+  and errors.
 - ``ScriptedGrounder``: sees what is in the camera's field of view within range on the
   priori-map (doors and landmarks where the map puts them), with a 3D ``point`` per
   detection; entities can be hidden, signs made unreadable, errors injected.
@@ -28,8 +30,10 @@ from pmnav_bt.planning.graph_planner import GraphPlanner
 from pmnav_bt.planning.plan import Plan
 from pmnav_bt.planning.resolve import entity_position, sign_text
 from pmnav_bt.seams import (
+    CAMERA_HEIGHT_M,
     CREATE3_MAX_ANGULAR,
     CREATE3_MAX_LINEAR,
+    CREATE3_RADIUS_M,
     FORWARD_STEP_M,
     TURN_STEP_RAD,
     CameraIntrinsics,
@@ -67,13 +71,62 @@ class FakeClock:
         self._on_wait.append(advance)
 
 
+@dataclass(frozen=True)
+class FakeObstacle:
+    """An upright cylinder of ``radius`` m standing on the floor, taller than the camera:
+    a person, a post, a piece of a barrier. ``path``: (clock s, x, y) points it walks
+    between at constant speed, standing at the first before it and at the last after."""
+
+    path: tuple[tuple[float, float, float], ...]
+    radius: float = 0.25
+
+    def at(self, t: float) -> tuple[float, float]:
+        """Where it stands at clock time ``t``."""
+        ts = [p[0] for p in self.path]
+        return (
+            float(np.interp(t, ts, [p[1] for p in self.path])),
+            float(np.interp(t, ts, [p[2] for p in self.path])),
+        )
+
+    @classmethod
+    def standing(cls, x: float, y: float, radius: float = 0.25) -> FakeObstacle:
+        return cls(((0.0, x, y),), radius)
+
+
+FAR_M = 30.0  # the depth above the horizon where nothing stands (walls are not drawn)
+
+
+def obstacle_depth(
+    pose: Pose2D, k: CameraIntrinsics, centres: Sequence[tuple[float, float, float]]
+) -> np.ndarray:
+    """A depth frame (metres along the optical axis) from ``pose`` of a bare floor, open
+    to ``FAR_M``, with upright cylinders (x, y, radius) that hide the floor behind them."""
+    rows = np.arange(k.height, dtype=float)[:, None]
+    with np.errstate(divide="ignore"):
+        floor = np.where(rows > k.cy, CAMERA_HEIGHT_M * k.fy / (rows - k.cy), FAR_M)
+    depth = np.broadcast_to(floor, (k.height, k.width))
+    bearings = np.arctan2(k.cx - np.arange(k.width, dtype=float), k.fx)
+    hit = np.full(k.width, np.inf)
+    for x, y, r in centres:
+        a = pose.yaw + bearings
+        dx, dy = x - pose.x, y - pose.y
+        along = dx * np.cos(a) + dy * np.sin(a)
+        miss2 = dx * dx + dy * dy - along * along
+        reach = along - np.sqrt(np.maximum(0.0, r * r - miss2))
+        hit = np.where((miss2 <= r * r) & (reach > 0.0), np.minimum(hit, reach), hit)
+    z = (hit * np.cos(bearings)).astype(np.float32)[None, :]
+    return np.where(z < depth, z, depth).astype(np.float32)
+
+
 @dataclass
 class FakeBase:
     """A kinematic body: velocity commands integrate exactly, discrete steps are instant.
 
     ``blocked``: motion is refused (MotionStatus.BLOCKED); ``faulted``: FAULT;
-    ``observe_error``: ``observe`` raises it (e.g. a SensorError for a silent camera).
-    Odometry is exact, so the map and odometry frames coincide.
+    ``observe_error``: ``observe`` raises it (e.g. a SensorError for a silent camera);
+    ``obstacles``: ``FakeObstacle``s drawn in each frame's depth (none: no depth). They
+    are not solid: a test checks its gaps to them (``gap``). Odometry is exact, so the
+    map and odometry frames coincide.
     """
 
     start: Pose2D = Pose2D(0.0, 0.0, 0.0)
@@ -85,6 +138,7 @@ class FakeBase:
     faulted: bool = False
     observe_error: Exception | None = None
     observations: int = 0
+    obstacles: list[FakeObstacle] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self._pose = self.start
@@ -96,12 +150,25 @@ class FakeBase:
         if self.observe_error is not None:
             raise self.observe_error
         self.observations += 1
-        k = self.intrinsics
+        k, pose, now = self.intrinsics, self.pose(), self.clock.now()
+        depth = None
+        if self.obstacles:
+            centres = [(*o.at(now), o.radius) for o in self.obstacles]
+            depth = obstacle_depth(pose, k, centres)
         return Observation(
             rgb=np.zeros((k.height, k.width, 3), np.uint8),
-            pose=self.pose(),
-            stamp=self.clock.now(),
+            pose=pose,
+            stamp=now,
             intrinsics=k,
+            depth=depth,
+        )
+
+    def gap(self, radius: float = CREATE3_RADIUS_M) -> float:
+        """The least distance (m) from a body of ``radius`` here to any obstacle, now."""
+        p, now = self.pose(), self.clock.now()
+        return min(
+            (math.dist((p.x, p.y), o.at(now)) - o.radius - radius for o in self.obstacles),
+            default=math.inf,
         )
 
     def pose(self) -> Pose2D:

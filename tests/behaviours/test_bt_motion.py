@@ -134,7 +134,8 @@ def test_approach_stops_before_a_tall_obstacle_seen_in_depth(make_rig):
     seen = rig.run(Approach("Approach", rig.ctx), max_ticks=400)
     rig.expect(seen, Status.FAILURE)
     assert rig.failure.code == FailureCode.BLOCKED
-    assert "obstacle" in rig.failure.message and "ahead" in rig.failure.message
+    assert "the corridor between room1 and room4 blocked for" in rig.failure.message
+    assert "m ahead" in rig.failure.message
     assert rig.body.stats.collisions == 0  # stopped before touching it
     assert rig.stopped()
     assert [e.kind for e in rig.ctx.trace][-1] == "obstacle"

@@ -33,17 +33,27 @@ GOAL = "room2"  # its door (10, 1.1) is in view from the start
 
 @dataclasses.dataclass
 class BoxAhead(doubles.FakeBase):
-    """A FakeBase whose frames taken while it drives forward have depth: the floor and,
-    straight ahead at ``box_m``, a thin box (``half_width`` m either side of the optical
-    axis) that moves with the camera, so that every drive finds its way blocked with open
-    floor beside it. Frames taken standing have no depth (as doubles.FakeBase's)."""
+    """A FakeBase whose frames taken while it drives forward, or stands held up in a
+    drive, have depth: the floor and, straight ahead at ``box_m``, a thin box
+    (``half_width`` m either side of the optical axis) that moves with the camera, so
+    that every drive finds its way blocked with open floor beside it. Frames taken
+    standing otherwise have no depth (as doubles.FakeBase's)."""
 
     box_m: float = 1.0
     half_width: float = 0.08
+    held: bool = False  # the last drive frame showed the box (it stopped for it)
+
+    def set_velocity(self, linear: float, angular: float) -> None:
+        super().set_velocity(linear, angular)
+        self.held = self.held and linear == 0.0 and angular == 0.0
+
+    def stop(self) -> None:
+        self.held = self.held or self.velocity_command[0] != 0.0
+        super().stop()
 
     def observe(self) -> Observation:
         obs = super().observe()
-        if self.velocity_command[0] == 0.0:
+        if self.velocity_command[0] == 0.0 and not self.held:
             return obs
         k, h = obs.intrinsics, obs.camera_height
         rows = np.arange(k.height, dtype=float)[:, None]
