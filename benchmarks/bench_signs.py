@@ -79,6 +79,7 @@ def run(
     by_angle = defaultdict(lambda: defaultdict(int))  # (angle band, band) -> views, hits
     times: list[float] = []
     cpu: list[float] = []
+    false: list[str] = []
     total = 0
     for k, name in enumerate(names):
         world = SimWorld(name)
@@ -112,7 +113,10 @@ def run(
             ad["hit"] += any(d.entity == v.entity for d in dets)
             for d in dets:
                 s["named"] += 1
-                s["right"] += shows(obs, d.entity, d.box)
+                right = shows(obs, d.entity, d.box)
+                s["right"] += right
+                if not right:
+                    false.append(f"{name}: read {d.label!r} as {d.entity.id}, view of {v.text!r}")
             total += 1
         world.close()
     ms = np.array(times) * 1000
@@ -144,6 +148,8 @@ def run(
     print(
         f"{'all':>10s} {tot['views']:6d} {rec:6.1f}% {tot['named']:6d} {prec:8.1f}% {false:5d}"
     )
+    for f in false:
+        print(f"  false target: {f}")
     print("recall per plate kind (read_range.plate_kind):")
     for kind in PLATE_KINDS:
         print(f"{kind:>10s} " + recall_cells([kinds[(kind, i)] for i in range(len(BANDS))]))
