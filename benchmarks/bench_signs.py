@@ -79,7 +79,7 @@ def run(
     by_angle = defaultdict(lambda: defaultdict(int))  # (angle band, band) -> views, hits
     times: list[float] = []
     cpu: list[float] = []
-    false: list[str] = []
+    false_targets: list[str] = []
     total = 0
     for k, name in enumerate(names):
         world = SimWorld(name)
@@ -116,7 +116,7 @@ def run(
                 right = shows(obs, d.entity, d.box)
                 s["right"] += right
                 if not right:
-                    false.append(f"{name}: read {d.label!r} as {d.entity.id}, view of {v.text!r}")
+                    false_targets.append(f"{name}: read {d.label!r} as {d.entity.id}, view of {v.text!r}")
             total += 1
         world.close()
     ms = np.array(times) * 1000
@@ -148,7 +148,7 @@ def run(
     print(
         f"{'all':>10s} {tot['views']:6d} {rec:6.1f}% {tot['named']:6d} {prec:8.1f}% {false:5d}"
     )
-    for f in false:
+    for f in false_targets:
         print(f"  false target: {f}")
     print("recall per plate kind (read_range.plate_kind):")
     for kind in PLATE_KINDS:
