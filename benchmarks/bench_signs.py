@@ -116,7 +116,9 @@ def run(
                 right = shows(obs, d.entity, d.box)
                 s["right"] += right
                 if not right:
-                    false_targets.append(f"{name}: read {d.label!r} as {d.entity.id}, view of {v.text!r}")
+                    false_targets.append(
+                        f"{name}: read {d.label!r} as {d.entity.id}, view of {v.text!r}"
+                    )
             total += 1
         world.close()
     ms = np.array(times) * 1000
