@@ -18,7 +18,7 @@ hold, as log-likelihoods in one currency:
   words like no name (similarity ``NAME_NULL``).
 
 A reading is a sighting of the best entity only when that entity is ``MARGIN`` times as
-likely as the runner-up and as none of them (``decide``): otherwise it is ambiguous and
+likely as all the others and none of them together (``decide``): otherwise it is ambiguous and
 names nothing, and the tree looks again. ``Evidence`` from several reads of one plate
 adds up (consistency), and a prior over entities (the order of the doors along the
 corridor, ``grounders/plate_memory.py``) can settle what one read leaves open.
@@ -91,6 +91,7 @@ class Evidence:
     unknown: float = 0.0
     keys: dict[Entity, str] = field(default_factory=dict)
     reads: int = 1
+    code_read: bool = False  # a read showed a code: every room's code was weighed
 
     def add(self, other: Evidence) -> Evidence:
         ents = set(self.entities) & set(other.entities)
@@ -99,24 +100,28 @@ class Evidence:
             self.unknown + other.unknown,
             {**other.keys, **self.keys},
             self.reads + other.reads,
+            self.code_read or other.code_read,
         )
 
 
 def decide(ev: Evidence, prior: Mapping[Entity, float] | None = None) -> Match | None:
     """The entity ``ev`` names, with ``prior`` (log, per entity; 0 where missing) added:
-    the best, when it is ``MARGIN`` more likely than the runner-up and the unknown plate;
-    else None (ambiguous)."""
+    the best, when it is ``MARGIN`` more likely than all the others and the unknown plate
+    together (its posterior at least 10/11); else None (ambiguous)."""
     if not ev.entities:
         return None
     post = {e: ll + (prior.get(e, 0.0) if prior else 0.0) for e, ll in ev.entities.items()}
-    ranked = sorted(post.items(), key=lambda kv: -kv[1])
-    best, ll = ranked[0]
-    rival = max([ev.unknown] + [v for _, v in ranked[1:2]])
+    best, ll = max(post.items(), key=lambda kv: kv[1])
+    # The rest together: many rooms each a little likely are, together, a real doubt. With
+    # no code read, one whose name is no likelier than an unknown plate's is one of those.
+    rest = [ev.unknown] + [
+        v for e, v in post.items() if e != best and (ev.code_read or v > ev.unknown)
+    ]
+    z = max(rest)
+    rival = z + math.log(sum(math.exp(v - z) for v in rest))
     if ll - rival < MARGIN:
         return None
-    z = max(ll, ev.unknown)
-    total = math.exp(ev.unknown - z) + sum(math.exp(v - z) for v in post.values())
-    return Match(best, math.exp(ll - z) / total, ev.keys.get(best, ""))
+    return Match(best, 1.0 / (1.0 + math.exp(rival - ll)), ev.keys.get(best, ""))
 
 
 @dataclass(frozen=True)
@@ -171,8 +176,8 @@ class SignMatcher:
         for k in self.known:
             ll, how = 0.0, []
             if code:
-                if k.code is None:
-                    ll += math.log(P_UNKNOWN) + self.model.log_read_right(code, scores)
+                if k.code is None:  # its sign has no code: one read is a plate unknown
+                    ll += 2 * math.log(P_UNKNOWN) + self.model.log_read_right(code, scores)
                 else:
                     ll += code_ll[k.code]
                     how.append(k.code)
@@ -183,7 +188,7 @@ class SignMatcher:
                     how.append(key)
             ents[k.entity] = ll
             keys[k.entity] = " ".join(how)
-        return Evidence(ents, unknown, keys)
+        return Evidence(ents, unknown, keys, code_read=bool(code))
 
     def _code_token(
         self, tokens: list[tuple[str, list[float]]]
