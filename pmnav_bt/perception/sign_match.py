@@ -90,7 +90,6 @@ class Evidence:
     entities: dict[Entity, float] = field(default_factory=dict)
     unknown: float = 0.0
     keys: dict[Entity, str] = field(default_factory=dict)
-    reads: int = 1
     code_read: bool = False  # a read showed a code: every room's code was weighed
 
     def add(self, other: Evidence) -> Evidence:
@@ -99,7 +98,6 @@ class Evidence:
             {e: self.entities[e] + other.entities[e] for e in ents},
             self.unknown + other.unknown,
             {**other.keys, **self.keys},
-            self.reads + other.reads,
             self.code_read or other.code_read,
         )
 
