@@ -5,6 +5,8 @@ deg off the plate's normal (``sim.sign_views``), at 320x240 and 640x480. For eac
 the grounder's ``read_signs`` names entities; a named entity is right when the frame
 shows that entity's sign (its simulator label covers pixels inside the detection's box).
 Recall: views whose target sign was named. Precision: named entities that were right.
+False targets: named entities that were not right (the frame does not show their sign inside
+the detection's box): each one a room the tree would take for another. The target is none.
 Latency: wall time and process CPU time of ``read_signs`` per frame (the models are
 loaded before timing; one onnxruntime thread). On a shared machine the wall time
 includes waiting for a core: the load average is printed with it.
@@ -77,6 +79,7 @@ def run(
     by_angle = defaultdict(lambda: defaultdict(int))  # (angle band, band) -> views, hits
     times: list[float] = []
     cpu: list[float] = []
+    false_targets: list[str] = []
     total = 0
     for k, name in enumerate(names):
         world = SimWorld(name)
@@ -110,7 +113,12 @@ def run(
             ad["hit"] += any(d.entity == v.entity for d in dets)
             for d in dets:
                 s["named"] += 1
-                s["right"] += shows(obs, d.entity, d.box)
+                right = shows(obs, d.entity, d.box)
+                s["right"] += right
+                if not right:
+                    false_targets.append(
+                        f"{name}: read {d.label!r} as {d.entity.id}, view of {v.text!r}"
+                    )
             total += 1
         world.close()
     ms = np.array(times) * 1000
@@ -120,7 +128,10 @@ def run(
         f"\n{width}x{height}: {total} views, {len(names)} buildings, "
         f"{angles[0]:g}-{angles[1]:g} deg off the plate{only}"
     )
-    print(f"{'distance':>10s} {'views':>6s} {'recall':>7s} {'named':>6s} {'precision':>9s}")
+    print(
+        f"{'distance':>10s} {'views':>6s} {'recall':>7s} {'named':>6s} {'precision':>9s} "
+        f"{'false':>5s}"
+    )
     tot = defaultdict(int)
     for i, (a, b) in enumerate(BANDS):
         s = stats[i]
@@ -128,10 +139,19 @@ def run(
             tot[key] += s[key]
         rec = 100 * s["hit"] / max(s["views"], 1)
         prec = 100 * s["right"] / s["named"] if s["named"] else float("nan")
-        print(f"{a:4.1f}-{b:3.1f} m {s['views']:6d} {rec:6.1f}% {s['named']:6d} {prec:8.1f}%")
+        false = s["named"] - s["right"]
+        print(
+            f"{a:4.1f}-{b:3.1f} m {s['views']:6d} {rec:6.1f}% {s['named']:6d} {prec:8.1f}% "
+            f"{false:5d}"
+        )
     rec = 100 * tot["hit"] / max(tot["views"], 1)
     prec = 100 * tot["right"] / tot["named"] if tot["named"] else float("nan")
-    print(f"{'all':>10s} {tot['views']:6d} {rec:6.1f}% {tot['named']:6d} {prec:8.1f}%")
+    false = tot["named"] - tot["right"]
+    print(
+        f"{'all':>10s} {tot['views']:6d} {rec:6.1f}% {tot['named']:6d} {prec:8.1f}% {false:5d}"
+    )
+    for f in false_targets:
+        print(f"  false target: {f}")
     print("recall per plate kind (read_range.plate_kind):")
     for kind in PLATE_KINDS:
         print(f"{kind:>10s} " + recall_cells([kinds[(kind, i)] for i in range(len(BANDS))]))

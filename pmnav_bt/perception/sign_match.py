@@ -1,41 +1,58 @@
-"""Which room or landmark a read sign names, tolerant of OCR errors in words, strict in numbers.
+"""Which room or landmark a read sign names, by likelihood, never by a guess.
 
-Every entity of the building is known by keys: its sign text, the sign text without its
-leading room number, its name and aliases (all normalised to lower-case letters and
-digits). A reading matches a key by string similarity (difflib), or as a fragment of it
-(a sign cut by the image border), under one hard rule: **the digits must agree**. The
-digit sequence of the reading must equal the key's, so "108 Pharmacy" never matches
-"102 Pharmacy", and a bare number matches only the room whose sign starts with exactly
-that number. Letters commonly read for digits inside a number ("1O5", "l12") are mapped
-to digits first; a reading that then matches nothing is tried as read (a lettered room
-number, "D103") and with its leading digit as a look-alike letter ("0103" for "D103",
-when only one such reading names an entity). Digits read with a low recogniser score are
-not trusted at all: such a reading matches nothing. The best entity must beat the
-runner-up by a margin, else the reading is ambiguous and matches nothing.
+Buildings hold near-identical codes (``1A``..``1G``, ``2.04`` and ``2.40``, ``B117`` and
+``8117`` as OCR reads it): a reading one character away from a room's code is a fair
+reading of that room, but it may be a fair reading of its neighbour too. So a reading is
+weighed against every entity of the building, and against a plate the building does not
+hold, as log-likelihoods in one currency:
+
+- **the code**: the building's numbering scheme is parsed from its codes
+  (``map.numbering.parse_scheme``); the tokens of the reading that could be one of its
+  codes are weighed with the OCR confusion model (``ocr_confusion``): the characters'
+  confidences, and which characters the reader confuses, counted from data;
+- **the name**: the words left are compared with the entity's name and aliases (difflib,
+  tolerant of a letter or two; a fragment of a name cut by the image border counts):
+  ``NAME_WEIGHT * (similarity - 1)``, no lower than what any text other than the name
+  gets, so garbled words neither name nor veto a room;
+- **none of them**: a code the building does not hold, read right (``P_UNKNOWN``), or
+  words like no name (similarity ``NAME_NULL``).
+
+A reading is a sighting of the best entity only when that entity is ``MARGIN`` times as
+likely as all the others and none of them together (``decide``): otherwise it is ambiguous and
+names nothing, and the tree looks again. ``Evidence`` from several reads of one plate
+adds up (consistency), and a prior over entities (the order of the doors along the
+corridor, ``grounders/plate_memory.py``) can settle what one read leaves open.
 """
 
 from __future__ import annotations
 
 import difflib
+import math
 import re
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 from pmnav_bt.map.building import Building
-from pmnav_bt.map.signage import split_number
-from pmnav_bt.seams import Entity
+from pmnav_bt.map.numbering import NumberingScheme, parse_scheme
+from pmnav_bt.map.signage import ROOM_NUMBER, split_number
+from pmnav_bt.perception.ocr_confusion import ConfusionModel, shipped_model
+from pmnav_bt.seams import Entity, EntityKind
 
-MIN_SIMILARITY = 0.78  # difflib ratio for a fuzzy word match
-MIN_FRAGMENT = 4  # characters of a key a cut-off reading must show
-MARGIN = 0.1  # the best entity must beat the runner-up by this much
-MIN_DIGIT_SCORE = 0.85  # recogniser score a line with digits needs
+MIN_FRAGMENT = 4  # characters of a name a cut-off reading must show
+# A sighting is this many times as likely as any other entity and as an unknown plate: a
+# posterior of at least 10/11 between the two.
+MARGIN = math.log(10.0)
+# Log-likelihood per unit of name similarity: a name 0.1 less similar is MARGIN less likely,
+# so two names are told apart by a tenth of similarity.
+NAME_WEIGHT = MARGIN / 0.1
+# Similarity of words that name nothing of the building: with the margin, a name needs a
+# similarity of 0.78 to be read.
+NAME_NULL = 0.78 - 0.1
+P_UNKNOWN = 0.02  # a code read right that the building does not hold (another floor, a sign)
+SURE_DIGITS = 0.85  # recogniser score of digits a map update trusts (map_check.py)
 
-_NUMBER = re.compile(r"^[A-Za-z]?\d+[A-Za-z]?$")
-# Letters an OCR model reads for digits, fixed only inside tokens that are mostly digits.
-_DIGIT_LOOKALIKES = str.maketrans({"O": "0", "o": "0", "D": "0", "I": "1", "l": "1", "|": "1"})
-# Digits an OCR model reads for the letter of a lettered room number ("0103" for "D103"),
-# tried only when a reading matches nothing as read.
-_LETTER_LOOKALIKES = {"0": "doq", "1": "il", "2": "z", "4": "a", "5": "s", "6": "g", "8": "b"}
+# Lines of one sign as read: (text, recogniser score) or (text, score, character scores).
+Line = tuple[str, float] | tuple[str, float, Sequence[float]]
 
 
 def normalise(text: str) -> str:
@@ -43,154 +60,202 @@ def normalise(text: str) -> str:
     return re.sub(r"[^0-9a-z]", "", text.casefold())
 
 
-def digits(key: str) -> str:
-    return "".join(c for c in key if c.isdigit())
-
-
-def fix_numbers(text: str) -> str:
-    """Map look-alike letters to digits in tokens that are mostly digits ("1O5" -> "105")."""
-    out = []
-    for tok in text.split():
-        n_digits = sum(c.isdigit() for c in tok)
-        if n_digits >= 2 and n_digits >= len(tok) - 1:
-            tok = tok.translate(_DIGIT_LOOKALIKES)
-        out.append(tok)
-    return " ".join(out)
-
-
-def lettered(text: str) -> list[str]:
-    """The readings of ``text`` with the first digit of one all-digit token (3 or more
-    digits) read as a look-alike letter: the wing letter of "D103" is often read "0"."""
-    toks = text.split()
-    out = []
-    for i, tok in enumerate(toks):
-        if len(tok) >= 3 and tok.isdigit():
-            for c in _LETTER_LOOKALIKES.get(tok[0], ""):
-                out.append(" ".join([*toks[:i], c + tok[1:], *toks[i + 1 :]]))
-    return out
-
-
 def sign_number(sign_text: str) -> str | None:
-    """The room number a sign starts with ("117 One-Stop ..." -> "117"), if any."""
-    words = sign_text.split()
-    return words[0].casefold() if words and _NUMBER.match(words[0]) else None
+    """The room code a sign starts with (``"2.04 Radiology"`` -> ``"2.04"``), casefolded."""
+    number, _ = split_number(sign_text)
+    return number.casefold() or None
+
+
+def entity_code(sign_text: str) -> str | None:
+    """The code a sign carries: its leading room number, or the first word of it that is
+    one (``"Stairs 2"`` -> ``"2"``), casefolded."""
+    return next((w.casefold() for w in sign_text.split() if ROOM_NUMBER.match(w)), None)
 
 
 @dataclass(frozen=True)
 class Match:
-    """A reading matched to an entity: how similar (0..1), and the key it matched."""
+    """A reading matched to an entity: its posterior probability (0..1) and how it was
+    named (``code`` and/or ``name``)."""
 
     entity: Entity
     score: float
     key: str
 
 
-class SignMatcher:
-    """Matches sign readings to the rooms and landmarks of one building."""
+@dataclass
+class Evidence:
+    """What reads of one plate say: log-likelihood of each entity and of an unknown plate.
 
-    def __init__(self, building: Building):
-        self.keys: list[tuple[str, Entity]] = []
-        self._numbers: dict[Entity, str] = {}
-        self._sign_numbers: dict[str, list[Entity]] = {}  # "117" -> entities whose signs start so
+    ``add`` combines the reads of one plate (independent reads multiply)."""
+
+    entities: dict[Entity, float] = field(default_factory=dict)
+    unknown: float = 0.0
+    keys: dict[Entity, str] = field(default_factory=dict)
+    code_read: bool = False  # a read showed a code: every room's code was weighed
+
+    def add(self, other: Evidence) -> Evidence:
+        ents = set(self.entities) & set(other.entities)
+        return Evidence(
+            {e: self.entities[e] + other.entities[e] for e in ents},
+            self.unknown + other.unknown,
+            {**other.keys, **self.keys},
+            self.code_read or other.code_read,
+        )
+
+
+def decide(ev: Evidence, prior: Mapping[Entity, float] | None = None) -> Match | None:
+    """The entity ``ev`` names, with ``prior`` (log, per entity; 0 where missing) added:
+    the best, when it is ``MARGIN`` more likely than all the others and the unknown plate
+    together (its posterior at least 10/11); else None (ambiguous)."""
+    if not ev.entities:
+        return None
+    post = {e: ll + (prior.get(e, 0.0) if prior else 0.0) for e, ll in ev.entities.items()}
+    best, ll = max(post.items(), key=lambda kv: kv[1])
+    # The rest together: many rooms each a little likely are, together, a real doubt. With
+    # no code read, one whose name is no likelier than an unknown plate's is one of those.
+    rest = [ev.unknown] + [
+        v for e, v in post.items() if e != best and (ev.code_read or v > ev.unknown)
+    ]
+    z = max(rest)
+    rival = z + math.log(sum(math.exp(v - z) for v in rest))
+    if ll - rival < MARGIN:
+        return None
+    return Match(best, 1.0 / (1.0 + math.exp(rival - ll)), ev.keys.get(best, ""))
+
+
+@dataclass(frozen=True)
+class _Known:
+    """One entity as signs name it: its code (casefolded) and its name keys."""
+
+    entity: Entity
+    code: str | None
+    names: tuple[str, ...]
+
+
+class SignMatcher:
+    """Weighs sign readings against the rooms and landmarks of one building."""
+
+    def __init__(self, building: Building, model: ConfusionModel | None = None):
+        self.model = model if model is not None else shipped_model()
+        self.known: list[_Known] = []
         for r in building.rooms:
             self._add(Entity.room(r.id), r.sign_text, r.name, *r.aliases)
         for lm in building.landmarks:
             self._add(Entity.landmark(lm.id), lm.sign or lm.display_name, lm.name, *lm.aliases)
+        self.scheme: NumberingScheme = parse_scheme(
+            k.code for k in self.known if k.code and k.entity.kind == EntityKind.ROOM
+        )
 
     def _add(self, entity: Entity, sign: str, *names: str) -> None:
-        texts = [sign, *names]
-        number = split_number(sign)[0].casefold()
-        if number:
-            self._sign_numbers.setdefault(number, []).append(entity)
-        num = sign_number(sign)
-        if num is not None:
-            self._numbers[entity] = digits(num)
-        if num is not None:  # the number alone (the rest unread) and the rest alone
-            texts += [num, sign.split(None, 1)[1] if " " in sign else ""]
-        seen = set()
-        for t in texts:
+        code = entity_code(sign)
+        words = [w for w in sign.split() if w.casefold() != code]
+        keys = []
+        for t in (" ".join(words), *names):
             k = normalise(t)
-            if k and k not in seen:
-                seen.add(k)
-                self.keys.append((k, entity))
-
-    def sign_text_of(self, entity: Entity) -> str:
-        """The first key registered for ``entity`` (its sign text, normalised)."""
-        return next(k for k, e in self.keys if e == entity)
+            if k and k not in keys and not (code and k == normalise(code)):
+                keys.append(k)
+        self.known.append(_Known(entity, code, tuple(keys)))
 
     @staticmethod
-    def trusted(lines: Sequence[tuple[str, float]]) -> bool:
-        """False when a line shows digits read with a low recogniser score."""
-        return not any(digits(normalise(fix_numbers(t))) and s < MIN_DIGIT_SCORE for t, s in lines)
+    def trusted(lines: Sequence[Line]) -> bool:
+        """Whether every line showing digits was read with a recogniser score of at least
+        ``SURE_DIGITS``: a plate that names nothing is written as a map update only then."""
+        return not any(any(c.isdigit() for c in ln[0]) and ln[1] < SURE_DIGITS for ln in lines)
 
     def numbered(self, text: str) -> Entity | None:
-        """The one entity whose sign starts with the room number ``text`` starts with, when
-        ``text`` also has a name: for a reading that matched nothing, the room whose sign
-        reads differently from the map ("117 Quiet Room" where the map says "117
-        Pharmacy"). None without a number, a name, or a single owner of the number."""
-        number, name = split_number(fix_numbers(text))
-        owners = self._sign_numbers.get(number.casefold(), []) if number and name else []
+        """The one entity whose sign carries the code ``text`` starts with, when ``text``
+        also has a name: for a reading that matched nothing, the room whose sign reads
+        differently from the map ("117 Quiet Room" where the map says "117 Pharmacy").
+        None without a code, a name, or a single owner of the code."""
+        number, name = split_number(text)
+        code = number.casefold()
+        owners = [k.entity for k in self.known if code and k.code == code] if name else []
         return owners[0] if len(owners) == 1 else None
 
-    def match(self, lines: Sequence[tuple[str, float]]) -> Match | None:
-        """The entity that the lines of one sign (text, recogniser score) name, or None.
+    def match(self, lines: Sequence[Line]) -> Match | None:
+        """The entity the lines of one sign name (see ``decide``), or None."""
+        return decide(self.evidence(lines))
 
-        The lines are matched together; failing that (a number cut by the image border),
-        the lines without digits are, and the digits read must then be a part of the
-        matched sign's number.
-        """
-        if not self.trusted(lines):
-            return None  # digits we do not trust: never guess a number
-        whole = self._match_whole(" ".join(t for t, _ in lines))
-        if whole is not None or len(lines) < 2:
-            return whole
-        read_digits = [digits(normalise(fix_numbers(t))) for t, _ in lines]
-        words = [t for (t, _), d in zip(lines, read_digits, strict=True) if not d]
-        part = self._match_key(normalise(" ".join(words))) if words else None
-        if part is None:
-            return None
-        number = self._numbers.get(part.entity, "")
-        if all(d in number for d in read_digits if d):
-            return Match(part.entity, 0.9 * part.score, part.key)
-        return None
+    def evidence(self, lines: Sequence[Line]) -> Evidence:
+        """What the lines of one sign (top to bottom) say about each entity."""
+        tokens = _tokens(lines)
+        code_at, code_ll = self._code_token(tokens)
+        words = "".join(t for i, (t, _) in enumerate(tokens) if i not in code_at)
+        code = "".join(tokens[i][0] for i in code_at)
+        scores = [s for i in code_at for s in tokens[i][1]]
+        name_null = NAME_WEIGHT * (NAME_NULL - 1.0) if words else 0.0
+        unknown = name_null
+        if code:
+            unknown += math.log(P_UNKNOWN) + self.model.log_read_right(code, scores)
+        ents, keys = {}, {}
+        for k in self.known:
+            ll, how = 0.0, []
+            if code:
+                if k.code is None:  # its sign has no code: one read is a plate unknown
+                    ll += 2 * math.log(P_UNKNOWN) + self.model.log_read_right(code, scores)
+                else:
+                    ll += code_ll[k.code]
+                    how.append(k.code)
+            if words:
+                sim, key = max(((_similarity(words, n), n) for n in k.names), default=(0, ""))
+                ll += max(NAME_WEIGHT * (sim - 1.0), name_null)
+                if sim >= NAME_NULL:
+                    how.append(key)
+            ents[k.entity] = ll
+            keys[k.entity] = " ".join(how)
+        return Evidence(ents, unknown, keys, code_read=bool(code))
 
-    def _match_whole(self, text: str) -> Match | None:
-        """``text`` with look-alike letters in numbers read as digits ("1O5"); failing
-        that, as read (a lettered number, "D103", is not "0103"); failing that, with a
-        leading digit read as a look-alike letter ("0103"), when exactly one such reading
-        names an entity."""
-        fixed = fix_numbers(text)
-        for reading in (fixed, text):
-            m = self._match_key(normalise(reading))
-            if m is not None:
-                return m
-        found: dict[Entity, Match] = {}
-        for reading in lettered(fixed):
-            m = self._match_key(normalise(reading))
-            if m is not None and m.entity not in found:
-                found[m.entity] = Match(m.entity, 0.9 * m.score, m.key)
-        return next(iter(found.values())) if len(found) == 1 else None
+    def _code_token(
+        self, tokens: list[tuple[str, list[float]]]
+    ) -> tuple[tuple[int, ...], dict[str, float]]:
+        """Which tokens (one, or two read apart: "L2 -204") are the plate's code: those
+        that look like one of the building's codes and are likelier a misread code than
+        words; the likeliest, with its log-likelihood under each code. () when none."""
+        codes = {k.code for k in self.known if k.code}
+        best: tuple[tuple[int, ...], dict[str, float]] = ((), {})
+        best_ll = -math.inf
+        spans = [(i,) for i in range(len(tokens))]
+        spans += [(i, i + 1) for i in range(len(tokens) - 1)]
+        for span in spans:
+            text = "".join(tokens[i][0] for i in span)
+            if not codes or not self.scheme.looks_like_code(text):
+                continue
+            sc = [s for i in span for s in tokens[i][1]]
+            lls = {c: self.model.log_likelihood(text, sc, _compact(c)) for c in codes}
+            ll = max(lls.values())
+            has_digit = any(c.isdigit() for c in text)
+            if not has_digit and ll < math.log(P_UNKNOWN) + self.model.log_read_right(text, sc):
+                continue  # a word, more likely than a misread code
+            if ll > best_ll:
+                best, best_ll = (span, lls), ll
+        return best
 
-    def _match_key(self, key: str) -> Match | None:
-        if not key:
-            return None
-        best: dict[Entity, Match] = {}
-        for k, entity in self.keys:
-            score = _similarity(key, k)
-            if score > 0 and (entity not in best or score > best[entity].score):
-                best[entity] = Match(entity, score, k)
-        ranked = sorted(best.values(), key=lambda m: -m.score)
-        if not ranked or ranked[0].score < MIN_SIMILARITY:
-            return None
-        if len(ranked) > 1 and ranked[0].score - ranked[1].score < MARGIN:
-            return None
-        return ranked[0]
+
+def _compact(text: str) -> str:
+    return text.casefold().replace(" ", "")
+
+
+def _tokens(lines: Sequence[Line]) -> list[tuple[str, list[float]]]:
+    """The reading's words, casefolded and trimmed of punctuation at their ends, each
+    with its characters' confidences (the line's score where the reader gave none)."""
+    out = []
+    for line in lines:
+        text, score = line[0], line[1]
+        chars = list(line[2]) if len(line) > 2 else []  # type: ignore[misc]
+        if len(chars) != len(text):
+            chars = [score] * len(text)
+        for m in re.finditer(r"\S+", text):
+            tok, sc = m.group().casefold(), chars[m.start() : m.end()]
+            lo = next((i for i, c in enumerate(tok) if c.isalnum()), len(tok))
+            hi = next((i for i in range(len(tok), 0, -1) if tok[i - 1].isalnum()), 0)
+            if lo < hi:
+                out.append((tok[lo:hi], sc[lo:hi]))
+    return out
 
 
 def _similarity(reading: str, key: str) -> float:
-    """Similarity of a normalised reading to a normalised key; 0 when the digits disagree."""
-    if digits(reading) != digits(key):
-        return 0.0
+    """Similarity of a normalised reading to a normalised name key (0..1)."""
+    reading = normalise(reading)
     if reading == key:
         return 1.0
     ratio = difflib.SequenceMatcher(None, reading, key, autojunk=False).ratio()
@@ -200,6 +265,5 @@ def _similarity(reading: str, key: str) -> float:
         sm = difflib.SequenceMatcher(None, key, reading, autojunk=False)
         m = sm.find_longest_match(0, len(key), 0, len(reading))
         if m.size >= len(reading) - 1:
-            part = 0.8 + 0.2 * len(reading) / len(key)
-            ratio = max(ratio, part)
+            ratio = max(ratio, 0.8 + 0.2 * len(reading) / len(key))
     return ratio

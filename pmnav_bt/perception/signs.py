@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import functools
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -31,11 +31,14 @@ PAD_LINES = 0.8  # crop padding around a plate candidate, in line heights
 
 @dataclass(frozen=True)
 class TextLine:
-    """One line of text read in a frame: ASCII text, recogniser score, box in frame pixels."""
+    """One line of text read in a frame: ASCII text, recogniser score, box in frame pixels,
+    and the recogniser's confidence in each character of ``text`` (its CTC step's
+    probability; empty where unknown). ``score`` is their mean over the raw line."""
 
     text: str
     score: float
     box: Box
+    char_scores: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -163,8 +166,15 @@ def group_lines(lines: list[tuple[Box, float]]) -> list[tuple[Box, float]]:
     return out
 
 
-def _ascii(text: str) -> str:
-    return "".join(c for c in text if 32 <= ord(c) < 127).strip()
+def _ascii(text: str, scores: list[float]) -> tuple[str, tuple[float, ...]]:
+    """``text`` filtered to printable ASCII and stripped, with the scores of the kept
+    characters."""
+    kept = [(c, float(s)) for c, s in zip(text, scores, strict=True) if 32 <= ord(c) < 127]
+    while kept and kept[0][0] == " ":
+        kept.pop(0)
+    while kept and kept[-1][0] == " ":
+        kept.pop()
+    return "".join(c for c, _ in kept), tuple(s for _, s in kept)
 
 
 def _quad_crop(img: np.ndarray, quad: np.ndarray) -> np.ndarray:
@@ -186,7 +196,7 @@ def scale_sign(sign: SignText, f: float) -> SignText:
     def box(b: Box) -> Box:
         return (b[0] * f, b[1] * f, b[2] * f, b[3] * f)
 
-    lines = tuple(TextLine(ln.text, ln.score, box(ln.box)) for ln in sign.lines)
+    lines = tuple(replace(ln, box=box(ln.box)) for ln in sign.lines)
     return SignText(lines, box(sign.box))
 
 
@@ -237,16 +247,17 @@ class SignReader:
         crops = [crop for _, lines in found for _, crop in lines]
         if not crops:
             return []
-        results, _ = self._ocr.text_rec(crops)
+        # word boxes: the per-character confidences come with them
+        results, _ = self._ocr.text_rec(crops, return_word_box=True)
         out, i = [], 0
         for box, lines in found:
             read = []
             for line_box, _ in lines:
-                text, score = results[i]
+                raw, score, info = results[i]
                 i += 1
-                text = _ascii(text)
+                text, chars = _ascii(raw, info[4] if raw else [])
                 if text and score >= self.min_score:
-                    read.append(TextLine(text, float(score), line_box))
+                    read.append(TextLine(text, float(score), line_box, chars))
             if read:
                 out.append(SignText(tuple(read), box))
         return out

@@ -1,10 +1,11 @@
 """The ``ocr`` grounder: reads door and landmark signs in RGB, floor and walls from depth.
 
 - ``read_signs``: every plate whose text names a room or landmark of the building
-  (``SignReader`` + ``SignMatcher``); the detection's box is the sign's, its ``point``
-  where the named entity is, the point the priori-map knows it by: for a room its door
-  (derived from the sign, as ``detect`` does), for a landmark its sign; None without
-  depth. Localization pairs these points with the map's.
+  (``SignReader`` + ``SignMatcher``), its reads in earlier frames and the rooms named
+  around it weighed (``PlateMemory``); an ambiguous plate names nothing. The box is the
+  sign's, its ``point`` where the named entity is, the point the priori-map knows it by:
+  for a room its door (derived from the sign, as ``detect`` does), for a landmark its
+  sign; None without depth. Localization pairs these points with the map's.
 - ``detect(room)``: the room's *door*, derived from its sign (``doors.door_from_sign``):
   box and mask of the door rectangle projected into the image, ``point`` its centre.
   Without depth the door cannot be placed: the sign's detection stands in for it.
@@ -20,6 +21,7 @@ ask ``read_signs`` and ``detect`` of one frame at the cost of one reading.
 
 from __future__ import annotations
 
+import math
 import threading
 from dataclasses import dataclass, replace
 
@@ -29,7 +31,8 @@ from pmnav_bt.backends import BackendDeps
 from pmnav_bt.map.building import Building
 from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.doors import DoorLayout, door_from_sign
-from pmnav_bt.perception.sign_match import SignMatcher
+from pmnav_bt.perception.grounders.plate_memory import PlateMemory
+from pmnav_bt.perception.sign_match import Match, SignMatcher, decide
 from pmnav_bt.perception.signs import MIN_LINE_PX, SignReader, SignText, scale_sign
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
 
@@ -56,8 +59,10 @@ class OcrGrounder:
         self.building = building
         self.reader = reader if reader is not None else SignReader()
         self.matcher = SignMatcher(building)
+        self.memory = PlateMemory(self._door_of)
         self.layout = layout if layout is not None else DoorLayout()
         self._lock = threading.Lock()
+        self._memory_lock = threading.Lock()
         self._cache: tuple[np.ndarray, float, _Read] | None = None
         self._observer = None
 
@@ -95,13 +100,13 @@ class OcrGrounder:
                 return c[2]
         signs, doors, unmatched = [], [], []
         for sign in self._read_text(obs):
-            lines = [(line.text, line.score) for line in sign.lines]
-            m = self.matcher.match(lines)
+            lines = [(ln.text, ln.score) for ln in sign.lines]
+            plate = depth_geom.plate_pose(obs, sign.box)
+            m = self._match(obs, sign, plate)
             if m is None:
                 if self._observer is not None and self.matcher.trusted(lines):
                     unmatched.append(_unmatched(obs, sign))
                 continue
-            plate = depth_geom.plate_pose(obs, sign.box)
             det = Detection(
                 label=sign.text,
                 box=sign.box,
@@ -121,6 +126,28 @@ class OcrGrounder:
         if self._observer is not None:
             self._observer(obs, list(signs), unmatched)
         return result
+
+    def _match(
+        self, obs: Observation, sign: SignText, plate: depth_geom.PlatePose | None
+    ) -> Match | None:
+        """What ``sign`` names: with its plate's place known, all reads of that plate and
+        the plates named around it weighed (``PlateMemory``); else this read alone."""
+        ev = self.matcher.evidence([(ln.text, ln.score, ln.char_scores) for ln in sign.lines])
+        if plate is None:
+            return decide(ev)
+        p = obs.pose
+        x, y = float(plate.centre[0]), float(plate.centre[1])
+        c, s = math.cos(p.yaw), math.sin(p.yaw)
+        xy = (p.x + c * x - s * y, p.y + s * x + c * y)
+        with self._memory_lock:
+            return self.memory.read(xy, (p.x, p.y, p.yaw), obs.stamp, ev)
+
+    def _door_of(self, e: Entity) -> tuple[float, float] | None:
+        """Where the map puts ``e``'s door (a landmark: where it stands); None where the
+        map does not say (the map-less baseline's sign vocabulary has no positions)."""
+        b = self.building
+        x, y = b.room(e.id).door if e.kind == EntityKind.ROOM else b.landmark(e.id).pos
+        return (float(x), float(y)) if math.isfinite(x) and math.isfinite(y) else None
 
     def _read_text(self, obs: Observation) -> list[SignText]:
         """The frame's signs, boxes in the frame's pixels. Where the body offers a wider
