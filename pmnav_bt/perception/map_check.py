@@ -5,10 +5,11 @@ what each new frame showed: the signs it matched to the map and the plates it re
 could not match (:class:`WatchesReads`). :class:`MapCheck` is such a watcher, and
 compares each frame with the map:
 
-- **a sign that reads differently** (``sign_text``): a plate that names nothing of the map,
-  with a name (``MIN_NAME_LETTERS``), that starts with the room number of one room's
-  sign ("117 Quiet Room" where the map says "117 Pharmacy"), or, with no number, hangs
-  within ``ATTRIBUTE_M`` of one room's door (by the pose estimate, once localized);
+- **a sign that reads differently** (``sign_text``): a plate with a name
+  (``MIN_NAME_LETTERS``) that the matcher named by its room code but whose words are none
+  of that room's names, or that names nothing of the map and starts with the code of one
+  room's sign ("117 Quiet Room" where the map says "117 Pharmacy"), or, with no number,
+  hangs within ``ATTRIBUTE_M`` of one room's door (by the pose estimate, once localized);
 - **a landmark not where the map puts it** (``moved``): a landmark's sign seen more than
   ``MOVED_M`` from the map's place for it, by the pose estimate. Rooms are not judged so:
   directional signs ("Radiology ->") name rooms far from their doors.
@@ -95,7 +96,7 @@ class MapCheck:
         """Compare one frame's reads with the map."""
         tf = self.map_T_odom()
         for d in unmatched:
-            if sum(c.isalpha() for c in split_number(d.label)[1]) < MIN_NAME_LETTERS:
+            if _name_letters(d.label) < MIN_NAME_LETTERS:
                 continue  # digits and specks: a misread, not a sign with another name
             xy = self._map_xy(obs, d, tf)
             entity = self.matcher.numbered(d.label)
@@ -105,7 +106,14 @@ class MapCheck:
                 mapped = sign_text(self.pm.building, entity)
                 self._note("sign_text", entity, mapped, d.label, obs, d, xy, tf)
         for d in matched:
-            if d.entity is None or d.entity.kind is not EntityKind.LANDMARK:
+            if d.entity is None:
+                continue
+            if d.entity.kind is EntityKind.ROOM:  # named by its code, with another name
+                if _name_letters(d.label) >= MIN_NAME_LETTERS and self.matcher.names_other(
+                    d.entity, d.label
+                ):
+                    mapped = sign_text(self.pm.building, d.entity)
+                    self._note("sign_text", d.entity, mapped, d.label, obs, d, None, tf)
                 continue
             xy = self._map_xy(obs, d, tf)
             if xy is None:
@@ -169,6 +177,11 @@ class MapCheck:
         if len(order) > 1 and d[order[1]] - d[order[0]] < ATTRIBUTE_MARGIN_M:
             return None
         return Entity.room(rooms[int(order[0])].id)
+
+
+def _name_letters(label: str) -> int:
+    """Letters of a read beside its number."""
+    return sum(c.isalpha() for c in split_number(label)[1])
 
 
 def crop(rgb: np.ndarray, box: tuple[float, float, float, float]) -> np.ndarray:

@@ -172,6 +172,15 @@ class SignMatcher:
         owners = [k.entity for k in self.known if code and k.code == code] if name else []
         return owners[0] if len(owners) == 1 else None
 
+    def names_other(self, entity: Entity, text: str) -> bool:
+        """Whether ``text`` (a plate read as ``entity``, by its code) carries words that are
+        none of ``entity``'s names: a sign renamed since the map was drawn."""
+        _, name = split_number(text)
+        key = next((k for k in self.known if k.entity == entity), None)
+        if key is None or not normalise(name):
+            return False
+        return max((_similarity(name, n) for n in key.names), default=0.0) < NAME_NULL + 0.1
+
     def match(self, lines: Sequence[Line]) -> Match | None:
         """The entity the lines of one sign name (see ``decide``), or None."""
         return decide(self.evidence(lines))

@@ -44,7 +44,8 @@ def test_a_renamed_room_read_on_its_plate_is_written_once_confirmed(ocr, fig2_ma
     assert isinstance(ocr, WatchesReads)
     ocr.watch_reads(MapCheck(fig2_map, sink, lambda: None).frame)
     frames = _frames(wall, CONFIRM_READS + 2, "108 Quiet Room")
-    assert ocr.read_signs(frames[0]) == []  # nothing of the map is named
+    named = [d.entity for d in ocr.read_signs(frames[0])]
+    assert named == [Entity.room("room8")]  # by its number: the robot still finds it
     assert sink.updates == []  # one read is not a stale map
     for obs in frames[1:]:
         ocr.detect(obs, Entity.room("room15"))  # frames read for any reason are watched
