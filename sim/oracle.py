@@ -152,7 +152,7 @@ def run_oracle(
     t0 = time.perf_counter()
     score, drive = fields or goal_fields(base.world, pm, episode.goal)
     base.set_pose(episode.start_pose)
-    collisions0 = base.stats.collisions
+    collisions0, contacts0 = base.stats.collisions, base.world.people.contacts
     runner = _Runner(base, episode.step_budget, trace)
     follow(runner, drive.path((episode.start_x, episode.start_y)))
     base.stop()
@@ -170,6 +170,7 @@ def run_oracle(
         path_length=runner.travelled,
         steps=runner.actions,
         collisions=base.stats.collisions - collisions0,
+        people_contacts=base.world.people.contacts - contacts0,
         wall_time=time.perf_counter() - t0,
         failure=reason,
         trace=runner.trace,

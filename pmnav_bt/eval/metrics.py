@@ -83,7 +83,10 @@ class EpisodeResult:
     are counted apart, not as navigation failures. ``shortest_path_length`` is SPL's l,
     ``distance_to_goal`` the geodesic from the stop to the success region,
     ``distance_to_door`` the straight line from the stop to the door point.
-    ``trace`` optionally holds the visited poses or tree events.
+    ``trace`` optionally holds the visited poses or tree events. ``collisions`` counts the
+    robot's contact events with anything (walls, clutter, people); ``people_contacts`` the
+    times the robot and a person touched, whoever moved (the crowd's count, so a person
+    walking into a standing robot counts too); None in results made before it was recorded.
     """
 
     episode_id: str
@@ -103,6 +106,7 @@ class EpisodeResult:
     distance_to_door: float = float("nan")  # straight line from the stop to the door point
     route_length: float = float("nan")  # corridor route (tiers and budget), metres
     error: str | None = None
+    people_contacts: int | None = None
 
     def to_dict(self, with_trace: bool = False) -> dict[str, Any]:
         d = asdict(self)
@@ -188,6 +192,41 @@ def _row(tier: str, all_rs: list[EpisodeResult]) -> TierRow:
         soft_spl=100.0 * _mean([r.soft_spl for r in rs]),
         mean_distance_to_goal=_mean([r.distance_to_goal for r in rs]),
         errors=len(all_rs) - len(rs),
+    )
+
+
+@dataclass(frozen=True)
+class ContactTotals:
+    """One variant's contacts over the episodes that ran: the robot's collisions with
+    anything and its contacts with people, totals (the targets are per 100 episodes).
+    ``unrecorded``: episodes whose results predate the people count (left out of it)."""
+
+    episodes: int
+    collisions: int
+    people_contacts: int
+    unrecorded: int = 0
+
+    def per_100_text(self) -> str:
+        """Collisions per 100 episodes, one decimal; "-" when no episode ran."""
+        return f"{100.0 * self.collisions / self.episodes:.1f}" if self.episodes else "-"
+
+    def people_text(self) -> str:
+        """The people count, saying how many episodes did not record it."""
+        if self.unrecorded == self.episodes and self.episodes:
+            return "not recorded"
+        note = f" ({self.unrecorded} of {self.episodes} not recorded)" if self.unrecorded else ""
+        return f"{self.people_contacts}{note}"
+
+
+def contact_totals(results: Iterable[EpisodeResult]) -> ContactTotals:
+    """Collisions and people contacts summed over the episodes that ran (errors left out)."""
+    rs = [r for r in results if r.error is None]
+    people = [r.people_contacts for r in rs if r.people_contacts is not None]
+    return ContactTotals(
+        episodes=len(rs),
+        collisions=int(sum(r.collisions for r in rs)),
+        people_contacts=int(sum(people)),
+        unrecorded=len(rs) - len(people),
     )
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
 from pmnav_bt.config import Config
-from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
+from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier, contact_totals
 from pmnav_bt.loading import atomic_write_text, safe_filename
 from pmnav_bt.registry import grounder_label
 from pmnav_bt.tree_variants import TREE_VARIANTS
@@ -169,6 +169,7 @@ def run_episode(
             )
         final = inner.pose()
         stats = inner.stats
+        people_contacts = world.people.contacts
     wall = time.perf_counter() - t0
     result = score_episode(
         pm,
@@ -178,6 +179,7 @@ def run_episode(
         path_length=stats.path_length,
         steps=outcome.actions,
         collisions=stats.collisions,
+        people_contacts=people_contacts,
         wall_time=wall,
         failure=None if outcome.success else str(outcome.failure),
         door=door,
@@ -396,7 +398,8 @@ def failure_code(reason: str) -> str:
 
 
 def run_summary(results: list[EpisodeResult]) -> str:
-    """Failure codes with their counts, and episode wall time mean and p95."""
+    """Failure codes with their counts, episode wall time mean and p95, and the contacts:
+    the robot's collisions (total and per 100 episodes) and its contacts with people."""
     import numpy as np
 
     codes: dict[str, int] = {}
@@ -407,7 +410,12 @@ def run_summary(results: list[EpisodeResult]) -> str:
     fails = ", ".join(f"{c} {k}" for c, k in sorted(codes.items())) or "none"
     walls = [r.wall_time for r in results if r.error is None]
     wall = f"{np.mean(walls):.1f} s / {np.percentile(walls, 95):.1f} s" if walls else "-"
-    return f"failures: {fails}; episode wall time mean / p95: {wall}"
+    c = contact_totals(results)
+    return (
+        f"failures: {fails}; episode wall time mean / p95: {wall}; "
+        f"collisions: {c.collisions} ({c.per_100_text()} per 100 episodes); "
+        f"people contacts: {c.people_text()}"
+    )
 
 
 def error_counts(results: dict[str, list[EpisodeResult]]) -> dict[str, int]:

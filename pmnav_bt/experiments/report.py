@@ -161,6 +161,13 @@ def render_report(folder: Path) -> Path:
         "",
         T.per_building_table(results),
         "",
+        "## Contacts",
+        "",
+        "The robot's collisions with anything and its contacts with people, per variant "
+        "(targets: people 0, collisions <= 1 per 100 episodes).",
+        "",
+        T.contacts_table(results),
+        "",
     ]
     if results:
         plot_sr_spl(results, folder / "plots" / "sr_spl.png")

@@ -9,7 +9,7 @@ import re
 from collections import Counter
 
 from pmnav_bt.config import Config
-from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier
+from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier, contact_totals
 from pmnav_bt.eval.tiers import TIER_NAMES
 from pmnav_bt.experiments.variants import find_variant, variant_title
 
@@ -140,6 +140,22 @@ def failures_table(results: Results) -> str:
     ]
     for n, cnt in counts.items():
         lines.append(f"| {variant_title(n)} | " + " | ".join(str(cnt[c]) for c in codes) + " |")
+    return "\n".join(lines)
+
+
+def contacts_table(results: Results) -> str:
+    """Per variant over the episodes that ran: the robot's collisions with anything (total
+    and per 100 episodes, the target's unit) and its contacts with people."""
+    lines = [
+        "| variant | episodes | collisions | collisions per 100 episodes | people contacts |",
+        "|---|---|---|---|---|",
+    ]
+    for n, rs in results.items():
+        c = contact_totals(rs)
+        lines.append(
+            f"| {variant_title(n)} | {c.episodes} | {c.collisions} | {c.per_100_text()} | "
+            f"{c.people_text()} |"
+        )
     return "\n".join(lines)
 
 

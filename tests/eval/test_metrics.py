@@ -12,6 +12,7 @@ from pmnav_bt.eval.metrics import (
     SUCCESS_RADIUS_M,
     EpisodeResult,
     aggregate_by_tier,
+    contact_totals,
     results_to_json,
     sdf,
     sdf_term,
@@ -132,3 +133,22 @@ def test_tiers_parse():
     assert parse_tiers("hard, easy") == ["hard", "easy"]
     with pytest.raises(ValueError, match="choose easy, medium, hard or all"):
         parse_tiers("extreme")
+
+
+def test_contacts_are_totalled_over_the_episodes_that_ran_and_old_rows_load():
+    old_row = {k: v for k, v in _r("easy", True, 1.0).to_dict().items() if k != "people_contacts"}
+    old = EpisodeResult.from_dict(old_row)  # written before people contacts were recorded
+    assert old.people_contacts is None
+    rs = [
+        dataclasses.replace(_r("easy", False, 0.0), collisions=2, people_contacts=1),
+        dataclasses.replace(_r("easy", True, 1.0), collisions=1, people_contacts=0),
+        dataclasses.replace(_r("easy", False, 0.0), collisions=5, error="RuntimeError: boom"),
+        dataclasses.replace(old, collisions=1),
+    ]
+    c = contact_totals(rs)
+    assert (c.episodes, c.collisions, c.people_contacts, c.unrecorded) == (3, 4, 1, 1)
+    assert c.per_100_text() == "133.3" and c.people_text() == "1 (1 of 3 not recorded)"
+    assert contact_totals([old]).people_text() == "not recorded"
+    assert contact_totals([]).per_100_text() == "-"
+    back = EpisodeResult.from_dict(json.loads(json.dumps(rs[0].to_dict())))
+    assert (back.collisions, back.people_contacts) == (2, 1)

@@ -8,9 +8,9 @@ from pmnav_bt.experiments.evaluation import comparison_markdown, failure_code, v
 from pmnav_bt.registry import grounder_label
 
 
-def _result(ok: bool, reason: str | None, wall: float) -> EpisodeResult:
-    return EpisodeResult("e", "easy", ok, 1.0 if ok else 0.0, 5.0, 10, wall_time=wall,
-                         failure_reason=reason)  # fmt: skip
+def _result(ok: bool, reason: str | None, wall: float, hits=0, people=0) -> EpisodeResult:
+    return EpisodeResult("e", "easy", ok, 1.0 if ok else 0.0, 5.0, 10, collisions=hits,
+                         wall_time=wall, failure_reason=reason, people_contacts=people)  # fmt: skip
 
 
 def test_the_default_grounder_is_real_and_the_oracle_is_labelled():
@@ -19,11 +19,11 @@ def test_the_default_grounder_is_real_and_the_oracle_is_labelled():
     assert grounder_label("sim_gt") == "sim_gt (oracle)" and grounder_label("ocr") == "ocr"
 
 
-def test_the_report_lists_failure_codes_and_wall_times_per_variant():
+def test_the_report_lists_failure_codes_wall_times_and_contacts_per_variant():
     rs = {
         "pmnav": [
             _result(True, None, 10.0),
-            _result(False, "BUDGET_EXCEEDED: 500 actions", 30.0),
+            _result(False, "BUDGET_EXCEEDED: 500 actions", 30.0, hits=2, people=1),
             _result(False, "LOCALIZATION_FAILED: 0 signs read", 20.0),
         ],
         "pmnav_oracle": [_result(True, None, 5.0)],
@@ -32,7 +32,8 @@ def test_the_report_lists_failure_codes_and_wall_times_per_variant():
     assert "| easy | 3 | 33.3 |" in md
     assert (
         "- PM-Nav: failures: BUDGET_EXCEEDED 1, LOCALIZATION_FAILED 1; "
-        "episode wall time mean / p95: 20.0 s / 29.0 s" in md
+        "episode wall time mean / p95: 20.0 s / 29.0 s; "
+        "collisions: 2 (66.7 per 100 episodes); people contacts: 1" in md
     )
     assert "- PM-Nav (oracle: simulator labels): failures: none" in md
     assert failure_code("stopped 2.3 m from the door") == "OTHER"

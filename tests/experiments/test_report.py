@@ -18,7 +18,7 @@ from pmnav_bt.experiments.stored_run import STUDY
 from pmnav_bt.experiments.variants import ORACLE_LABEL, config_hash, variant_configs
 
 
-def _result(eid, tier, ok, spl, reason=None, error=None):
+def _result(eid, tier, ok, spl, reason=None, error=None, hits=0, people=0):
     return EpisodeResult(
         episode_id=eid,
         tier=tier,
@@ -30,6 +30,8 @@ def _result(eid, tier, ok, spl, reason=None, error=None):
         building="b1" if eid.endswith("0") else "b2",
         route_length=4.0,
         error=error,
+        collisions=hits,
+        people_contacts=people,
     )
 
 
@@ -37,7 +39,7 @@ FIXTURE = {
     "pmnav": [
         _result("e0", "easy", True, 0.8),
         _result("e1", "easy", True, 0.6),
-        _result("h0", "hard", False, 0.0, "TARGET_NOT_FOUND: room9 not seen"),
+        _result("h0", "hard", False, 0.0, "TARGET_NOT_FOUND: room9 not seen", hits=1, people=1),
     ],
     "coarse_only": [
         _result("e0", "easy", False, 0.0, "STOPPED_AWAY: stopped 1.7 m from the door"),
@@ -109,6 +111,8 @@ def test_report_from_results_has_the_three_tables_beside_the_paper(folder, capsy
     assert "| pmnav_oracle | PM-Nav (oracle: simulator labels) | pmnav | sim_gt |" in md
     # failure codes per variant, an errored run counted as ERROR
     assert "| coarse-only | 1 | 1 | 0 |" in md and "| ERROR | STOPPED_AWAY |" in md
+    # contacts per variant: collisions (per 100 episodes that ran) and people
+    assert "| PM-Nav | 3 | 1 | 33.3 | 1 |" in md and "| coarse-only | 2 | 0 | 0.0 | 0 |" in md
     # the configuration and the commit
     assert "grounder:\n    backend: ocr" in md and "Commit `" in md
     for png in ("sr_spl.png", "failures.png"):

@@ -44,7 +44,7 @@ def test_oracle_scores_sr_100_and_spl_95(name):
         assert row.sr == 100.0, (name, row)
         assert row.spl >= 95.0, (name, row)
     for r in results:
-        assert r.failure_reason is None and r.collisions == 0
+        assert r.failure_reason is None and r.collisions == 0 and r.people_contacts == 0
         assert r.distance_to_goal == 0.0 and r.distance_to_door <= 1.0
         # The geodesic is a lower bound the oracle meets (it keeps 5 cm more clearance
         # and ends 5 cm inside the success disc).

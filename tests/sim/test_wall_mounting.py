@@ -207,6 +207,7 @@ def test_success_is_measured_at_the_door_the_world_has(worlds):
     def scored(stop_y: float, door) -> bool:
         r = score_episode(
             pm, ep, (5.0, stop_y), geodesic=Flat(), path_length=5.0, steps=20, collisions=0,
+            people_contacts=0,
             wall_time=0.0, door=door,
         )
         return r.success

@@ -29,7 +29,7 @@ def test_an_episode_of_each_tier_succeeds(tier, tmp_path):
     # SPL against the free-space geodesic to the 1 m disc: the tree stops 0.6 m from the
     # door and keeps to the middle of corridors round corners, so the shortest (3-6 m)
     # episodes score 0.6-0.8.
-    assert r.spl > 0.5 and r.collisions == 0
+    assert r.spl > 0.5 and r.collisions == 0 and r.people_contacts == 0  # recorded: not None
     assert r.path_length >= r.shortest_path_length and r.distance_to_goal == 0.0
     assert run.tree_log.exists() and run.plot.exists()
 
