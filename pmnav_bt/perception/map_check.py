@@ -98,7 +98,7 @@ class MapCheck:
         for d in unmatched:
             if _name_letters(d.label) < MIN_NAME_LETTERS:
                 continue  # digits and specks: a misread, not a sign with another name
-            xy = self._map_xy(obs, d, tf)
+            xy = plate_in_map(obs, d, tf)
             entity = self.matcher.numbered(d.label)
             if entity is None and xy is not None:
                 entity = self._door_near(xy)
@@ -115,7 +115,7 @@ class MapCheck:
                     mapped = sign_text(self.pm.building, d.entity)
                     self._note("sign_text", d.entity, mapped, d.label, obs, d, None, tf)
                 continue
-            xy = self._map_xy(obs, d, tf)
+            xy = plate_in_map(obs, d, tf)
             if xy is None:
                 continue
             mx, my = entity_position(self.pm, d.entity)
@@ -159,13 +159,6 @@ class MapCheck:
         )
         self.sink.record(update, seen.crop)
 
-    def _map_xy(self, obs: Observation, d: Detection, tf) -> tuple[float, float] | None:
-        if tf is None or d.point is None:
-            return None
-        odom = se2_apply((obs.pose.x, obs.pose.y, obs.pose.yaw), d.point[:2])
-        x, y = se2_apply(tf, (float(odom[0]), float(odom[1])))
-        return float(x), float(y)
-
     def _door_near(self, xy: tuple[float, float]) -> Entity | None:
         rooms = self.pm.building.rooms
         if not rooms:
@@ -177,6 +170,16 @@ class MapCheck:
         if len(order) > 1 and d[order[1]] - d[order[0]] < ATTRIBUTE_MARGIN_M:
             return None
         return Entity.room(rooms[int(order[0])].id)
+
+
+def plate_in_map(obs: Observation, d: Detection, tf) -> tuple[float, float] | None:
+    """Where the plate of ``d`` (its ``point`` in the body frame of ``obs``) is on the map,
+    by the map-from-odometry transform ``tf``; None before localization or without depth."""
+    if tf is None or d.point is None:
+        return None
+    odom = se2_apply((obs.pose.x, obs.pose.y, obs.pose.yaw), d.point[:2])
+    x, y = se2_apply(tf, (float(odom[0]), float(odom[1])))
+    return float(x), float(y)
 
 
 def _name_letters(label: str) -> int:
