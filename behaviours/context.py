@@ -7,7 +7,7 @@ the Context holds the things a behaviour *uses* (injected once, not looked up).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,6 +21,9 @@ from pmnav_bt.pose.odometry import CalibratedBase
 from pmnav_bt.seams import Base, CoarseDirection, Grounder, Planner, Pose2D, Refiner
 from pmnav_bt.tree_variants import DetourCheck
 from pmnav_bt.worker import Worker
+
+if TYPE_CHECKING:  # pragma: no cover
+    from pmnav_bt.perception.misreads import Misreads
 
 
 @dataclass
@@ -56,6 +59,7 @@ class Context:
     trace: list[TraceEvent] = field(default_factory=list)
     budget_actions: int = 500
     map_updates: MapUpdateSink = NO_MAP_UPDATES  # where disagreements with the map go
+    misreads: Misreads | None = None  # plates read that named nothing (trees.map_watch)
 
     def __post_init__(self) -> None:
         if not isinstance(self.base, CalibratedBase):

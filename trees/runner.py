@@ -22,9 +22,11 @@ from pmnav_bt.config import Config
 from pmnav_bt.eval.task import action_budget as task_action_budget
 from pmnav_bt.failures import Failure, FailureCode, failure_from, root_cause
 from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.planning.resolve import step_entity
 from pmnav_bt.pose.evidence.floor_model import wall_source
-from pmnav_bt.seams import Base
+from pmnav_bt.seams import Base, Entity
 from pmnav_bt.tree_variants import TREE_VARIANTS
+from pmnav_bt.trees.map_watch import watch_misreads
 from pmnav_bt.trees.snapshots import SnapshotLogger
 from pmnav_bt.trees.view_record import ViewRecorder
 
@@ -97,17 +99,25 @@ def make_context(
         backends = build_backends(config, known, on_robot=on_robot, seed=seed, planner=knows.plans)
     elif not knows.plans:
         backends = replace(backends, planner=None)
-    return Context.wired(
+    ctx = Context.wired(
         base, known, config, backends, budget, deferred_work,
         detour_check=knows.detour_check(known),
         walls=wall_source(config.tree.localization_walls, grid),
     )  # fmt: skip
+    watch_misreads(ctx)
+    return ctx
 
 
 def build_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourTree:
     """The tree of the variant ``ctx.config.tree.variant`` for ``goal``
     (``pmnav_bt.tree_variants.TREE_VARIANTS``), on a context ``make_context`` built for it."""
     return TREE_VARIANTS.spec(ctx.config.tree.variant).build_tree(ctx, goal)
+
+
+def _target_entity(ctx: Context) -> Entity | None:
+    """What the tree looked for when it ended (the plan step's room or landmark)."""
+    t = _blackboard("target")
+    return None if t is None or t.look_for is None else step_entity(ctx.pm.building, t.look_for)
 
 
 def _blackboard(key: str):
@@ -171,6 +181,8 @@ def run_tree(
             or _blackboard("failure")
             or Failure(FailureCode.TIMEOUT, f"no result after {tree.count} ticks")
         )
+        if ctx.misreads is not None:  # what was read where the target was not found
+            failure = ctx.misreads.explain(failure, _target_entity(ctx))
     return RunOutcome(
         success=status == py_trees.common.Status.SUCCESS,
         failure=failure,
