@@ -224,7 +224,8 @@ def run(
         typer.echo(
             f"{'SUCCESS' if res.success else 'FAILURE'}: SPL {res.spl:.3f}, {res.steps} actions, "
             f"{res.path_length:.1f} m driven (shortest {res.shortest_path_length:.1f} m), "
-            f"{res.collisions} collisions, stopped {res.distance_to_door:.2f} m from the door, "
+            f"{res.collisions} collisions, {res.people_contacts} people contacts, "
+            f"stopped {res.distance_to_door:.2f} m from the door, "
             f"{res.wall_time:.1f} s wall"
         )
         if res.failure_reason:

@@ -72,6 +72,7 @@ def test_run_a_goal_in_an_own_building_by_relative_path(capsys, own_building):
     code, out, err = run(capsys, *argv)
     assert code == 0, out + err
     assert "PM-Nav [sim_gt (oracle)] in my_office" in out and "SUCCESS" in out
+    assert " 0 collisions, 0 people contacts, " in out  # the clean world has nobody about
 
 
 def test_eval_an_own_building_from_another_directory(capsys, own_building):
@@ -91,6 +92,10 @@ def test_eval_an_own_building_from_another_directory(capsys, own_building):
     assert list(results) == ["pmnav@clean", "pmnav@realistic"]
     r = results["pmnav@clean"][0]
     assert r["error"] is None and r["building"] == "my_office"
+    # Contacts with people are recorded per episode (the realistic world has people) and
+    # totalled per variant.
+    assert all(isinstance(rs[0]["people_contacts"], int) for rs in results.values())
+    assert "per 100 episodes); people contacts: " in out
 
 
 def test_eval_refuses_an_unknown_world_or_none(capsys):
