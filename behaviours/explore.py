@@ -174,7 +174,7 @@ class ExploreFrontier(RouteDrive):
     """
 
     READS = DriveTo.READS + ("grid", "goal_entity")
-    WRITES = ("explore_over",)
+    WRITES = ("explore_over", "way_shut")  # (a drive notes a shut way; no map pose here)
     JOBS = RouteDrive.JOBS + ("_choice_job",)
 
     def initialise(self) -> None:
