@@ -6,19 +6,19 @@ they can go and look at; "the corridor between room8 and turn2 blocked for 10 s"
 by the two places (rooms, landmarks, waypoints) at the ends of its priori-map segment,
 a fire door by the waypoint (node) it stands at.
 
-A fire door is a landmark of the building file whose ``kind`` is in ``FIRE_DOOR_KINDS``,
-standing across its corridor; something that shuts the way within ``FIRE_DOOR_NEAR_M``
-of one is taken for that door, closed.
+A fire door is a landmark of the building file whose ``kind`` names one
+(``pmnav_bt.map.landmark_kinds.FIRE_DOOR``), standing across its corridor; something
+that shuts the way within ``FIRE_DOOR_NEAR_M`` of one is taken for that door, closed.
 """
 
 from __future__ import annotations
 
 import math
 
+from pmnav_bt.map.landmark_kinds import is_fire_door
 from pmnav_bt.map.priori_map import PrioriMap, Segment
 from pmnav_bt.map.signs_only import MapAccessError
 
-FIRE_DOOR_KINDS = frozenset({"fire_door", "fire door", "firedoor"})
 # A door leaf stands within half a corridor width of its landmark point; the depth a
 # drive measures to what shut its way is good to a few tenths of a metre.
 FIRE_DOOR_NEAR_M = 1.5
@@ -34,7 +34,7 @@ def fire_door_at(pm: PrioriMap, point: tuple[float, float]) -> str | None:
     ("fire door at branch1", or its name where it has one); None when there is none."""
     best, words = FIRE_DOOR_NEAR_M, None
     for lm in pm.building.landmarks:
-        if lm.kind.strip().lower() not in FIRE_DOOR_KINDS:
+        if not is_fire_door(lm.kind):
             continue
         d = math.dist(point, lm.pos)
         if d <= best:
