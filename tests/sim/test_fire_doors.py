@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from building_kit import with_landmark
-from shapely.geometry import LineString
+from shapely.geometry import LineString, Point
 from shapely.ops import unary_union
 
 from pmnav_bt.config import WorldConfig
@@ -65,3 +65,11 @@ def test_a_shut_fire_door_closes_its_corridor_and_an_open_one_leaves_it_free(off
             assert hit.label == landmark_label("fd1") and hit.distance == pytest.approx(3.2, 0.01)
         else:
             assert hit is None
+
+
+def test_clutter_keeps_clear_of_where_a_fire_door_swings(office):
+    cfg = WorldConfig(preset="realistic", people_per_100m=0.0, clutter_per_10m=5.0)
+    with SimWorld(office, scene=cfg, seed=3) as w:
+        line = LineString(w.fire_doors["fd1"].line)
+        assert w.clutter  # a corridor full of it
+        assert all(line.distance(Point(c.centre)) > line.length / 2.0 for c in w.clutter)
