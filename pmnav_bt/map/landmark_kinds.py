@@ -99,7 +99,7 @@ PLATE = LandmarkShape(
 FIRE_DOOR = LandmarkShape(
     "fire door",
     ("fire_door", "fire door", "firedoor"),
-    2 * FIRE_DOOR_LEAF_M,  # a leaf either side of its point: where one lies held open
+    FIRE_DOOR_LEAF_M,  # beside its point, where a leaf lies held open
     FIRE_DOOR_THICKNESS_M,
     "two door leaves across the corridor, wall to wall: shut (solid) or held open flat "
     "against the walls (`world.fire_doors_closed`); no name plate",

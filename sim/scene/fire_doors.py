@@ -13,8 +13,9 @@ The door line crosses the corridor at the point of the nearest corridor centre l
 landmark's ``pos``, square to that corridor, from wall to wall of the open floor. Shut,
 two leaves fill it (solid, so the robot's drive stops at them and the way-ahead check
 reports the door: pmnav_bt/map/wording.py). Open, each leaf lies flat against its wall,
-swung the way the corridor runs from its ``from`` waypoint to its ``to``. Every leaf
-carries the landmark's label, so segmentation sees the door by its id.
+swung the way the corridor runs from its ``from`` waypoint to its ``to``. The leaves are
+labelled ``obstacle``, as a barrier is, not ``landmark:<id>``: a fire door carries no sign,
+and a grounder that reads labels (``sim_gt``) must not read it as one.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from pmnav_bt.map.landmark_kinds import (
     FIRE_DOOR_THICKNESS_M,
     is_fire_door,
 )
-from pmnav_bt.seams import landmark_label
+from pmnav_bt.seams import OBSTACLE_LABEL
 from pmnav_bt.sim.scene.blocking import chord_through
 from pmnav_bt.sim.scene.doors import GLASS_RGBA
 
@@ -104,7 +105,7 @@ def _door_line(world: SimWorld, lm: Landmark) -> tuple[np.ndarray, np.ndarray, n
 
 def _build(world: SimWorld, lm: Landmark, closed: bool) -> FireDoor:
     p0, p1, along = _door_line(world, lm)
-    label = landmark_label(lm.id)
+    label = OBSTACLE_LABEL
     rgba = world.appearance.door
     h, t = FIRE_DOOR_HEIGHT_M, FIRE_DOOR_THICKNESS_M
     leaf = float(np.hypot(*(p1 - p0))) / 2.0
