@@ -19,8 +19,9 @@ from pmnav_bt.map.landmark_kinds import is_fire_door
 from pmnav_bt.map.priori_map import PrioriMap, Segment
 from pmnav_bt.map.signs_only import MapAccessError
 
-# A door leaf stands within half a corridor width of its landmark point; the depth a
-# drive measures to what shut its way is good to a few tenths of a metre.
+# The leaves cross the corridor where the map links the door to its centre line (its
+# node: sim/scene/fire_doors.py builds them there, whichever wall ``pos`` is at); the
+# depth a drive measures to what shut its way is good to a few tenths of a metre.
 FIRE_DOOR_NEAR_M = 1.5
 
 
@@ -36,9 +37,11 @@ def fire_door_at(pm: PrioriMap, point: tuple[float, float]) -> str | None:
     for lm in pm.building.landmarks:
         if not is_fire_door(lm.kind):
             continue
-        d = math.dist(point, lm.pos)
+        place = pm.places.get(lm.id)
+        # its leaves cross the corridor where the map puts the door on the centre line
+        where = pm.node_xy(place.node) if place is not None else lm.pos
+        d = math.dist(point, where)
         if d <= best:
-            place = pm.places.get(lm.id)
             at = place.node if place is not None else lm.id
             best, words = d, f"fire door {lm.name} at {at}" if lm.name else f"fire door at {at}"
     return words

@@ -62,7 +62,9 @@ class FireDoor:
     bodies: tuple[int, ...]
 
 
-def fire_doors_closed(ids: list[str], probability: float, rng: np.random.Generator) -> dict:
+def fire_doors_closed(
+    ids: list[str], probability: float, rng: np.random.Generator
+) -> dict[str, bool]:
     """Which of the fire doors ``ids`` are shut: each with ``probability``, drawn by ``rng``."""
     draws = rng.random(len(ids))
     return {i: bool(d < probability) for i, d in zip(ids, draws, strict=True)}
