@@ -404,6 +404,11 @@ class WorldConfig(_Section):
     )
     doors_open: float = Field(0.0, ge=0.0, le=1.0, description="fraction of doors standing open")
     doors_glass: float = Field(0.0, ge=0.0, le=1.0, description="fraction of doors glazed")
+    fire_doors_closed: float = Field(
+        0.0, ge=0.0, le=1.0, description="probability that each fire door (a landmark of kind "
+        "fire_door) is shut across its corridor, else held open (sim/scene/fire_doors.py; 0 in "
+        "both presets)",
+    )
     light_level: list[float] = _pair("light_level", "light level, 1 = the clean world's")
     light_turn_deg: float = Field(
         0.0, ge=0.0, le=180.0, description="the light's direction turns by up to this (deg)"

@@ -73,6 +73,7 @@ from pmnav_bt.sim.scene import scene_rng
 from pmnav_bt.sim.scene.appearance import WALL_THICKNESS, appearance_of
 from pmnav_bt.sim.scene.clutter import ClutterItem, place_clutter
 from pmnav_bt.sim.scene.doors import DoorLeaf, DoorState, build_leaf, door_states
+from pmnav_bt.sim.scene.fire_doors import FireDoor, build_fire_doors
 from pmnav_bt.sim.scene.people import Crowd, populate
 from pmnav_bt.sim.scene.plates import make_line_plate
 from pmnav_bt.sim.scene.sign_mounting import SIGN_DEPTH, SIGN_GAP, mount_signage
@@ -226,6 +227,7 @@ class SimWorld:
         self.signs: dict[str, WallItem] = {}
         self.landmarks: dict[str, WallItem] = {}
         self.landmark_signs: dict[str, WallItem] = {}
+        self.fire_doors: dict[str, FireDoor] = {}  # across corridors, not on walls
         self.directional_signs: dict[str, WallItem] = {}  # by index in the file, "0", "1" ...
         self.obstacles: dict[int, tuple[float, float, float]] = {}
         self.clutter: list[ClutterItem] = []
@@ -576,6 +578,7 @@ class SimWorld:
         self._build_signage()
         if self._grid_plan is not None:
             self._build_grid_walls()
+        self.fire_doors = build_fire_doors(self)
         self.clutter = place_clutter(self)
         self.people = populate(self)
         self.appearance.dress(self)  # last: it dresses what the rest built
@@ -793,6 +796,8 @@ class SimWorld:
 
     def _build_landmark(self, lm: Landmark) -> None:
         shape = landmark_shape(lm.kind)
+        if shape.across:
+            return  # a fire door stands across its corridor (build_fire_doors), not on a wall
         label = landmark_label(lm.id)
         text = lm.sign_text
         if shape is ELEVATOR:

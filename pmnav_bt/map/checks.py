@@ -30,6 +30,7 @@ from pmnav_bt.map.building import Building, WaypointKind
 from pmnav_bt.map.floorplan import DOOR_WIDTH_M, FloorPlanImage, door_frames, load_floor_plan
 from pmnav_bt.map.free_space import free_space_polygon, free_space_rings
 from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask
+from pmnav_bt.map.landmark_kinds import landmark_shape
 from pmnav_bt.map.wall_items import wall_item_warnings
 from pmnav_bt.map.wall_surface import SEARCH_M, RealWalls, nearest_boundary_point
 
@@ -142,7 +143,7 @@ def sign_warnings(b: Building, range_m: float = SIGN_RANGE_M) -> list[Problem]:
     """
     seg_a, seg_b = _segments(b)
     signs = [r.door for r in b.rooms if r.sign_text] + [
-        lm.pos for lm in b.landmarks if lm.sign_text
+        lm.pos for lm in b.landmarks if lm.sign_text and landmark_shape(lm.kind).readable
     ]
     if signs:
         pts = np.array(signs, float)

@@ -6,21 +6,22 @@ they can go and look at; "the corridor between room8 and turn2 blocked for 10 s"
 by the two places (rooms, landmarks, waypoints) at the ends of its priori-map segment,
 a fire door by the waypoint (node) it stands at.
 
-A fire door is a landmark of the building file whose ``kind`` is in ``FIRE_DOOR_KINDS``,
-standing across its corridor; something that shuts the way within ``FIRE_DOOR_NEAR_M``
-of one is taken for that door, closed.
+A fire door is a landmark of the building file whose ``kind`` names one
+(``pmnav_bt.map.landmark_kinds.FIRE_DOOR``), standing across its corridor; something
+that shuts the way within ``FIRE_DOOR_NEAR_M`` of one is taken for that door, closed.
 """
 
 from __future__ import annotations
 
 import math
 
+from pmnav_bt.map.landmark_kinds import is_fire_door
 from pmnav_bt.map.priori_map import PrioriMap, Segment
 from pmnav_bt.map.signs_only import MapAccessError
 
-FIRE_DOOR_KINDS = frozenset({"fire_door", "fire door", "firedoor"})
-# A door leaf stands within half a corridor width of its landmark point; the depth a
-# drive measures to what shut its way is good to a few tenths of a metre.
+# The leaves cross the corridor where the map links the door to its centre line (its
+# node: sim/scene/fire_doors.py builds them there, whichever wall ``pos`` is at); the
+# depth a drive measures to what shut its way is good to a few tenths of a metre.
 FIRE_DOOR_NEAR_M = 1.5
 
 
@@ -34,11 +35,13 @@ def fire_door_at(pm: PrioriMap, point: tuple[float, float]) -> str | None:
     ("fire door at branch1", or its name where it has one); None when there is none."""
     best, words = FIRE_DOOR_NEAR_M, None
     for lm in pm.building.landmarks:
-        if lm.kind.strip().lower() not in FIRE_DOOR_KINDS:
+        if not is_fire_door(lm.kind):
             continue
-        d = math.dist(point, lm.pos)
+        place = pm.places.get(lm.id)
+        # its leaves cross the corridor where the map puts the door on the centre line
+        where = pm.node_xy(place.node) if place is not None else lm.pos
+        d = math.dist(point, where)
         if d <= best:
-            place = pm.places.get(lm.id)
             at = place.node if place is not None else lm.id
             best, words = d, f"fire door {lm.name} at {at}" if lm.name else f"fire door at {at}"
     return words

@@ -19,6 +19,7 @@ import numpy as np
 
 from pmnav_bt.errors import PlanningError
 from pmnav_bt.geometry import Action, heading, relative_action, wrap_angle
+from pmnav_bt.map.landmark_kinds import landmark_shape
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.planning.plan import MAX_GAP_M, ForkChoice, Plan, PlanStart, PlanStep
 from pmnav_bt.planning.resolve import StartPoint, resolve_room, resolve_start
@@ -151,7 +152,8 @@ def _side(heading_in: float, at: np.ndarray, target) -> str:
 def _target_of(
     pm: PrioriMap, node_id: str, goal_id: str, avoid: frozenset[str] = frozenset()
 ) -> tuple[str | None, object]:
-    """What to look for at a node (room or landmark id) and its position, or (None, None)."""
+    """What to look for at a node (room or landmark id) and its position, or (None, None).
+    A landmark with no sign to read (a fire door: ``LandmarkShape.readable``) is never it."""
     n = pm.nodes[node_id]
     b = pm.building
     if goal_id in n.rooms:
@@ -160,8 +162,9 @@ def _target_of(
         if rid not in avoid:
             return rid, b.room(rid).door
     for lid in n.landmarks:
-        if lid not in avoid:
-            return lid, b.landmark(lid).pos
+        lm = b.landmark(lid)
+        if lid not in avoid and landmark_shape(lm.kind).readable:
+            return lid, lm.pos
     return None, None
 
 

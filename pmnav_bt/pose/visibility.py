@@ -19,6 +19,7 @@ import numpy as np
 import scipy.sparse.csgraph
 import shapely
 
+from pmnav_bt.map.landmark_kinds import landmark_shape
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.planning.resolve import entity_position
 from pmnav_bt.seams import Entity
@@ -34,9 +35,10 @@ def entity_xy(pm: PrioriMap, entity: Entity) -> tuple[float, float]:
 
 
 def map_entities(pm: PrioriMap) -> list[Entity]:
-    """Every room and landmark of the building (each has a sign)."""
+    """Every room and landmark of the building with a sign (all but fire doors)."""
     b = pm.building
-    return [Entity.room(r.id) for r in b.rooms] + [Entity.landmark(lm.id) for lm in b.landmarks]
+    lms = [Entity.landmark(lm.id) for lm in b.landmarks if landmark_shape(lm.kind).readable]
+    return [Entity.room(r.id) for r in b.rooms] + lms
 
 
 class LandmarkDensity(str, Enum):

@@ -29,6 +29,7 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.planning.graph_planner import GraphPlanner
 from pmnav_bt.planning.plan import Plan
 from pmnav_bt.planning.resolve import entity_position, sign_text
+from pmnav_bt.pose.visibility import map_entities
 from pmnav_bt.seams import (
     CAMERA_HEIGHT_M,
     CREATE3_MAX_ANGULAR,
@@ -258,10 +259,7 @@ class ScriptedGrounder:
         self._called("read_signs")
         if not self.signs_readable:
             return []
-        b = self.pm.building
-        every = [Entity.room(r.id) for r in b.rooms] + [
-            Entity.landmark(lm.id) for lm in b.landmarks
-        ]
+        every = map_entities(self.pm)  # every room and landmark with a sign to read
         return [d for e in every if (d := self._see(obs, e)) is not None]
 
     def surfaces(self, obs: Observation) -> SurfaceMasks:

@@ -49,7 +49,7 @@ def block_segment(world: SimWorld, pm: PrioriMap, ref: str) -> list[int]:
         raise BlockError(f"blocked segment {ref!r} has no length")
     across = np.array([-d[1], d[0]]) / float(np.hypot(*d))
     line = LineString([mid - across * REACH_M, mid + across * REACH_M])
-    chord = _chord_through(world.floor_space().intersection(line), mid)
+    chord = chord_through(world.floor_space().intersection(line), mid)
     if chord is None:
         raise BlockError(f"blocked segment {ref!r}: no open floor at its middle")
     p0, p1 = (np.asarray(c, float) for c in chord.coords[:2])
@@ -70,7 +70,7 @@ def block_segment(world: SimWorld, pm: PrioriMap, ref: str) -> list[int]:
     return bodies
 
 
-def _chord_through(cut, point: np.ndarray) -> LineString | None:
+def chord_through(cut, point: np.ndarray) -> LineString | None:
     """The piece of ``cut`` (a line's intersection with the floor) nearest ``point``."""
     pieces = [g for g in getattr(cut, "geoms", [cut]) if isinstance(g, LineString) and g.length]
     if not pieces:

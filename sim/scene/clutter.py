@@ -157,6 +157,9 @@ class ClutterPlan:
         for lm in world.landmarks.values():
             if lm.z[0] < 0.5:  # stands on the floor: an elevator, stairs, a desk
                 keep.append(_front(lm, LANDMARK_CLEAR_M, across))
+        for fd in world.fire_doors.values():  # where its leaves swing and lie held open
+            line = LineString(fd.line)
+            keep.append(line.buffer(line.length / 2.0))
         self.keep_out = shapely.union_all(keep)
         shapely.prepare(self.keep_out)
         self.signs = self._sign_sites()

@@ -26,6 +26,12 @@ class Mounted(Protocol):
     z: tuple[float, float]  # bottom and top heights
 
 
+class Crossing(Protocol):
+    """Something across a corridor (a fire door): its ``line`` from wall to wall."""
+
+    line: tuple[tuple[float, float], tuple[float, float]]
+
+
 class Segment(Protocol):
     @property
     def length(self) -> float: ...
@@ -45,6 +51,7 @@ class SceneWorld(Protocol):
     signs: Mapping[str, Mounted]
     landmarks: Mapping[str, Mounted]
     landmark_signs: Mapping[str, Mounted]
+    fire_doors: Mapping[str, Crossing]
 
     def rng(self, part: str) -> np.random.Generator: ...
 

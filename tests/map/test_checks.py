@@ -132,3 +132,19 @@ def test_validate_prints_warnings_and_strict_fails(tmp_path):
     assert r.exit_code == 1
     r = CliRunner().invoke(app, ["validate", "--strict", "l_hospital"])
     assert r.exit_code == 0, r.output
+
+
+def test_a_fire_door_is_no_readable_sign():
+    d = _data()
+    gone = [r for r in d["rooms"] if not (r["door"][0] < 20 and r["door"][1] > 0)]
+    d["rooms"] = [r for r in d["rooms"] if r not in gone]
+    bare = sign_warnings(_b(d))
+
+    def with_kind(kind):
+        lms = [
+            {"id": f"lm_{r['id']}", "kind": kind, "pos": r["door"], "sign": "FD"} for r in gone
+        ]
+        return sign_warnings(_b({**d, "landmarks": [*d.get("landmarks", []), *lms]}))
+
+    assert len(with_kind("sign")) < len(bare)  # plates where the doors were count ...
+    assert with_kind("fire_door") == bare  # ... fire doors there do not

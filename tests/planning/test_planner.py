@@ -258,3 +258,30 @@ def test_two_landmarks_at_one_spot_are_one_place_on_a_straight_route(end):
         actions = [s.action for s in p.steps]
         assert actions == [Action.GO_STRAIGHT] * (len(actions) - 1) + [Action.ARRIVE]
         assert sum(s.distance for s in p.steps) == pytest.approx(p.length) == pytest.approx(18.0)
+
+
+@pytest.mark.parametrize("kind", ["sign", "fire_door"])
+def test_a_fire_door_is_never_a_step_to_look_for(kind):
+    """A sign 10 m along the corridor is a step to look for; a fire door there has no
+    sign to read, so the plan never asks the robot to find it (it drives through)."""
+    from pmnav_bt.map.building import building_from_data
+
+    pm = parse_building(
+        building_from_data(
+            {
+                "schema_version": 1,
+                "name": "one_corridor",
+                "waypoints": [
+                    {"id": "start", "kind": "start", "pos": [0, 0]},
+                    {"id": "end1", "kind": "end", "pos": [20, 0]},
+                ],
+                "edges": [["start", "end1"]],
+                "rooms": [{"id": "room1", "door": [18, 1.2], "sign": "101"}],
+                "landmarks": [{"id": "thing", "kind": kind, "pos": [10, 1.2], "sign": "FD1"}],
+            }
+        )
+    )
+    p = GraphPlanner(max_gap=2.0).plan(pm, "start", "room1")  # asks for every landmark
+    looked_for = {s.look_for for s in p.steps}
+    assert ("thing" in looked_for) is (kind == "sign")
+    assert p.steps[-1].look_for == "room1"

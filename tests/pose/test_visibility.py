@@ -95,3 +95,15 @@ def test_the_trip_to_a_target_by_way_of_signs_is_never_shorter_than_the_route():
     near = dict(vis.exits[mid])
     assert near[3.14] < near[0.0]
     assert east < west - 10.0
+
+
+def test_a_fire_door_is_not_a_sign_the_map_expects_to_be_read():
+    from building_kit import with_landmark
+
+    from pmnav_bt.map.building import Landmark
+
+    b = load_building("straight_office")
+    for kind, expected in (("sign", True), ("fire_door", False)):
+        door = Landmark(id="fd1", kind=kind, name="FD-1", pos=(15.25, 1.1), sign="FD-1")
+        vis = Visibility(parse_building(with_landmark(b, door)))
+        assert (Entity.landmark("fd1") in vis.entities) is expected
