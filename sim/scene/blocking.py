@@ -19,10 +19,10 @@ from shapely.geometry import LineString
 
 from pmnav_bt.errors import PmNavError, UnknownNameError
 from pmnav_bt.seams import OBSTACLE_LABEL
+from pmnav_bt.sim.scene.host import BoxWorld
 
 if TYPE_CHECKING:  # pragma: no cover
     from pmnav_bt.map.priori_map import PrioriMap
-    from pmnav_bt.sim.world import SimWorld
 
 BARRIER_DEPTH_M = 0.3
 BARRIER_HEIGHT_M = 1.0
@@ -35,7 +35,7 @@ class BlockError(PmNavError):
     """A segment to block that the building does not have, or has no floor at its middle."""
 
 
-def block_segment(world: SimWorld, pm: PrioriMap, ref: str) -> list[int]:
+def block_segment(world: BoxWorld, pm: PrioriMap, ref: str) -> list[int]:
     """A barrier across the corridor at the middle of priori-map segment ``ref`` ("seg13");
     the body ids of its stripes."""
     try:

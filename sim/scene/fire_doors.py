@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from shapely.geometry import LineString
@@ -37,9 +36,7 @@ from pmnav_bt.map.landmark_kinds import (
 from pmnav_bt.seams import OBSTACLE_LABEL
 from pmnav_bt.sim.scene.blocking import chord_through
 from pmnav_bt.sim.scene.doors import GLASS_RGBA
-
-if TYPE_CHECKING:  # pragma: no cover
-    from pmnav_bt.sim.world import SimWorld
+from pmnav_bt.sim.scene.host import BoxWorld
 
 WALL_MARGIN_M = 0.3  # how far past the corridor's nominal width the door line may reach
 MEETING_GAP_M = 0.01  # between the two shut leaves: their faces never coincide
@@ -70,7 +67,7 @@ def fire_doors_closed(
     return {i: bool(d < probability) for i, d in zip(ids, draws, strict=True)}
 
 
-def build_fire_doors(world: SimWorld) -> dict[str, FireDoor]:
+def build_fire_doors(world: BoxWorld) -> dict[str, FireDoor]:
     """Every fire door of ``world``'s building, shut or open as the world's knob draws."""
     doors = [lm for lm in world.building.landmarks if is_fire_door(lm.kind)]
     if not doors:
@@ -81,7 +78,7 @@ def build_fire_doors(world: SimWorld) -> dict[str, FireDoor]:
     return {lm.id: _build(world, lm, shut[lm.id]) for lm in doors}
 
 
-def _door_line(world: SimWorld, lm: Landmark) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _door_line(world: BoxWorld, lm: Landmark) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The door line's two ends (wall to wall) and the unit direction its corridor runs."""
     b = world.building
     pos = np.asarray(lm.pos, float)
@@ -105,7 +102,7 @@ def _door_line(world: SimWorld, lm: Landmark) -> tuple[np.ndarray, np.ndarray, n
     return p0, p1, along
 
 
-def _build(world: SimWorld, lm: Landmark, closed: bool) -> FireDoor:
+def _build(world: BoxWorld, lm: Landmark, closed: bool) -> FireDoor:
     p0, p1, along = _door_line(world, lm)
     label = OBSTACLE_LABEL
     rgba = world.appearance.door
@@ -133,7 +130,7 @@ def _build(world: SimWorld, lm: Landmark, closed: bool) -> FireDoor:
     return FireDoor(lm.id, closed, ends, tuple(bodies))
 
 
-def _pane(world: SimWorld, centre: np.ndarray, yaw: float, label: str) -> None:
+def _pane(world: BoxWorld, centre: np.ndarray, yaw: float, label: str) -> None:
     """A leaf's vision panel, standing a few mm proud of both its faces (seen, not felt)."""
     z0, z1 = PANE_Z
     world.add_box(

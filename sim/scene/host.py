@@ -67,3 +67,27 @@ class SceneWorld(Protocol):
         footprint: Polygon | None = None,
         bottom: float = 0.0,
     ) -> int: ...
+
+
+class Painted(Protocol):
+    """The part of the world's look (``appearance.Appearance``) that boxes take."""
+
+    door: tuple[float, ...]  # RGBA of door leaves
+
+
+class BoxWorld(SceneWorld, Protocol):
+    """A world that also adds plain static boxes (barriers, fire-door leaves)."""
+
+    appearance: Painted
+
+    def add_box(
+        self,
+        centre: tuple[float, float, float],
+        half_extents: tuple[float, float, float],
+        yaw: float,
+        rgba: tuple[float, ...],
+        label: str,
+        *,
+        solid: bool = True,
+        collision: bool | None = None,
+    ) -> int: ...
