@@ -467,14 +467,6 @@ def _place_nodes(h: nx.Graph, world: dict, lines: dict) -> dict:
 # -- doors ----------------------------------------------------------------------------
 
 
-def _is_free(plan: FloorPlanImage, free: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    cell = plan.world_to_cell(pts)
-    ok = (cell >= 0).all(axis=1) & (cell[:, 0] < plan.width) & (cell[:, 1] < plan.height)
-    out = np.zeros(len(pts), bool)
-    out[ok] = free[cell[ok, 1], cell[ok, 0]]
-    return out
-
-
 def door_candidates(
     plan: FloorPlanImage,
     free: np.ndarray,
@@ -500,7 +492,7 @@ def door_candidates(
     found = []
     for side in (1, -1):
         pts = a + s[:, None, None] * u + side * offs[None, :, None] * n
-        open_ = _is_free(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(offs)).all(axis=1)
+        open_ = plan.mask_at(free, pts.reshape(-1, 2)).reshape(len(s), len(offs)).all(axis=1)
         for lo, hi in _runs(open_):
             run = (hi - lo) * step
             if params.door_min_m <= run <= params.door_max_m:

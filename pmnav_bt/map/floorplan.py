@@ -107,6 +107,15 @@ class FloorPlanImage:
         j = np.floor((-s * d[:, 0] + c * d[:, 1]) / self.resolution)
         return np.stack([i, self.height - 1 - j], axis=1).astype(int)
 
+    def mask_at(self, mask: np.ndarray, xy) -> np.ndarray:
+        """``mask`` (a boolean image of this plan's size, such as its free cells) at each
+        map point (N,); False for points off the image."""
+        cell = self.world_to_cell(xy)
+        ok = (cell >= 0).all(axis=1) & (cell[:, 0] < self.width) & (cell[:, 1] < self.height)
+        out = np.zeros(len(cell), bool)
+        out[ok] = mask[cell[ok, 1], cell[ok, 0]]
+        return out
+
     def corners_world(self) -> np.ndarray:
         """The image's four outer corners in the map frame (4, 2)."""
         w, h = self.width, self.height

@@ -87,14 +87,6 @@ def lane_corridors(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray) -> C
 # -- 1. lanes inside the free space -------------------------------------------------------
 
 
-def inside(plan: FloorPlanImage, free: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    cell = plan.world_to_cell(pts)
-    ok = (cell >= 0).all(axis=1) & (cell[:, 0] < plan.width) & (cell[:, 1] < plan.height)
-    out = np.zeros(len(pts), bool)
-    out[ok] = free[cell[ok, 1], cell[ok, 0]]
-    return out
-
-
 def _lanes_inside(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray):
     g = nx.Graph()
     skipped, cuts = [], 0
@@ -106,7 +98,7 @@ def _lanes_inside(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray):
         if length < 1e-6:
             continue
         s = np.arange(0.0, length + step, step).clip(max=length)
-        ins = inside(plan, free, a + np.outer(s / length, b - a))
+        ins = plan.mask_at(free, a + np.outer(s / length, b - a))
         if ins.all():
             _add(g, lane.a, a, lane.b, b)
             continue
@@ -220,7 +212,7 @@ def _centre(plan: FloorPlanImage, free, walls, a: np.ndarray, b: np.ndarray):
     dist = []
     for side in (1.0, -1.0):
         pts = a + s[:, None, None] * u + side * t[None, :, None] * n
-        ok = inside(plan, walls, pts.reshape(-1, 2)).reshape(len(s), len(t))
+        ok = plan.mask_at(walls, pts.reshape(-1, 2)).reshape(len(s), len(t))
         hit = ~ok.all(axis=1)
         first = np.where(hit, np.argmin(ok, axis=1), len(t) - 1)
         dist.append(np.where(hit, t[first], np.inf))
@@ -242,7 +234,7 @@ def _centre(plan: FloorPlanImage, free, walls, a: np.ndarray, b: np.ndarray):
 def _blocked(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     """The share of the line a-b off the free space."""
     n = max(2, int(np.linalg.norm(b - a) / (plan.resolution / 2.0)))
-    return 1.0 - float(inside(plan, free, a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).mean())
+    return 1.0 - float(plan.mask_at(free, a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).mean())
 
 
 def _walled(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
@@ -255,7 +247,7 @@ def _walled(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray
     hit = []
     for side in (1.0, -1.0):
         pts = a + s[:, None, None] * u + side * t[None, :, None] * n
-        hit.append(~inside(plan, free, pts.reshape(-1, 2)).reshape(len(s), len(t)).all(axis=1))
+        hit.append(~plan.mask_at(free, pts.reshape(-1, 2)).reshape(len(s), len(t)).all(axis=1))
     return float((hit[0] & hit[1]).mean())
 
 
@@ -269,7 +261,7 @@ def _extend_dead_ends(g: nx.Graph, pos: dict, widths: dict, plan, masks) -> None
         u = pos[n] - pos[m]
         u = u / max(float(np.linalg.norm(u)), 1e-9)
         t = np.arange(plan.resolution, EXTEND_M, plan.resolution / 2.0)
-        ahead = inside(plan, free, pos[n] + t[:, None] * u)
+        ahead = plan.mask_at(free, pos[n] + t[:, None] * u)
         clear = float(t[int(np.argmin(ahead))]) if not ahead.all() else EXTEND_M
         half = widths[frozenset((n, m))] / 2.0
         reach = clear - max(half, 0.5)

@@ -18,7 +18,7 @@ import numpy as np
 
 from pmnav_bt.geometry import project_points_to_segments
 from pmnav_bt.map.floorplan import FloorPlanImage
-from pmnav_bt.map.rmf_corridors import MIN_EDGE_M, Corridors, inside
+from pmnav_bt.map.rmf_corridors import MIN_EDGE_M, Corridors
 
 SPUR_HALF_M = 0.9  # the spur's centre line runs this far in front of the door's wall
 SPUR_MAX_M = 12.0  # a door farther than this along its wall from the network gets no spur
@@ -40,7 +40,7 @@ def add_spur(
     best = None
     for side in (1.0, -1.0):
         front = door + side * normal * SPUR_HALF_M
-        if not inside(plan, free, front[None])[0]:
+        if not plan.mask_at(free, front[None])[0]:
             continue
         for way in (1.0, -1.0):
             hit = _first_hit(cor, front, way * along)
@@ -111,7 +111,7 @@ def _add_bent_spur(cor, plan, free, door, along, normal) -> bool:
         foot = seg_a[j[0]] + t[0] * (seg_b[j[0]] - seg_a[j[0]])
         way = 1.0 if np.dot(front - foot, along) < 0 else -1.0  # the knee nearer the network
         knee, end = front + way * along * PAST_M, front - way * along * PAST_M
-        if not (d[0] <= SPUR_MAX_M and inside(plan, free, front[None])[0]
+        if not (d[0] <= SPUR_MAX_M and plan.mask_at(free, front[None])[0]
                 and _clear(plan, free, foot, knee) and _clear(plan, free, knee, end)
                 and np.linalg.norm(knee - foot) >= MIN_EDGE_M):
             continue
@@ -149,7 +149,7 @@ def _first_hit(cor: Corridors, p: np.ndarray, d: np.ndarray):
 
 def _clear(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> bool:
     n = max(2, int(np.linalg.norm(b - a) / (plan.resolution / 2.0)))
-    return bool(inside(plan, free, a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).all())
+    return bool(plan.mask_at(free, a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).all())
 
 
 def _node_at(cor: Corridors, k: int, foot: np.ndarray) -> int:

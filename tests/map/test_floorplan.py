@@ -56,6 +56,14 @@ def test_world_to_cell_matches_costmap_indexing():
     assert p.world_to_cell(pts)[:2].tolist() == [[0, 2], [3, 0]]
 
 
+def test_a_mask_is_read_at_map_points_and_is_false_off_the_image():
+    p = _plan()  # 3 rows x 4 columns, 0.5 m, bottom-left corner at (1, 2)
+    mask = np.zeros((3, 4), bool)
+    mask[2, 0] = True  # the bottom-left cell
+    pts = [[1.25, 2.25], [2.75, 3.25], [0.9, 2.25], [1.25, 1.9], [3.1, 2.25], [1.25, 3.6]]
+    assert p.mask_at(mask, pts).tolist() == [True, False, False, False, False, False]
+
+
 def test_yaw_rotates_about_the_origin():
     p = _plan(origin=(1.0, 2.0, math.pi / 2))
     # Cell (0, 0) centre is (0.25, 0.25) in the map's own axes, rotated a quarter turn.
