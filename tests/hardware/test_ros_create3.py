@@ -215,11 +215,14 @@ def test_faults_over_dds(probe, domain_id, tmp_path):
         start = time.monotonic()
         probe.send_goal(ep.goal)
         probe.wait_for(lambda: _moving_cmds(probe, start), 15.0, "the robot to move", procs)
+        probe.wait_for(  # (best-effort odometry can reach the probe late on a loaded machine)
+            lambda: probe.odom and probe.odom[-1][0] > start, 15.0, "odometry at the probe", procs
+        )
         probe.set_param("sim_create3", "publish_odom", False)
         time.sleep(1.0)
         r = _result(probe, procs, ep.goal, 10.0)
         with probe.lock:
-            last_odom = probe.odom[-1][0] if probe.odom else None
+            last_odom = probe.odom[-1][0]
             cmds = list(probe.cmd)
         # The stop that holds: the first zero after the last motion command.
         last_motion = max((t for t, v, w in cmds if v or w), default=-math.inf)
