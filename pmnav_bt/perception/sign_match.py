@@ -167,8 +167,7 @@ class SignMatcher:
         also has a name: for a reading that matched nothing, the room whose sign reads
         differently from the map ("117 Quiet Room" where the map says "117 Pharmacy").
         None without a code, a name, or a single owner of the code."""
-        number, name = split_number(text)
-        code = number.casefold()
+        code, name = sign_number(text), split_number(text)[1]
         owners = [k.entity for k in self.known if code and k.code == code] if name else []
         return owners[0] if len(owners) == 1 else None
 
