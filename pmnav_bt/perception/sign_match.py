@@ -48,6 +48,7 @@ NAME_WEIGHT = MARGIN / 0.1
 # Similarity of words that name nothing of the building: with the margin, a name needs a
 # similarity of 0.78 to be read.
 NAME_NULL = 0.78 - 0.1
+NAME_READ = NAME_NULL + MARGIN / NAME_WEIGHT  # (0.78) the similarity a name is read at
 P_UNKNOWN = 0.02  # a code read right that the building does not hold (another floor, a sign)
 SURE_DIGITS = 0.85  # recogniser score of digits a map update trusts (map_check.py)
 
@@ -178,7 +179,7 @@ class SignMatcher:
         key = next((k for k in self.known if k.entity == entity), None)
         if key is None or not normalise(name):
             return False
-        return max((_similarity(name, n) for n in key.names), default=0.0) < NAME_NULL + 0.1
+        return max((_similarity(name, n) for n in key.names), default=0.0) < NAME_READ
 
     def match(self, lines: Sequence[Line]) -> Match | None:
         """The entity the lines of one sign name (see ``decide``), or None."""
