@@ -23,6 +23,9 @@ class FailureCode(str, Enum):
     TARGET_NOT_FOUND = "TARGET_NOT_FOUND"  # a plan landmark was not found after re-search/replan
     BLOCKED = "BLOCKED"  # the way is physically blocked
     DOOR_CLOSED = "DOOR_CLOSED"  # a door across the route (a fire door) is closed
+    LIFT_NOT_COMING = "LIFT_NOT_COMING"  # the lift did not come, or its door did not open, in time
+    LIFT_FULL = "LIFT_FULL"  # the lift came full, every time the robot waited for it
+    WRONG_LEVEL = "WRONG_LEVEL"  # the signs read on leaving the lift belong to another level
     BUDGET_EXCEEDED = "BUDGET_EXCEEDED"  # the action budget ran out
     TIMEOUT = "TIMEOUT"  # a step took longer than its clock budget
     SENSOR_TIMEOUT = "SENSOR_TIMEOUT"  # no camera frames or odometry

@@ -420,3 +420,63 @@ class Planner(Protocol):
         goal: str,
         constraints: PlanConstraints = PlanConstraints(),
     ) -> Plan: ...
+
+
+# -- lifts -------------------------------------------------------------------------------
+# A Create 3 cannot press a lift's buttons: the building's lift system (or a person) moves
+# the lift for it. The seam follows Open-RMF's lift protocol (rmf_lift_msgs): a robot asks
+# for a lift by a *session* (LiftRequest: lift_name, session_id, request_type AGV mode or
+# end session, destination_floor, door_state open) and watches the lift's LiftState
+# (current_floor, destination_floor, door_state, motion_state, session_id,
+# available_floors). Levels are named as the building file names them.
+
+
+class LiftDoor(str, Enum):
+    """The lift's door, as rmf_lift_msgs/LiftState.door_state (0 closed, 1 moving, 2 open)."""
+
+    CLOSED = "closed"
+    MOVING = "moving"
+    OPEN = "open"
+
+
+class LiftMotion(str, Enum):
+    """The cabin's motion, as rmf_lift_msgs/LiftState.motion_state (0..3)."""
+
+    STOPPED = "stopped"
+    UP = "up"
+    DOWN = "down"
+    UNKNOWN = "unknown"
+
+
+@dataclass(frozen=True)
+class LiftState:
+    """What the lift system says about one lift. ``session``: the session the lift serves
+    now ("" when none); ``stamp``: the lift system's time of this state, in seconds."""
+
+    lift: str
+    current_level: str
+    destination_level: str
+    door: LiftDoor
+    motion: LiftMotion
+    session: str = ""
+    available_levels: tuple[str, ...] = ()
+    stamp: float = 0.0
+
+
+@runtime_checkable
+class Lift(Protocol):
+    """The building's lift system as the robot sees it: requests out, states in.
+
+    ``request(lift, level, session)`` asks the lift to come to (or, with the robot inside,
+    go to) ``level`` and open its door there, for ``session`` (RMF's REQUEST_AGV_MODE with
+    DOOR_OPEN); asking again with another level moves the cabin. ``release`` ends the
+    session (REQUEST_END_SESSION), so others may use the lift. ``state`` is the latest state
+    heard of the lift, ``None`` before any. Implementations: the simulator's lift
+    (``sim/``), the ROS 2 lift client over rmf_lift_msgs (``hardware/``), and the doubles.
+    """
+
+    def request(self, lift: str, level: str, session: str) -> None: ...
+
+    def release(self, lift: str, session: str) -> None: ...
+
+    def state(self, lift: str) -> LiftState | None: ...
