@@ -15,9 +15,42 @@ import random
 import networkx as nx
 
 from pmnav_bt.map.building import SCHEMA_VERSION, Building, building_from_data
+from pmnav_bt.map.floorplan import DOOR_WIDTH_M
+from pmnav_bt.map.landmark_kinds import landmark_shape
 
 ROOM_PITCH = 3.0  # metres between door centres along a corridor (alternating walls)
 JUNCTION_CLEARANCE = 2.5  # no door closer than this to a junction
+# A lift or stairs is slid along its wall in these steps until no door hangs through it;
+# a door takes its leaf and a frame each side (pmnav_bt/map/wall_items.DOOR_SPAN_M).
+LANDMARK_SLIDE_M = 0.25
+DOOR_CLEARANCE_M = DOOR_WIDTH_M / 2.0 + 0.1
+
+
+def _landmark_spot(
+    g: nx.Graph, pos: dict, junction, corridor_width: float, span: float, rooms: list[dict]
+) -> list[float]:
+    """Where a lift or stairs ``span`` wide goes at ``junction``: on the right-hand wall of
+    a corridor leaving it (the one going +y where there is one), just past the corner, slid
+    along that wall away from the junction until no door hangs through it."""
+    x, y = pos[junction]
+    ways = sorted(
+        (pos[m][0] - x, pos[m][1] - y) for m in g.neighbors(junction)
+    )
+    dx, dy = next(((a, b) for a, b in ways if b > 0 and a == 0), ways[0])
+    length = math.hypot(dx, dy)
+    ux, uy = dx / length, dy / length
+    wall = (x + uy * corridor_width / 2.0, y - ux * corridor_width / 2.0)
+    reach = span / 2.0 + DOOR_CLEARANCE_M
+    # doors on that wall, by their distance along it from the junction
+    along = [
+        (r["door"][0] - wall[0]) * ux + (r["door"][1] - wall[1]) * uy
+        for r in rooms
+        if abs((r["door"][0] - wall[0]) * uy - (r["door"][1] - wall[1]) * ux) < 1e-6
+    ]
+    s = corridor_width / 2.0 + 0.5
+    while any(abs(d - s) < reach for d in along):
+        s += LANDMARK_SLIDE_M
+    return [round(wall[0] + ux * s, 3), round(wall[1] + uy * s, 3)]
 
 
 def generate_building(
@@ -114,13 +147,14 @@ def generate_building(
     junctions = [n for n in sorted(g, key=str) if g.degree(n) >= 2]
     for i, n in enumerate(junctions[:: max(1, len(junctions) // 4)][:n_landmarks]):
         kind = ("elevator", "stairs")[i % 2]
-        x, y = pos[n]
         landmarks.append(
             {
                 "id": f"{kind}{i + 1}",
                 "kind": kind,
                 "name": f"{kind.title()} {i + 1}",
-                "pos": [x + corridor_width / 2.0, y + corridor_width / 2.0 + 0.5],
+                "pos": _landmark_spot(
+                    g, pos, n, corridor_width, landmark_shape(kind).span_m, rooms
+                ),
             }
         )
     data = {

@@ -9,7 +9,8 @@ import pytest
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.experiments.options import building_names
-from pmnav_bt.map.catalogue import family_members, generated_family
+from pmnav_bt.map.catalogue import family_members, generated_family, load_building
+from pmnav_bt.map.wall_items import wall_item_warnings
 from pmnav_bt.sim.episodes import episode_building_file, generate_episodes
 
 
@@ -48,3 +49,14 @@ def test_an_episode_finds_its_generated_building_where_its_file_is_missing(tmp_p
     moved = dataclasses.replace(ep, building_path=str(tmp_path / "gone" / "gen_small_1.yaml"))
     path = episode_building_file(moved)
     assert path.is_file() and str(path).startswith(str(tmp_path / "node"))
+
+
+@pytest.mark.parametrize("family", ["gen_small", "sign_sparse"])
+def test_no_generated_lift_or_stairs_hangs_through_a_door(family):
+    """Lifts and stairs go on a wall of a corridor that leaves their junction, slid clear
+    of its doors (they once sat in a turn's corner, past its corridors, and the simulator
+    hung them over the nearest door)."""
+    for name in family_members(f"{family}:10"):
+        b = load_building(name)
+        clashes = [p.message for p in wall_item_warnings(b) if p.field.startswith("landmarks")]
+        assert not clashes, (name, clashes)
