@@ -39,6 +39,8 @@ ARGS: dict[str, tuple[str, str]] = {
     "segmentation_topic": ("camera/segmentation", "empty on a real robot"),
     "tree_log": ("", "also write tree snapshots (JSON lines) here"),
     "record": ("", "record the run to this FILE.mcap (pmnav-ros --record)"),
+    "view_port": ("0", "serve the live web view (pmnav view) on this port; 0: none"),
+    "map_updates_dir": ("", "write what the robot saw that disagrees with the map here"),
 }
 SIM_STRINGS = ("building", "start_pose")
 SIM_NUMBERS = ("width", "height", "camera_rate_hz")
@@ -51,7 +53,9 @@ CONTROLLER_STRINGS = (
     "depth_topic",
     "segmentation_topic",
     "tree_log",
+    "map_updates_dir",
 )
+CONTROLLER_NUMBERS = ("view_port",)
 
 
 class LaunchArgumentError(ValueError):
@@ -91,7 +95,7 @@ def commands(values: dict[str, str]) -> list[tuple[str, list[str]]]:
         sim = ros_args("sim_create3", values, SIM_STRINGS, SIM_NUMBERS)
         out.append(("sim_create3", [*py, "pmnav_bt.hardware.sim_create3", *sim]))
     record = ["--record", values["record"]] if values["record"] else []
-    ctl = ros_args("pmnav", values, CONTROLLER_STRINGS)
+    ctl = ros_args("pmnav", values, CONTROLLER_STRINGS, CONTROLLER_NUMBERS)
     out.append(("pmnav", [*py, "pmnav_bt.hardware.node", *record, *ctl]))
     return out
 

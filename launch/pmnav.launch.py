@@ -21,7 +21,12 @@ from launch.conditions import IfCondition
 from launch.substitutions import LaunchConfiguration
 
 from pmnav_bt.hardware.launcher import ARGS as LAUNCHER_ARGS
-from pmnav_bt.hardware.launcher import CONTROLLER_STRINGS, SIM_NUMBERS, SIM_STRINGS
+from pmnav_bt.hardware.launcher import (
+    CONTROLLER_NUMBERS,
+    CONTROLLER_STRINGS,
+    SIM_NUMBERS,
+    SIM_STRINGS,
+)
 
 # The arguments and the parameters each node gets are shared with ``pmnav-launch``
 # (pmnav_bt/hardware/launcher.py), the launcher that runs without the launch packages
@@ -50,7 +55,7 @@ def generate_launch_description() -> LaunchDescription:
         condition=IfCondition(LaunchConfiguration("sim")),
     )
     controller = ExecuteProcess(
-        cmd=["pmnav-ros"] + _ros_args("pmnav", list(CONTROLLER_STRINGS)),
+        cmd=["pmnav-ros"] + _ros_args("pmnav", list(CONTROLLER_STRINGS), CONTROLLER_NUMBERS),
         name="pmnav",
         output="screen",
         # SIGINT first: pmnav-ros sends a zero cmd_vel before it exits.

@@ -60,6 +60,9 @@ def test_launcher_builds_the_launch_files_command_lines():
     assert sim_name == "sim_create3" and "start_pose:='47,20,0'" in sim
     assert ctl_name == "pmnav" and ctl[ctl.index("--record") + 1] == "r.mcap"
     assert "segmentation_topic:='camera/segmentation'" in ctl
+    # the controller's own parameters reach it: the web view's port as a number
+    ctl = launcher.commands(launcher.parse(["view_port:=8765", "map_updates_dir:=u"]))[1][1]
+    assert "view_port:=8765" in ctl and "map_updates_dir:='u'" in ctl
     assert [n for n, _ in launcher.commands(launcher.parse(["sim:=false"]))] == ["pmnav"]
     with pytest.raises(launcher.LaunchArgumentError, match="did you mean 'building'"):
         launcher.parse(["bulding:=x"])
