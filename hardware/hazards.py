@@ -12,8 +12,8 @@ built (the body then feels nothing: one line in its log says so).
 - a bump forbids driving forwards while the bumper is pressed (felt within
   ``BUMP_HOLD_S``): the body stops at once, BLOCKED; backing off and turning in place
   (a round body turning never pushes) stay allowed, or the recoveries could not leave;
-- a stall stops a motion that has run ``STALL_GRACE_S`` (the wheels had time to turn):
-  BLOCKED; a new command may try again;
+- a stall stops a motion that has run ``STALL_GRACE_S`` (the wheels had time to turn)
+  and was felt since that motion began: BLOCKED; a new command may try again;
 - a cliff or a dropped wheel forbids every motion while it is felt and ``FAULT_HOLD_S``
   after: the body's status is FAULT, which ends the mission (the tree must never drive
   on where the floor ends; the robot's own reflexes back it off the edge).
@@ -42,10 +42,10 @@ TYPE_CODES = {
 BACKUP_LIMIT_CODE = 0
 _KINDS = {code: kind for kind, code in TYPE_CODES.items()}
 
-# A hazard is held for a while after its last detection: longer than a few of the
-# robot's periods (16 ms; the simulated Create 3 publishes at 20 Hz), so one late
-# message does not let the body push again.
-BUMP_HOLD_S = 0.3
+# A hazard is held for a while after its last detection: longer than the robot's period
+# (16 ms) and than the gaps of a starved simulated Create 3 (20 Hz, gaps of 0.3 s seen on
+# 2 busy cores), so one late message does not let the body push again.
+BUMP_HOLD_S = 0.5
 STALL_GRACE_S = 0.3  # ... and a stall only stops a motion older than this
 FAULT_HOLD_S = 2.0  # a cliff: long enough for any tick rate to see the FAULT
 SAME_PLACE_M = 0.05  # a hazard felt again this close to the last is the same one
@@ -130,11 +130,11 @@ class HazardWatch:
         held = self.fault(now)
         if held is None and v > 0.0:
             held = self._held((HazardKind.BUMP,), BUMP_HOLD_S, now)
-        if held is None and moving_for >= STALL_GRACE_S:
-            held = self._held((HazardKind.STALL,), BUMP_HOLD_S, now)
+        if held is None and moving_for >= STALL_GRACE_S:  # felt since this motion began
+            held = self._held((HazardKind.STALL,), min(BUMP_HOLD_S, moving_for), now)
         return held
 
     def _held(self, kinds: tuple[HazardKind, ...], hold: float, now: float) -> Hazard | None:
-        """The newest hazard of ``kinds`` felt within ``hold`` s, or None."""
+        """The newest hazard of ``kinds`` felt within the last ``hold`` s, or None."""
         held = [(t, h) for k, (h, t) in self._last.items() if k in kinds and now - t <= hold]
         return max(held, key=lambda th: th[0])[1] if held else None

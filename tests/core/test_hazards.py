@@ -99,6 +99,8 @@ def test_a_stall_stops_only_a_motion_that_had_time_to_turn_the_wheels():
     assert w.forbids(-0.1, 0.0, 5.05, 0.0) is None  # a new command may try again
     assert w.forbids(-0.1, 0.0, 5.05, STALL_GRACE_S - 0.01) is None
     assert w.forbids(-0.1, 0.0, 5.05, STALL_GRACE_S).kind == HazardKind.STALL
+    # a stall felt before this motion began is not this motion's
+    assert w.forbids(-0.1, 0.0, 5.0 + STALL_GRACE_S + 0.1, STALL_GRACE_S) is None
 
 
 def test_a_cliff_forbids_every_motion_and_faults_for_a_while():
