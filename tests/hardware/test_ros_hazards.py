@@ -17,12 +17,10 @@ import pytest
 from pmnav_bt.hardware.hazards import message_types
 from pmnav_bt.hardware.testing import Proc
 
-pytestmark = [
-    pytest.mark.timeout(120),
-    pytest.mark.skipif(
-        message_types() is None, reason="irobot_create_msgs not built (interfaces/build.sh)"
-    ),
-]
+pytestmark = pytest.mark.timeout(120)
+needs_messages = pytest.mark.skipif(
+    message_types() is None, reason="irobot_create_msgs not built (interfaces/build.sh)"
+)
 
 BUILDING = "fig2_hospital"
 READY_S = 45.0  # process start (imports, pybullet world) on a busy 2-core machine
@@ -98,6 +96,7 @@ class _Rig:
         self.sim.stop()
 
 
+@needs_messages
 def test_driving_into_a_wall_the_body_stops_on_the_bump_and_names_its_side(domain_id, tmp_path):
     """Heading 54 deg, the north wall comes 36 deg left of ahead: the front-left zone."""
     from pmnav_bt.hazards import HazardKind
@@ -152,6 +151,7 @@ def test_driving_into_a_wall_the_body_stops_on_the_bump_and_names_its_side(domai
         rig.close()
 
 
+@needs_messages
 def test_a_hazard_from_another_publisher_stops_a_moving_body(domain_id, tmp_path):
     """A bump while driving (BLOCKED), then a cliff while turning on the spot (FAULT: no
     motion at all), both from a test publisher on hazard_detection."""
@@ -192,3 +192,27 @@ def test_a_hazard_from_another_publisher_stops_a_moving_body(domain_id, tmp_path
         assert [h.kind for h in rig.base.hazards()] == [HazardKind.BUMP, HazardKind.CLIFF]
     finally:
         rig.close()
+
+
+def test_without_the_messages_the_body_feels_nothing_and_says_so(
+    domain_id, monkeypatch, capfd
+):
+    from rclpy.node import Node
+
+    from pmnav_bt.hardware import create3
+    from pmnav_bt.hardware.runtime import RosRuntime
+
+    monkeypatch.setattr(create3, "message_types", lambda: None)  # as where it was not built
+    rt = RosRuntime(args=[], domain_id=domain_id)
+    node = Node("no_hazards", context=rt.context)
+    base = create3.Create3Base(node)
+    try:
+        assert not base.hazards_enabled
+        assert base.hazards() == [] and base.blocked_by() is None
+        assert not [t for t, _ in node.get_subscriber_names_and_types_by_node(
+            "no_hazards", "/") if "hazard" in t]  # fmt: skip
+    finally:
+        base.close()
+        rt.shutdown()
+    err = capfd.readouterr().err
+    assert err.count("irobot_create_msgs is not built (interfaces/build.sh)") == 1, err
