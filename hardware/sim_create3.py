@@ -19,7 +19,7 @@ against a Create 3:
   or ``gdino_sam``) needs none;
 - out ``hazard_detection`` (irobot_create_msgs/HazardDetectionVector, ``hazard_rate_hz``,
   QoS as the robot's: reliable sensor data) where ``interfaces/build.sh`` built that
-  package: BUMP in the bumper zone that touches something (``sim/bumper.py``), STALL of
+  package: BUMP in the bumper zone pressed, driving into something (``sim/bumper.py``), STALL of
   both wheels when commanded to drive for ``STALL_AFTER_S`` without moving, BACKUP_LIMIT
   while a reverse command is refused. Its worlds have no floor edges, so no CLIFF;
 - out ``sim/true_pose`` (geometry_msgs/PoseStamped, frame ``map``: ground truth) and
@@ -270,13 +270,14 @@ class SimCreate3:
         """What the robot's sensors feel now, as one HazardDetectionVector (empty: none)."""
         from pmnav_bt.hardware.hazards import BACKUP_LIMIT_CODE, TYPE_CODES, vector_message
         from pmnav_bt.hazards import HazardKind
-        from pmnav_bt.sim.bumper import bumped_zone
+        from pmnav_bt.sim.bumper import pressed_zone
 
         with self._lock:
             self._physics_locked()
             now = self.clock.now()
             true = self.inner.pose()
-            zone = bumped_zone(self.world, true, self.inner.radius)
+            driving = self._wanted[0] if self._commanded() else 0.0
+            zone = pressed_zone(self.world, true, self.inner.radius, driving)
             stalled = self._stalled(true, now)
             refused = not self.backup.allows(self._wanted[0])
         found = []
