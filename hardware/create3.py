@@ -59,7 +59,12 @@ from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.hardware import qos
 from pmnav_bt.hardware.clock import RosClock
-from pmnav_bt.hardware.hazards import HazardWatch, hazards_from_message, message_types
+from pmnav_bt.hardware.hazards import (
+    FAULT_KINDS,
+    HazardWatch,
+    hazards_from_message,
+    message_types,
+)
 from pmnav_bt.hardware.messages import (
     depth_from_image,
     intrinsics_from_camera_info,
@@ -69,7 +74,7 @@ from pmnav_bt.hardware.messages import (
     shrink_frame,
     stamp_to_sec,
 )
-from pmnav_bt.hazards import Hazard, HazardKind
+from pmnav_bt.hazards import Hazard
 from pmnav_bt.seams import (
     CAMERA_HEIGHT_M,
     CREATE3_MAX_ANGULAR,
@@ -635,7 +640,7 @@ class Create3Base:
         self._step = None
         self._cmd = (0.0, 0.0)
         self._progress = None
-        fault = hazard.kind in (HazardKind.CLIFF, HazardKind.WHEEL_DROP)
+        fault = hazard.kind in FAULT_KINDS
         self._status = MotionStatus.FAULT if fault else MotionStatus.BLOCKED
         self._zero_left = ZERO_BURST
         self._blocked_by = hazard

@@ -50,7 +50,7 @@ STALL_GRACE_S = 0.3  # ... and a stall only stops a motion older than this
 FAULT_HOLD_S = 2.0  # a cliff: long enough for any tick rate to see the FAULT
 SAME_PLACE_M = 0.05  # a hazard felt again this close to the last is the same one
 KEPT = 200  # hazards kept for ``felt`` (the costmap reads them each tick)
-_FAULTS = (HazardKind.CLIFF, HazardKind.WHEEL_DROP)
+FAULT_KINDS = (HazardKind.CLIFF, HazardKind.WHEEL_DROP)  # the body faults: no motion at all
 
 
 def message_types():
@@ -120,7 +120,7 @@ class HazardWatch:
 
     def fault(self, now: float) -> Hazard | None:
         """The cliff or dropped wheel held now (every motion forbidden), or None."""
-        return self._held(_FAULTS, FAULT_HOLD_S, now)
+        return self._held(FAULT_KINDS, FAULT_HOLD_S, now)
 
     def forbids(self, v: float, w: float, now: float, moving_for: float) -> Hazard | None:
         """The hazard that forbids the motion (v m/s, w rad/s) that has been under way for
