@@ -216,3 +216,59 @@ def test_without_the_messages_the_body_feels_nothing_and_says_so(
         rt.shutdown()
     err = capfd.readouterr().err
     assert err.count("irobot_create_msgs is not built (interfaces/build.sh)") == 1, err
+
+
+@needs_messages
+def test_a_cliff_ends_the_controller_s_mission_naming_it(probe, domain_id, tmp_path):
+    """The whole controller: a cliff felt while it drives to a goal stops the robot and the
+    result is BASE_FAULT, its message naming the cliff."""
+    from pmnav_bt.hardware import qos
+    from pmnav_bt.hardware.hazards import TYPE_CODES, vector_message
+    from pmnav_bt.hazards import HazardKind
+
+    sim = Proc(
+        "pmnav_bt.hardware.sim_create3",
+        {"building": BUILDING, "start_pose": "47,20,180", "width": 160, "height": 120},
+        domain_id,
+        tmp_path / "sim.log",
+    )
+    ctl = Proc(
+        "pmnav_bt.hardware.node",
+        {"building": BUILDING, "overrides": "grounder.backend=sim_gt"},
+        domain_id,
+        tmp_path / "controller.log",
+    )
+    procs = (sim, ctl)
+    types = message_types()
+    pub = probe.node.create_publisher(types[0], "hazard_detection", qos.hazards())
+    try:
+        probe.wait_for(
+            lambda: probe.status is not None and probe.status["ready"], READY_S, "ready", procs
+        )
+        t0 = time.monotonic()
+        probe.send_goal("room17")
+        probe.wait_for(
+            lambda: [c for c in probe.cmd if c[0] > t0 and (c[1] or c[2])], 20.0, "motion", procs
+        )
+        stamp = probe.node.get_clock().now().to_msg()
+        cliff = [(TYPE_CODES[HazardKind.CLIFF], "cliff_front_left")]
+        t_cliff = time.time()
+        pub.publish(vector_message(types, cliff, stamp, "base_link"))
+        r = probe.wait_for(
+            lambda: next((r for r in probe.results if r["goal"] == "room17"), None),
+            10.0,
+            "the result",
+            procs,
+        )
+        assert r["code"] == "BASE_FAULT", r
+        assert "cliff front left at (" in r["message"], r
+        time.sleep(0.3)
+        with probe.lock:
+            sent = zip(probe.cmd, probe.cmd_dds, strict=True)
+            late = [src - t_cliff for (_, v, w), (src, _) in sent if src > t_cliff and (v or w)]
+        # stopped as the message arrived (a heartbeat may have gone out meanwhile)
+        assert max(late, default=0.0) < 0.2, late
+        print(f"cliff: {r['message']}; motion commands after it: {late}")
+    finally:
+        for p in procs:
+            p.stop()
