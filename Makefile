@@ -25,7 +25,9 @@ $(VENV)/.installed: pyproject.toml
 # PyPI into the venv (~35 s). Needs cmake and a C++ compiler; without them pmnav-ros runs
 # with its goal topics only and the action tests are skipped.
 $(VENV)/.interfaces: $(VENV)/.installed interfaces/build.sh $(wildcard interfaces/pmnav_interfaces/*.*) $(wildcard interfaces/pmnav_interfaces/action/*)
-	interfaces/build.sh $(VENV) && touch $@ || echo "make: pmnav_interfaces not built (see above); the action is unavailable"
+	interfaces/build.sh $(VENV) && touch $@ || echo "make: interface packages not built (see above); what needs them is unavailable"
+# irobot_create_msgs: the Create 3's hazard messages (without it the body ignores hazards)
+$(VENV)/.interfaces: interfaces/cmake/pypi_wheels.cmake $(wildcard interfaces/irobot_create_msgs/*.* interfaces/irobot_create_msgs/msg/*)
 
 demo: setup
 	mkdir -p $(OUT)

@@ -13,10 +13,13 @@ from py_trees.common import Access, Status
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.control import rotate_command
 from pmnav_bt.failures import Failure, FailureCode, failure_from
+from pmnav_bt.hazards import body_blocked_by
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.worker import Job
 
 NAMESPACE = "/pmnav"
+# Failures of the body's motion: their message names the hazard that stopped it, if any.
+HAZARD_CODES = (FailureCode.BLOCKED, FailureCode.BASE_FAULT)
 
 # Every blackboard key of the tree, under /pmnav.
 KEYS = (
@@ -111,7 +114,13 @@ class PmNavBehaviour(py_trees.behaviour.Behaviour):
 
     def fail_with(self, failure: Failure) -> Status:
         """Record ``failure`` (during a recovery, with what the recovery started from as its
-        ``cause``, so that the root cause survives), and return FAILURE."""
+        ``cause``, so that the root cause survives), and return FAILURE. A BLOCKED or
+        BASE_FAULT failure names the hazard the body felt, where it has hazard sensors
+        ("3 collisions on the way: bumped front left at (1.20, 0.40)")."""
+        hazard = body_blocked_by(self.ctx.base) if failure.code in HAZARD_CODES else None
+        words = hazard.describe() if hazard is not None else None
+        if words is not None and not failure.message.endswith(words):
+            failure = dataclasses.replace(failure, message=f"{failure.message}: {words}")
         root = self.get("recovering_from")
         if root is not None and failure.cause is None and failure != root:
             failure = dataclasses.replace(failure, cause=root)

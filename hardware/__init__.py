@@ -1,7 +1,8 @@
 """pmnav_bt.hardware: PM-Nav on ROS 2 (docs/ros2.md).
 
 - ``create3``: the iRobot Create 3 as a ``Base`` over rclpy (cmd_vel heartbeat, odom,
-  camera, safety stops); ``clock``: ``RosClock``;
+  camera, safety stops); ``hazards``: its ``hazard_detection`` topic (bumps, cliffs,
+  stalls: the messages, and the motions a hazard forbids); ``clock``: ``RosClock``;
 - ``node``: the ``pmnav-ros`` controller node, wiring ``readiness`` (fresh sensors before a
   goal), ``requests`` (goals from any front end, feedback), ``action_server`` (the
   ``navigate_to_room`` action), ``diagnostics`` (/diagnostics), ``params`` (validation,

@@ -12,8 +12,14 @@ Topics (names configurable in ``Create3Options``):
 - a camera (sensor_msgs/Image rgb8/bgr8, and CameraInfo, sensor-data QoS); optional
   depth (32FC1 m or 16UC1 mm) and, from the simulator, a label-id segmentation image
   with its id -> label map (std_msgs/String JSON, latched).
-- optional ``hazard_detection`` (irobot_create_msgs/HazardDetectionVector) when that
-  package can be imported: a bump ends the motion as BLOCKED.
+- ``hazard_detection`` (irobot_create_msgs/HazardDetectionVector, sensor-data QoS) where
+  ``interfaces/build.sh`` built that package (``hardware/hazards.py``): a bump stops a
+  forward motion at once (BLOCKED) and refuses forward motion while the bumper is pressed,
+  a stall stops the motion (BLOCKED), a cliff or a dropped wheel stops every motion (FAULT,
+  which ends the mission). Each hazard is kept as a point in the odometry frame
+  (``hazards()``, for the local costmap), and the one that stopped the latest motion
+  (``blocked_by()``) is named in the tree's failure message ("bumped front left at
+  (1.20, 0.40)").
 
 Safety: velocities are clipped to the Create 3's limits. Reversing is allowed only
 within the robot's backup limit (``backup_limit.BackupBuffer``: with ``safety_override:
@@ -53,6 +59,12 @@ from pmnav_bt.failures import Failure, FailureCode
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.hardware import qos
 from pmnav_bt.hardware.clock import RosClock
+from pmnav_bt.hardware.hazards import (
+    FAULT_KINDS,
+    HazardWatch,
+    hazards_from_message,
+    message_types,
+)
 from pmnav_bt.hardware.messages import (
     depth_from_image,
     intrinsics_from_camera_info,
@@ -62,6 +74,7 @@ from pmnav_bt.hardware.messages import (
     shrink_frame,
     stamp_to_sec,
 )
+from pmnav_bt.hazards import Hazard
 from pmnav_bt.seams import (
     CAMERA_HEIGHT_M,
     CREATE3_MAX_ANGULAR,
@@ -103,7 +116,7 @@ class Create3Options:
     depth_topic: str = ""  # "" = no depth
     segmentation_topic: str = ""  # "" = none (the simulator publishes one)
     labels_topic: str = ""  # the segmentation's id -> label JSON (latched)
-    hazard_topic: str = "hazard_detection"  # used only if irobot_create_msgs imports
+    hazard_topic: str = "hazard_detection"  # "" = none; used where irobot_create_msgs is built
     cmd_rate_hz: float = 20.0
     odom_timeout: float = 0.3  # hold the robot stopped when odometry is older than this
     odom_fault_s: float = 1.0  # ... and report FAULT (the mission fails) after this long
@@ -147,15 +160,6 @@ def _interpolate(a: tuple[float, Pose2D], b: tuple[float, Pose2D], t: float) -> 
     return Pose2D(pa.x + f * (pb.x - pa.x), pa.y + f * (pb.y - pa.y), wrap_angle(yaw))
 
 
-def _hazard_type():
-    """irobot_create_msgs/HazardDetectionVector, or None (the package is optional)."""
-    try:
-        from irobot_create_msgs.msg import HazardDetectionVector
-    except ImportError:
-        return None
-    return HazardDetectionVector
-
-
 class Create3Base:
     """A ``Base`` for the Create 3 on an rclpy ``node`` that some executor spins.
 
@@ -189,6 +193,9 @@ class Create3Base:
         self._status = MotionStatus.IDLE
         self._zero_left = 0
         self._progress: tuple[Pose2D, float] | None = None
+        self._hazards = HazardWatch()
+        self._blocked_by: Hazard | None = None  # what stopped or refused the latest motion
+        self._motion_since = 0.0  # monotonic: when the motion in force began
         self.backup = BackupBuffer()  # how far the robot may still reverse
         self._stale: str | None = "odometry"
         self._stale_since: float | None = None
@@ -231,13 +238,18 @@ class Create3Base:
                     String, opt.labels_topic, self._on_labels, qos.latched(), callback_group=group
                 )
             )
-        hazards = _hazard_type() if opt.hazard_topic else None
-        self.hazards_enabled = hazards is not None
-        if hazards is not None:
+        types = message_types() if opt.hazard_topic else None
+        self.hazards_enabled = types is not None
+        if types is not None:
             self._subs.append(
                 node.create_subscription(
-                    hazards, opt.hazard_topic, self._on_hazards, sensor, callback_group=group
+                    types[0], opt.hazard_topic, self._on_hazards, sensor, callback_group=group
                 )
+            )
+        elif opt.hazard_topic:
+            node.get_logger().warn(
+                "irobot_create_msgs is not built (interfaces/build.sh): no bumps, cliffs or "
+                f"wheel stalls from {self._topic(opt.hazard_topic)}"
             )
         self._thread = threading.Thread(target=self._heartbeat, name="create3-cmd-vel", daemon=True)
         self._thread.start()
@@ -328,13 +340,20 @@ class Create3Base:
         if action == DiscreteAction.STOP:
             self.stop()
             return
+        forward = action == DiscreteAction.FORWARD
         with self._lock:
+            now = time.monotonic()
+            was_moving = self._cmd != (0.0, 0.0) or self._step is not None
+            if self._refuse(1.0 if forward else 0.0, 0.0 if forward else 1.0, now):
+                self._stop_now(was_moving)
+                return
             start = self.pose()
-            goal = FORWARD_STEP_M if action == DiscreteAction.FORWARD else TURN_STEP_RAD
-            self._step = _Step(action, start, goal, time.monotonic())
+            goal = FORWARD_STEP_M if forward else TURN_STEP_RAD
+            self._step = _Step(action, start, goal, now)
             self._cmd = (0.0, 0.0)
             self._progress = None
             self._status = MotionStatus.MOVING
+            self._motion_since = now
         self._wake.set()
 
     def set_velocity(self, linear: float, angular: float) -> None:
@@ -346,13 +365,19 @@ class Create3Base:
         if not (math.isfinite(v) and math.isfinite(w)):
             v = w = 0.0
         with self._lock:
+            now = time.monotonic()
             was_moving = self._cmd != (0.0, 0.0) or self._step is not None
+            if self._refuse(v, w, now):
+                self._stop_now(was_moving)
+                return
             self._step = None
             if (v, w) != self._cmd:
                 self._progress = None
             self._cmd = (v, w)
             moving = (v, w) != (0.0, 0.0)
             self._status = MotionStatus.MOVING if moving else MotionStatus.IDLE
+            if moving and not was_moving:
+                self._motion_since = now
             if not moving and was_moving:
                 self._zero_left = ZERO_BURST
         if moving != was_moving:
@@ -360,9 +385,12 @@ class Create3Base:
 
     def motion_status(self) -> MotionStatus:
         """FAULT once odometry has been missing for ``odom_fault_s`` (the robot is held
-        stopped from ``odom_timeout`` on); else the state of the last command."""
+        stopped from ``odom_timeout`` on) or while a cliff or a dropped wheel is felt;
+        else the state of the last command."""
         with self._lock:
             if self._odom_stale(self.options.odom_fault_s):
+                return MotionStatus.FAULT
+            if self._hazards.fault(time.monotonic()) is not None:
                 return MotionStatus.FAULT
             return self._status
 
@@ -377,6 +405,19 @@ class Create3Base:
         self._publish(0.0, 0.0)
 
     # -- beyond the seam ------------------------------------------------------------------
+
+    def hazards(self, since: float = -math.inf) -> list[Hazard]:
+        """The bumps, cliffs and wheel stalls felt with a stamp (ROS time, the tree's clock)
+        from ``since`` on, oldest first, each a point in the odometry frame
+        (``pmnav_bt.hazards``): for the local costmap to mark."""
+        with self._lock:
+            return self._hazards.felt(since)
+
+    def blocked_by(self) -> Hazard | None:
+        """The hazard that stopped or refused the latest motion command (a cliff felt
+        now even without one); None once a motion was accepted after it."""
+        with self._lock:
+            return self._hazards.fault(time.monotonic()) or self._blocked_by
 
     def fault(self) -> Failure | None:
         """Why the body cannot go on (stale odometry, a silent camera), or None."""
@@ -482,11 +523,17 @@ class Create3Base:
             self._frames.notify_all()
 
     def _on_hazards(self, msg) -> None:
-        bumps = [d for d in msg.detections if int(d.type) in (1, 2)]  # BUMP, CLIFF
-        if bumps:
-            with self._lock:
-                if self._cmd != (0.0, 0.0) or self._step is not None:
-                    self._block("hazard")
+        """Keep what the robot felt; stop at once a motion that a hazard forbids."""
+        if not msg.detections:
+            return
+        now = time.monotonic()
+        with self._lock:
+            for hazard in hazards_from_message(msg, self._pose_at, stamp_to_sec):
+                self._hazards.feel(hazard, now)
+            stopped = self._stop_if_forbidden(now)
+        if stopped is not None:
+            self._stop_now(True)
+            self.node.get_logger().warn(f"stopped: {stopped.describe()}")
 
     def _store(self, buf: deque, msg) -> None:
         item = _Stamped(stamp_to_sec(msg.header.stamp), time.monotonic(), msg)
@@ -553,6 +600,50 @@ class Create3Base:
             if hist[i - 1][0] <= t:
                 return _interpolate(hist[i - 1], hist[i], t)
         return hist[-1][1]
+
+    def _motion(self) -> tuple[float, float]:
+        """The motion in force as (v, w): a step's direction, else the command."""
+        s = self._step
+        if s is None:
+            return self._cmd
+        if s.action == DiscreteAction.FORWARD:
+            return 1.0, 0.0
+        return 0.0, 1.0 if s.action == DiscreteAction.TURN_LEFT else -1.0
+
+    def _refuse(self, v: float, w: float, now: float) -> bool:
+        """Whether a hazard forbids a new motion (v, w): then the body stops, BLOCKED or
+        FAULT. An allowed motion clears what blocked the last one."""
+        hazard = self._hazards.forbids(v, w, now, 0.0)
+        if hazard is None:
+            if (v, w) != (0.0, 0.0):
+                self._blocked_by = None
+            return False
+        self._halt(hazard)
+        return True
+
+    def _stop_now(self, was_moving: bool) -> None:
+        """A zero command at once (not at the heartbeat's next beat) if the body moved."""
+        if was_moving:
+            self._publish(0.0, 0.0)
+            self._wake.set()
+
+    def _stop_if_forbidden(self, now: float) -> Hazard | None:
+        """Stop the motion in force if a hazard forbids it; that hazard, or None."""
+        v, w = self._motion()
+        hazard = self._hazards.forbids(v, w, now, now - self._motion_since)
+        if hazard is not None:
+            self._halt(hazard)
+        return hazard
+
+    def _halt(self, hazard: Hazard) -> None:
+        """Stop for ``hazard``: FAULT for a cliff or a dropped wheel, else BLOCKED."""
+        self._step = None
+        self._cmd = (0.0, 0.0)
+        self._progress = None
+        fault = hazard.kind in FAULT_KINDS
+        self._status = MotionStatus.FAULT if fault else MotionStatus.BLOCKED
+        self._zero_left = ZERO_BURST
+        self._blocked_by = hazard
 
     def _block(self, why: str) -> None:
         self._step = None

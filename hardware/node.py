@@ -80,7 +80,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "depth_topic": ("camera/depth/image_raw", "32FC1 m or 16UC1 mm; empty: none"),
     "segmentation_topic": ("camera/segmentation", "simulator labels; empty: none"),
     "labels_topic": ("camera/segmentation_labels", "the segmentation's id -> label JSON"),
-    "hazard_topic": ("hazard_detection", "used only if irobot_create_msgs imports"),
+    "hazard_topic": ("hazard_detection", "bumps, cliffs, stalls; needs irobot_create_msgs"),
     "cmd_rate_hz": (20.0, "cmd_vel republish rate while moving"),
     "odom_timeout": (0.3, "hold the robot stopped when odometry is older than this (s)"),
     "odom_fault_s": (1.0, "fail the mission (SENSOR_TIMEOUT) after this long without odometry"),

@@ -3,6 +3,10 @@
 - ``sensor()``: best effort, keep last 5, volatile (rclpy's ``qos_profile_sensor_data``).
   A best-effort subscriber matches both best-effort and reliable publishers, so it is
   the right choice for odometry and cameras whatever the driver publishes with.
+- ``hazards()``: what the Create 3 publishes ``hazard_detection`` with: sensor data (keep
+  last 5, volatile) but reliable (iRobot's ``hazards_vector_publisher``:
+  ``SensorDataQoS().reliable()``). The body subscribes with ``sensor()``, which matches
+  it and a best-effort publisher alike; the simulated Create 3 publishes with this.
 - ``command()``: reliable, keep last 1: ``cmd_vel``. A reliable publisher matches the
   Create 3's subscriber (reliable) as well as best-effort ones; only the newest
   command matters.
@@ -26,6 +30,10 @@ def _qos():
 
 def sensor():
     return _qos().qos_profile_sensor_data
+
+
+def hazards():
+    return _reliable(depth=5, transient_local=False)
 
 
 def command():

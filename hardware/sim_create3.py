@@ -17,6 +17,11 @@ against a Create 3:
   (std_msgs/String JSON id -> label, latched). With ``publish_segmentation`` false no
   segmentation is rendered or published: the real stack (``grounder.backend`` ``ocr``
   or ``gdino_sam``) needs none;
+- out ``hazard_detection`` (irobot_create_msgs/HazardDetectionVector, ``hazard_rate_hz``,
+  QoS as the robot's: reliable sensor data) where ``interfaces/build.sh`` built that
+  package: BUMP in the bumper zone pressed, driving into something (``sim/bumper.py``), STALL of
+  both wheels when commanded to drive for ``STALL_AFTER_S`` without moving, BACKUP_LIMIT
+  while a reverse command is refused. Its worlds have no floor edges, so no CLIFF;
 - out ``sim/true_pose`` (geometry_msgs/PoseStamped, frame ``map``: ground truth) and
   ``sim/stats`` (std_msgs/String JSON: collisions, path length, rotation).
 
@@ -37,6 +42,12 @@ from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.seams import CAMERA_HEIGHT_M, Pose2D
 
+# A wheel stall: commanded to drive at least STALL_SPEED for STALL_AFTER_S without
+# getting STALL_MOVE_M further (the robot feels it in its motor currents).
+STALL_SPEED = 0.05  # m/s
+STALL_AFTER_S = 0.5
+STALL_MOVE_M = 0.01
+
 PARAMETERS = {
     "building": ("fig2_hospital", "building file (YAML) or built-in name"),
     "start_pose": ("", "x,y,yaw_deg in the map frame; empty: the building's start"),
@@ -47,6 +58,7 @@ PARAMETERS = {
     "camera_rate_hz": (5.0, "frames per second (rendering costs ~25 ms at 320x240)"),
     "odom_rate_hz": (20.0, ""),
     "physics_rate_hz": (50.0, "how often sim time catches up with the wall clock"),
+    "hazard_rate_hz": (20.0, "hazard_detection messages a second (the robot: about 60)"),
     "cmd_timeout": (0.5, "stop this long after the last cmd_vel (s)"),
     "odometry_noise": (0.02, "relative error of each odometry increment"),
     "seed": (0, "odometry noise seed"),
@@ -75,6 +87,7 @@ class SimCreate3:
         from std_msgs.msg import String
 
         from pmnav_bt.hardware import qos
+        from pmnav_bt.hardware.hazards import message_types
         from pmnav_bt.hardware.node import declare_parameters
         from pmnav_bt.sim.clock import SimClock
         from pmnav_bt.sim.odometry import NoisyOdometry
@@ -116,6 +129,8 @@ class SimCreate3:
         self._lock = threading.Lock()
         self._last_wall = time.monotonic()
         self._last_cmd: float | None = None
+        self._wanted = (0.0, 0.0)  # the last cmd_vel, before the backup limit refused it
+        self._stall_ref: tuple[Pose2D, float] | None = None  # progress of a drive
         self._last_odom: tuple[float, Pose2D] | None = None
         self._labels_sent = -1
         self.frames = 0
@@ -138,6 +153,17 @@ class SimCreate3:
         node.create_timer(1.0 / float(p["odom_rate_hz"]), self._odom, callback_group=motion)
         node.create_timer(1.0 / float(p["camera_rate_hz"]), self._camera, callback_group=camera)
         node.create_timer(1.0, self._stats, callback_group=motion)
+        self._hazard_types = message_types()
+        if self._hazard_types is None:
+            self.log.warn(
+                "irobot_create_msgs is not built (interfaces/build.sh): no hazard_detection"
+            )
+        else:
+            self.pub_hazards = node.create_publisher(
+                self._hazard_types[0], "hazard_detection", qos.hazards()
+            )
+            rate = float(p["hazard_rate_hz"])
+            node.create_timer(1.0 / rate, self._hazards, callback_group=motion)
         self._publish_labels()
         self.log.info(
             f"simulated Create 3 in {self.world.building.name} at "
@@ -152,6 +178,7 @@ class SimCreate3:
             self._physics_locked()
             self._last_cmd = time.monotonic()
             v, w = float(msg.linear.x), float(msg.angular.z)
+            self._wanted = (v, w)
             if not self.backup.allows(v):
                 v = w = 0.0  # the robot refuses to reverse beyond its backup limit
             self.inner.set_velocity(v, w)
@@ -238,6 +265,48 @@ class SimCreate3:
                 self.pub_seg.publish(image_message(seg.astype("<i4"), "32SC1", stamp, frame))
         self.frames += 1
         self._publish_labels()
+
+    def _hazards(self) -> None:
+        """What the robot's sensors feel now, as one HazardDetectionVector (empty: none)."""
+        from pmnav_bt.hardware.hazards import BACKUP_LIMIT_CODE, TYPE_CODES, vector_message
+        from pmnav_bt.hazards import HazardKind
+        from pmnav_bt.sim.bumper import pressed_zone
+
+        with self._lock:
+            self._physics_locked()
+            now = self.clock.now()
+            true = self.inner.pose()
+            driving = self._wanted[0] if self._commanded() else 0.0
+            zone = pressed_zone(self.world, true, self.inner.radius, driving)
+            stalled = self._stalled(true, now)
+            refused = not self.backup.allows(self._wanted[0])
+        found = []
+        if zone is not None:
+            found.append((TYPE_CODES[HazardKind.BUMP], zone))
+        if stalled:
+            code = TYPE_CODES[HazardKind.STALL]
+            found += [(code, "left_wheel"), (code, "right_wheel")]
+        if refused and self._commanded():
+            found.append((BACKUP_LIMIT_CODE, self.p["base_frame"]))
+        msg = vector_message(self._hazard_types, found, self._stamp(), self.p["base_frame"])
+        self.pub_hazards.publish(msg)
+
+    def _commanded(self) -> bool:
+        """Whether a cmd_vel is in force (the robot's own timeout has not stopped it)."""
+        t = self._last_cmd
+        return t is not None and time.monotonic() - t <= float(self.p["cmd_timeout"])
+
+    def _stalled(self, true: Pose2D, now: float) -> bool:
+        """Whether the wheels have been driven STALL_AFTER_S without moving the body."""
+        v = self._wanted[0]
+        if not self._commanded() or abs(v) < STALL_SPEED or not self.backup.allows(v):
+            self._stall_ref = None
+            return False
+        ref = self._stall_ref
+        if ref is None or math.dist((true.x, true.y), (ref[0].x, ref[0].y)) > STALL_MOVE_M:
+            self._stall_ref = (true, now)
+            return False
+        return now - ref[1] >= STALL_AFTER_S
 
     def _publish_labels(self) -> None:
         labels = dict(self.world.labels)

@@ -17,7 +17,8 @@ says.
 ``CalibratedBase`` wraps a ``Base`` and reports odometry re-integrated with every yaw
 increment multiplied by ``gain`` and every distance by ``distance_gain`` (1.0 until
 ``calibrate`` and its own straight-drive tracks learn them; until then it passes the
-poses through unchanged).
+poses through unchanged). What the body felt (``pmnav_bt.hazards``: bumps, cliffs) is put in
+the calibrated frame too.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from dataclasses import replace
 import numpy as np
 
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
+from pmnav_bt.hazards import Hazard, body_blocked_by, body_hazards
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.seams import Base, Observation, Pose2D
 from pmnav_bt.wrapped_base import WrappedBase
@@ -179,6 +181,21 @@ class CalibratedBase(WrappedBase):
     def pose(self) -> Pose2D:
         with self._lock:
             return self._update(self.inner.pose())
+
+    def hazards(self, since: float = -math.inf) -> list[Hazard]:
+        """The hazards the wrapped body felt since ``since``, in this odometry frame ([]
+        for a body without hazard sensors). Mapped with the correction of now: the body
+        stops at a hazard, so it is read where it was felt."""
+        felt = body_hazards(self.inner, since)
+        if not felt:
+            return felt
+        corr_T_raw = self.corr_T_raw()
+        return [h.moved(corr_T_raw) for h in felt]
+
+    def blocked_by(self) -> Hazard | None:
+        """The hazard that stopped the wrapped body's latest motion, in this frame."""
+        hazard = body_blocked_by(self.inner)
+        return None if hazard is None else hazard.moved(self.corr_T_raw())
 
     @property
     def distance_measured(self) -> bool:

@@ -1,0 +1,16 @@
+# Included by each interface package here after its rosidl_generate_interfaces().
+#
+# The ROS 2 wheels on PyPI export their Python targets with the include folder of the
+# machine that built them (/opt/python/...); use this interpreter's instead.
+get_directory_property(_imported IMPORTED_TARGETS)
+foreach(_target IN LISTS _imported)
+  if(_target MATCHES "__rosidl_generator_py$")
+    get_target_property(_inc ${_target} INTERFACE_INCLUDE_DIRECTORIES)
+    if(_inc)
+      list(FILTER _inc EXCLUDE REGEX "^/opt/python/")
+      list(APPEND _inc ${Python3_INCLUDE_DIRS})
+      list(REMOVE_DUPLICATES _inc)
+      set_target_properties(${_target} PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_inc}")
+    endif()
+  endif()
+endforeach()
