@@ -118,7 +118,7 @@ def shortest_route(
     seg = sp.segment
     a_xy, b_xy = pm.node_xy(seg.a), pm.node_xy(seg.b)
     start_xy = a_xy + sp.t * (b_xy - a_xy)
-    shut = _shut_ends(pm, sp, blocked_at)
+    shut = shut_ends(pm, sp, blocked_at)
     best: tuple[float, list[str]] | None = None
     for end, lead in ((seg.a, sp.t * seg.length), (seg.b, (1.0 - sp.t) * seg.length)):
         if end in shut:
@@ -142,7 +142,7 @@ def shortest_route(
     return nodes, length, start_xy
 
 
-def _shut_ends(
+def shut_ends(
     pm: PrioriMap, sp: StartPoint, blocked_at: frozenset[tuple[float, float]]
 ) -> set[str]:
     """The ends of the start's segment that a point of ``blocked_at`` on it (within half

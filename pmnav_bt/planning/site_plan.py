@@ -20,15 +20,18 @@ from __future__ import annotations
 
 import heapq
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from itertools import count
 
 import networkx as nx
 
 from pmnav_bt.errors import PlanningError
-from pmnav_bt.geometry import heading
+from pmnav_bt.geometry import heading, wrap_angle
+from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.map.site import Site
 from pmnav_bt.map.site_map import SiteMap
-from pmnav_bt.planning.graph_planner import GraphPlanner, graph_segment, shortest_route
+from pmnav_bt.planning.graph_planner import GraphPlanner, build_plan, shut_ends
 from pmnav_bt.planning.plan import MAX_GAP_M, Plan
 from pmnav_bt.planning.resolve import StartPoint, resolve_site_room, resolve_start
 from pmnav_bt.seams import CREATE3_MAX_LINEAR, PlanConstraints
@@ -148,6 +151,10 @@ class SitePlanner:
     ride_call_m: float = LIFT_CALL_M
     ride_level_m: float = LIFT_LEVEL_M
 
+    def ride_cost(self, site: Site, a: str, b: str) -> float:
+        """A ride's cost in corridor metres, from level ``a`` to level ``b``."""
+        return self.ride_call_m + self.ride_level_m * abs(site.rank(b) - site.rank(a))
+
     def plan(
         self,
         sm: SiteMap,
@@ -172,7 +179,8 @@ class SitePlanner:
             return SitePlan(
                 site.name, (Leg(level, plan),), (), level, goal_id, goal_name, plan.length
             )
-        route, cost = self._lobby_route(sm, level, sp, goal_level, goal_id, constraints)
+        search = _LobbySearch(self, sm, level, sp, goal_level, goal_id, constraints)
+        route, cost = search.route()
         legs: list[Leg] = []
         rides: list[LiftRide] = []
         here, at, prev = level, sp, None
@@ -180,63 +188,96 @@ class SitePlanner:
             if prev is not None and prev[1] == lift and prev[0] != lv:  # a ride
                 rides.append(LiftRide(lift, prev[0], lv))
                 here, at = lv, _out_of_lift(sm, lift, lv)
-            else:  # a walk on this level to the lift's lobby
+            elif prev is None:  # the first walk: its route is the search's
+                legs.append(Leg(lv, search.first_leg(lift, self.max_gap)))
+            else:  # a change of lifts on a level between
                 lobby = site.lift(lift).lobbies[lv]
-                cons = constraints if lv == level else PlanConstraints()
-                plan = legs_planner.plan_to_landmark(sm.maps[lv], at, lobby, cons)
-                legs.append(Leg(lv, plan))
+                legs.append(Leg(lv, legs_planner.plan_to_landmark(sm.maps[lv], at, lobby)))
             prev = (lv, lift)
-        legs.append(Leg(here, legs_planner.plan(goal_pm, at, goal_id)))
+        legs.append(Leg(here, search.last_leg(prev[1], at, self.max_gap)))
         return SitePlan(site.name, tuple(legs), tuple(rides), goal_level, goal_id, goal_name, cost)
 
-    def _lobby_route(
-        self,
-        sm: SiteMap,
-        level: str,
-        sp: StartPoint,
-        goal_level: str,
-        goal_id: str,
-        constraints: PlanConstraints,
-    ) -> tuple[list[tuple[str, str]], float]:
-        """The cheapest way from the start to the goal over the lifts' lobbies: the nodes
-        (level, lift) it passes, the start and goal dropped, and its cost."""
-        site = sm.site
+
+class _LobbySearch:
+    """The cheapest way from a start to a goal room on another level, over the lifts'
+    lobbies: a small graph whose nodes are the start, each (level, lift) lobby and the
+    goal. Its edges: the corridor metres from the start to each lobby of its level (one
+    search from the start, stopped when every lobby there is reached), a ride's cost
+    between two lobbies of one lift, the metres between two lifts' lobbies on a level
+    (cached on the site map), and the metres from each lobby of the goal's level to the
+    goal (one search from the goal). The first and last legs' routes come from the two
+    searches, so each costs one corridor search."""
+
+    def __init__(self, planner, sm, level, sp, goal_level, goal_id, constraints):
+        self.planner, self.sm, self.level, self.sp = planner, sm, level, sp
+        self.goal_level, self.goal_id, self.constraints = goal_level, goal_id, constraints
         pm = sm.maps[level]
-        graph = pm.graph
-        if constraints.blocked_segments:
-            graph = nx.subgraph_view(
-                pm.graph,
-                filter_edge=lambda u, v: graph_segment(pm, u, v)
-                not in constraints.blocked_segments,
-            )
-        goal_node = sm.maps[goal_level].places[goal_id].node
+        seg = sp.segment
+        a_xy, b_xy = pm.node_xy(seg.a), pm.node_xy(seg.b)
+        self.start_xy = a_xy + sp.t * (b_xy - a_xy)
+        shut = shut_ends(pm, sp, constraints.blocked_at)
+        sources = {}
+        for end, lead in ((seg.a, sp.t * seg.length), (seg.b, (1.0 - sp.t) * seg.length)):
+            if end in shut:
+                continue
+            tie = 0.0  # on a tie, the way the robot already faces (as shortest_route)
+            if sp.heading is not None:
+                toward = heading(self.start_xy, pm.node_xy(end)) if lead > 1e-9 else sp.heading
+                tie = abs(wrap_angle(toward - sp.heading)) * 1e-9
+            sources[end] = (lead + tie, lead)
+        site = sm.site
+        goal_pm = sm.maps[goal_level]
+        self.goal_node = goal_pm.places[goal_id].node
+        lobbies = {sm.lobby_nodes[(lift.id, goal_level)] for lift in site.lifts_at(goal_level)}
+        self.to_goal = _settle(goal_pm, {self.goal_node: (0.0, 0.0)}, lobbies)
+        # The start's search stops once no lobby it has not reached can lead to a cheaper
+        # route than one it knows: past such a lobby a route still rides (a call at
+        # least) and walks from a lobby of the goal's level (the nearest at least).
+        to_goal = {
+            lift.id: self.to_goal.dist.get(sm.lobby_nodes[(lift.id, goal_level)])
+            for lift in site.lifts_at(goal_level)
+        }
+        least_after = planner.ride_call_m + min(
+            (d for d in to_goal.values() if d is not None), default=0.0
+        )
+        ride = planner.ride_cost(site, level, goal_level)
+        by_node: dict[str, list[str]] = {}
+        for lift in site.lifts_at(level):
+            by_node.setdefault(sm.lobby_nodes[(lift.id, level)], []).append(lift.id)
+        known = [INF]
 
-        def neighbours(node: tuple[str, str]):
-            if node == _START:
-                for lift in site.lifts_at(level):
-                    try:
-                        _, d, _ = shortest_route(
-                            pm, sp, sm.lobby_nodes[(lift.id, level)], graph, constraints.blocked_at
-                        )
-                    except PlanningError:
-                        continue
-                    yield (level, lift.id), d
-                return
-            lv, lift_id = node
-            for other in site.lift(lift_id).lobbies:
-                if other != lv:
-                    levels = abs(site.rank(other) - site.rank(lv))
-                    yield (other, lift_id), self.ride_call_m + self.ride_level_m * levels
-            if lv == goal_level:
-                d = _node_distance(sm, lv, sm.lobby_nodes[(lift_id, lv)], goal_node)
+        def cutoff(node: str, cost: float) -> float:
+            for lift in by_node[node]:
+                if to_goal.get(lift) is not None:
+                    known[0] = min(known[0], cost + ride + to_goal[lift])
+            return known[0] - least_after
+
+        self.from_start = _settle(pm, sources, set(by_node), constraints.blocked_segments, cutoff)
+
+    def _neighbours(self, node: tuple[str, str]):
+        sm, site, level = self.sm, self.sm.site, self.level
+        if node == _START:
+            for lift in site.lifts_at(level):
+                d = self.from_start.dist.get(sm.lobby_nodes[(lift.id, level)])
                 if d is not None:
-                    yield _GOAL, d
-            for other in site.lifts_at(lv):
-                if other.id != lift_id:
-                    d = _lobby_distance(sm, lv, lift_id, other.id)
-                    if d is not None:
-                        yield (lv, other.id), d
+                    yield (level, lift.id), d
+            return
+        lv, lift_id = node
+        for other in site.lift(lift_id).lobbies:
+            if other != lv:
+                yield (other, lift_id), self.planner.ride_cost(site, lv, other)
+        if lv == self.goal_level:
+            d = self.to_goal.dist.get(sm.lobby_nodes[(lift_id, lv)])
+            if d is not None:
+                yield _GOAL, d
+        for other in site.lifts_at(lv):
+            if other.id != lift_id:
+                d = _lobby_distance(sm, lv, lift_id, other.id)
+                if d is not None:
+                    yield (lv, other.id), d
 
+    def route(self) -> tuple[list[tuple[str, str]], float]:
+        """The (level, lift) lobbies passed, in order, and the total cost."""
         best = {_START: 0.0}
         came: dict[tuple[str, str], tuple[str, str]] = {}
         tie = count()
@@ -252,21 +293,120 @@ class SitePlanner:
                 while route[-1] != _START:
                     route.append(came[route[-1]])
                 return route[-2:0:-1], cost
-            for nxt, step in neighbours(node):
+            for nxt, step in self._neighbours(node):
                 c = cost + step
                 if c < best.get(nxt, float("inf")):
                     best[nxt] = c
                     came[nxt] = node
                     heapq.heappush(heap, (c, next(tie), nxt))
+        site, level = self.sm.site, self.level
         served = ", ".join(lift.id for lift in site.lifts_at(level))
         why = (
             f"no lift leaves {level}"
             if not served
-            else f"no lift ({served}) reached from there leads to {goal_level}"
+            else f"no lift ({served}) reached from there leads to {self.goal_level}"
         )
         raise PlanningError(
-            f"{goal_id} on {goal_level} cannot be reached from {sp.description} on {level}: {why}"
+            f"{self.goal_id} on {self.goal_level} cannot be reached from "
+            f"{self.sp.description} on {level}: {why}"
         )
+
+    def first_leg(self, lift: str, max_gap: float) -> Plan:
+        """The walk from the start to ``lift``'s lobby on the start level."""
+        sm, level = self.sm, self.level
+        node = sm.lobby_nodes[(lift, level)]
+        nodes = self.from_start.path(node)[::-1]
+        length = self.from_start.length[node]
+        lobby = sm.site.lift(lift).lobbies[level]
+        return build_plan(
+            sm.maps[level], self.sp, lobby, nodes, length, self.start_xy, max_gap, "graph",
+            self.constraints.avoid_landmarks,
+        )
+
+    def last_leg(self, lift: str, at: StartPoint, max_gap: float) -> Plan:
+        """The walk out of ``lift`` on the goal level to the goal room."""
+        sm, level = self.sm, self.goal_level
+        pm = sm.maps[level]
+        node = sm.lobby_nodes[(lift, level)]
+        nodes = self.to_goal.path(node)
+        seg = at.segment
+        a_xy, b_xy = pm.node_xy(seg.a), pm.node_xy(seg.b)
+        start_xy = a_xy + at.t * (b_xy - a_xy)
+        length = self.to_goal.length[node]
+        return build_plan(pm, at, self.goal_id, nodes, length, start_xy, max_gap, "graph")
+
+
+@dataclass
+class _Settled:
+    """A corridor search's result: cost (``dist``), metres (``length``) and the node each
+    node was reached from (``pred``; None at a source)."""
+
+    dist: dict[str, float]
+    length: dict[str, float]
+    pred: dict[str, str | None]
+
+    def path(self, node: str) -> list[str]:
+        """The nodes from ``node`` back to the source it was reached from."""
+        out = [node]
+        while self.pred[out[-1]] is not None:
+            out.append(self.pred[out[-1]])
+        return out
+
+
+def _settle(
+    pm: PrioriMap,
+    sources: dict[str, tuple[float, float]],
+    targets: set[str],
+    blocked: frozenset[int] = frozenset(),
+    cutoff: Callable[[str, float], float] | None = None,
+) -> _Settled:
+    """Dijkstra on a level's map from several sources, each with a starting (cost,
+    metres), over corridor lengths, never over a segment of ``blocked``; stops when every
+    target is settled, or past the cost ``cutoff`` returns when a target is settled."""
+    heap = [(c, n) for n, (c, _) in sources.items()]
+    heapq.heapify(heap)
+    best = {n: c for n, (c, _) in sources.items()}
+    metres = {n: m for n, (_, m) in sources.items()}
+    pred: dict[str, str | None] = dict.fromkeys(sources)
+    dist: dict[str, float] = {}
+    left = set(targets)
+    adj = _adjacency(pm)
+    beyond = INF
+    while heap and left:
+        c, n = heapq.heappop(heap)
+        if c > beyond:
+            break
+        if n in dist:
+            continue
+        dist[n] = c
+        if n in left:
+            left.discard(n)
+            if cutoff is not None:
+                beyond = cutoff(n, c)
+        for m, length, segment in adj[n]:
+            nc = c + length
+            if nc < best.get(m, INF) and m not in dist and segment not in blocked:
+                best[m] = nc
+                metres[m] = metres[n] + length
+                pred[m] = n
+                heapq.heappush(heap, (nc, m))
+    return _Settled(dist, metres, pred)
+
+
+INF = float("inf")
+
+
+def _adjacency(pm: PrioriMap) -> dict[str, list[tuple[str, float, int]]]:
+    """Each node's (neighbour, metres, segment index), as plain lists (cached on the map):
+    a search over these is several times quicker than over the graph's views."""
+    cached = pm.__dict__.get("_site_adjacency")
+    if cached is None:
+        cached = {
+            n: [(m, e["length"], e["segment"]) for m, e in nbrs.items()]
+            for n, nbrs in pm.graph.adj.items()
+        }
+        pm.__dict__["_site_adjacency"] = cached
+    return cached
 
 
 def _node_distance(sm: SiteMap, level: str, a: str, b: str) -> float | None:
