@@ -42,15 +42,8 @@ class SiteMap:
             for level, lobby in lift.lobbies.items()
         }
 
-    def link_line(self, link: LiftLink, level: str | None = None) -> str:
-        """One lift (or stairs) for the text: its lobby on each level, where it is seen.
-        With ``level``, the lobby on that level first and the levels it goes to."""
-        if level is not None:
-            others = [lv for lv in link.lobbies if lv != level]
-            return (
-                f"- {link.id} \"{link.display_name}\": lobby {link.lobbies[level]}; goes to "
-                f"{', '.join(others)}"
-            )
+    def link_line(self, link: LiftLink) -> str:
+        """One lift (or stairs) for the text: its lobby on each level, where it is seen."""
         parts = []
         for lv, lobby in link.lobbies.items():
             pm = self.maps[lv]
@@ -62,26 +55,19 @@ class SiteMap:
             )
         return f"- {link.id} \"{link.display_name}\": " + "; ".join(parts)
 
-    def links_text(self, level: str | None = None) -> str:
-        """The lifts and stairs section (of every level, or of one level's lobbies)."""
+    def links_text(self) -> str:
+        """The lifts and stairs section: each one's lobby on each level."""
         site = self.site
-        lifts = site.lifts if level is None else site.lifts_at(level)
-        stairs = [s for s in site.stairs if level is None or level in s.lobbies]
         lines = ["## Lifts (id \"name\": the lobby landmark on each level)"]
-        lines += [self.link_line(lift, level) for lift in lifts] or ["- (none)"]
-        if stairs:
+        lines += [self.link_line(lift) for lift in site.lifts] or ["- (none)"]
+        if site.stairs:
             lines += ["", "## Stairs (never taken: the robot cannot climb them)"]
-            lines += [self.link_line(s, level) for s in stairs]
+            lines += [self.link_line(s) for s in site.stairs]
         return "\n".join(lines)
 
-    def to_text(self, level: str | None = None) -> str:
-        """The structured text a planner or VLM reads: the levels and lifts, then each
-        level's priori-map (only ``level``'s with a level named). One level: the
-        building's text."""
-        if self.single:
-            return next(iter(self.maps.values())).to_text()
+    def overview_text(self) -> str:
+        """The site's levels (lowest first) and the lifts and stairs that join them."""
         site = self.site
-        names = [site.level(level).name] if level is not None else list(site.level_names)
         lines = [f"# Site {site.name}: {len(site.levels)} levels joined by lifts"]
         if site.description:
             lines.append(site.description)
@@ -93,7 +79,18 @@ class SiteMap:
                 f"- {lv.name}: elevation {lv.elevation:.1f} m, {b.name}, {len(b.rooms)} rooms; "
                 f"lifts {lifts}"
             )
-        lines += ["", self.links_text(), ""]
+        lines += ["", self.links_text()]
+        return "\n".join(lines) + "\n"
+
+    def to_text(self, level: str | None = None) -> str:
+        """The structured text a planner or VLM reads: the levels and lifts, then each
+        level's priori-map (only ``level``'s with a level named). One level: the
+        building's text."""
+        if self.single:
+            return next(iter(self.maps.values())).to_text()
+        site = self.site
+        names = [site.level(level).name] if level is not None else list(site.level_names)
+        lines = [self.overview_text()]
         for name in names:
             lines += [f"# Level {name}", "", self.maps[name].to_text().rstrip(), ""]
         return "\n".join(lines).rstrip() + "\n"

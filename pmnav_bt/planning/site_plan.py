@@ -187,7 +187,7 @@ class SitePlanner:
         for lv, lift in route:
             if prev is not None and prev[1] == lift and prev[0] != lv:  # a ride
                 rides.append(LiftRide(lift, prev[0], lv))
-                here, at = lv, _out_of_lift(sm, lift, lv)
+                here, at = lv, out_of_lift(sm, lift, lv)
             elif prev is None:  # the first walk: its route is the search's
                 legs.append(Leg(lv, search.first_leg(lift, self.max_gap)))
             else:  # a change of lifts on a level between
@@ -220,10 +220,12 @@ class _LobbySearch:
         for end, lead in ((seg.a, sp.t * seg.length), (seg.b, (1.0 - sp.t) * seg.length)):
             if end in shut:
                 continue
-            tie = 0.0  # on a tie, the way the robot already faces (as shortest_route)
+            # On a tie, the way the robot already faces, else the segment's first end (as
+            # shortest_route): the legs' routes are the graph planner's.
+            tie = 0.0 if end == seg.a else 1e-12
             if sp.heading is not None:
                 toward = heading(self.start_xy, pm.node_xy(end)) if lead > 1e-9 else sp.heading
-                tie = abs(wrap_angle(toward - sp.heading)) * 1e-9
+                tie += abs(wrap_angle(toward - sp.heading)) * 1e-9
             sources[end] = (lead + tie, lead)
         site = sm.site
         goal_pm = sm.maps[goal_level]
@@ -428,7 +430,7 @@ def _lobby_distance(sm: SiteMap, level: str, lift_a: str, lift_b: str) -> float 
     return cache[key]
 
 
-def _out_of_lift(sm: SiteMap, lift: str, level: str) -> StartPoint:
+def out_of_lift(sm: SiteMap, lift: str, level: str) -> StartPoint:
     """Where a leg starts after a ride: the lift's lobby on ``level``, facing out of the
     lift (from the doors towards the corridor's centre line)."""
     pm = sm.maps[level]

@@ -12,7 +12,7 @@ from pmnav_bt.map.site import Level, LiftLink, Site, load_site, site_from_data
 from pmnav_bt.map.site_map import parse_site
 from pmnav_bt.planning.graph_planner import GraphPlanner
 from pmnav_bt.planning.resolve import resolve_site_room
-from pmnav_bt.planning.site_plan import LIFT_CALL_M, LIFT_LEVEL_M, SitePlanner
+from pmnav_bt.planning.site_plan import LIFT_CALL_M, LIFT_LEVEL_M, SitePlanner, out_of_lift
 from pmnav_bt.seams import PlanConstraints
 
 
@@ -169,3 +169,26 @@ def test_landmark_goal_keeps_room_plans_unchanged(fig2_map):
     assert lift.steps[-1].look_for == "elevator1" and lift.steps[-1].action.value == "arrive"
     with pytest.raises(UnknownNameError, match="no landmark 'room17'"):
         g.plan_to_landmark(fig2_map, "seg13", "room17")
+
+
+@pytest.mark.parametrize(
+    "start, goal",
+    [
+        ("start", "Laboratory"),
+        ("12,0,180", "Ward 7"),
+        ("room119", "L2/Toilets"),
+        ("seg5", "room210"),
+    ],
+)
+def test_legs_are_the_graph_planners_plans(hospital, start, goal):
+    p = SitePlanner().plan(hospital, "L1", start, goal)
+    g = GraphPlanner()
+    (ride,) = p.rides
+    lobby = hospital.site.lift(ride.lift).lobbies["L1"]
+    first = g.plan_to_landmark(hospital.maps["L1"], start, lobby)
+    last = g.plan(hospital.maps["L2"], out_of_lift(hospital, ride.lift, "L2"), p.goal)
+    for got, want in zip(p.legs, (first, last), strict=True):
+        assert got.plan.nodes == want.nodes
+        assert [s.text() for s in got.plan.steps] == [s.text() for s in want.steps]
+        assert got.plan.length == pytest.approx(want.length)
+        assert got.plan.initial_action is want.initial_action
