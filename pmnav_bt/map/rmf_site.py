@@ -64,8 +64,8 @@ def import_rmf_site(path: str | Path, out: str | Path) -> ImportedSite:
             if imp.lift_landmarks.get(lift)
         }
         if len(lobbies) < 2:
-            on = ", ".join(lobbies) or "no level"
-            skipped.append(f"lift {lift!r}: a door on a corridor on {on} only; it joins nothing")
+            where = f"on {', '.join(lobbies)} only" if lobbies else "on no level"
+            skipped.append(f"lift {lift!r}: its door is on a corridor {where}; it joins nothing")
             continue
         lifts.append({"id": _ident(lift), "name": lift.replace("_", " "), "lobbies": lobbies})
     data = {
