@@ -415,6 +415,18 @@ def read_building_file(path: str | Path) -> Building:
         data = load_yaml(path, "building")
     except InputFileError as err:
         raise BuildingFileError(str(path), [Problem(err.field, err.message)]) from None
+    if isinstance(data, dict) and "site_version" in data:  # map/site.py reads those
+        raise BuildingFileError(
+            str(path),
+            [
+                Problem(
+                    "site_version",
+                    "this is a site file (a building of several levels); this command takes "
+                    "one level: give that level's building file (or --level where the "
+                    "command has one)",
+                )
+            ],
+        )
     return building_from_data(data, str(path), path.parent)
 
 

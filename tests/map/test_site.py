@@ -228,3 +228,10 @@ def test_one_level_site_needs_no_lift():
     data["levels"] = data["levels"][:1]
     data["lifts"] = []
     assert site_from_data(data, "s.yaml").level_names == ("L1",)
+
+
+def test_a_one_building_command_refuses_a_site_file_saying_so():
+    from pmnav_bt.map.site import resolve_site_path
+
+    with pytest.raises(BuildingFileError, match="this is a site file .*give that level's"):
+        load_building(resolve_site_path("hospital_2l"))
