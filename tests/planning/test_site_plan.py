@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import networkx as nx
 import pytest
 from site_kit import level_data, two_level_site
 
@@ -192,3 +193,39 @@ def test_legs_are_the_graph_planners_plans(hospital, start, goal):
         assert [s.text() for s in got.plan.steps] == [s.text() for s in want.steps]
         assert got.plan.length == pytest.approx(want.length)
         assert got.plan.initial_action is want.initial_action
+
+
+def test_the_chosen_lifts_cost_least_on_generated_levels():
+    """Against every lift tried in full (the search stops early; it must not stop wrong)."""
+    import random
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parents[2] / "benchmarks"))
+    from bench_plan_levels import site_data
+
+    sm = parse_site(site_from_data(site_data(3, 150, 7), "s.yaml"))
+    rng = random.Random(3)
+    g, sp = GraphPlanner(), SitePlanner()
+    for _ in range(25):
+        here, there = rng.sample(sm.site.level_names, 2)
+        start = f"seg{rng.randint(1, len(sm.maps[here].segments))}"
+        room = rng.choice(sm.maps[there].building.rooms).id
+        p = sp.plan(sm, here, start, f"{there}/{room}")
+        ref = nx.DiGraph()  # every lobby, every leg planned in full
+        for lift in sm.site.lifts:
+            for lv, lobby in lift.lobbies.items():
+                for lv2 in set(lift.lobbies) - {lv}:
+                    ride = sp.ride_cost(sm.site, lv, lv2)
+                    ref.add_edge((lv, lift.id), (lv2, lift.id), w=ride)
+                for other in sm.site.lifts_at(lv):
+                    a, b = sm.lobby_nodes[(lift.id, lv)], sm.lobby_nodes[(other.id, lv)]
+                    d = nx.shortest_path_length(sm.maps[lv].graph, a, b, weight="length")
+                    ref.add_edge((lv, lift.id), (lv, other.id), w=d)
+                if lv == here:
+                    d = g.plan_to_landmark(sm.maps[here], start, lobby).length
+                    ref.add_edge("S", (lv, lift.id), w=d)
+                if lv == there:
+                    d = g.plan(sm.maps[there], out_of_lift(sm, lift.id, there), room).length
+                    ref.add_edge((lv, lift.id), "G", w=d)
+        assert p.cost == pytest.approx(nx.dijkstra_path_length(ref, "S", "G", weight="w"))
