@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import heapq
 import json
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from itertools import count
 
@@ -202,11 +201,11 @@ class _LobbySearch:
     """The cheapest way from a start to a goal room on another level, over the lifts'
     lobbies: a small graph whose nodes are the start, each (level, lift) lobby and the
     goal. Its edges: the corridor metres from the start to each lobby of its level (one
-    search from the start, stopped when every lobby there is reached), a ride's cost
-    between two lobbies of one lift, the metres between two lifts' lobbies on a level
-    (cached on the site map), and the metres from each lobby of the goal's level to the
-    goal (one search from the goal). The first and last legs' routes come from the two
-    searches, so each costs one corridor search."""
+    search from the start), a ride's cost between two lobbies of one lift, the metres
+    between two lifts' lobbies on a level (cached on the site map), and the metres from
+    each lobby of the goal's level to the goal (one search from the goal). The two
+    searches grow together and stop once no lobby left can do better (``_search_both``);
+    the first and last legs' routes are theirs, so each leg costs no search of its own."""
 
     def __init__(self, planner, sm, level, sp, goal_level, goal_id, constraints):
         self.planner, self.sm, self.level, self.sp = planner, sm, level, sp
@@ -230,31 +229,44 @@ class _LobbySearch:
         site = sm.site
         goal_pm = sm.maps[goal_level]
         self.goal_node = goal_pm.places[goal_id].node
-        lobbies = {sm.lobby_nodes[(lift.id, goal_level)] for lift in site.lifts_at(goal_level)}
-        self.to_goal = _settle(goal_pm, {self.goal_node: (0.0, 0.0)}, lobbies)
-        # The start's search stops once no lobby it has not reached can lead to a cheaper
-        # route than one it knows: past such a lobby a route still rides (a call at
-        # least) and walks from a lobby of the goal's level (the nearest at least).
-        to_goal = {
-            lift.id: self.to_goal.dist.get(sm.lobby_nodes[(lift.id, goal_level)])
-            for lift in site.lifts_at(goal_level)
+        at_start = {lift.id: sm.lobby_nodes[(lift.id, level)] for lift in site.lifts_at(level)}
+        at_goal = {
+            lift.id: sm.lobby_nodes[(lift.id, goal_level)] for lift in site.lifts_at(goal_level)
         }
-        least_after = planner.ride_call_m + min(
-            (d for d in to_goal.values() if d is not None), default=0.0
-        )
-        ride = planner.ride_cost(site, level, goal_level)
-        by_node: dict[str, list[str]] = {}
-        for lift in site.lifts_at(level):
-            by_node.setdefault(sm.lobby_nodes[(lift.id, level)], []).append(lift.id)
-        known = [INF]
+        self.from_start = _Search(pm, sources, set(at_start.values()), constraints.blocked_segments)
+        self.to_goal = _Search(goal_pm, {self.goal_node: (0.0, 0.0)}, set(at_goal.values()))
+        self._search_both(at_start, at_goal)
 
-        def cutoff(node: str, cost: float) -> float:
-            for lift in by_node[node]:
-                if to_goal.get(lift) is not None:
-                    known[0] = min(known[0], cost + ride + to_goal[lift])
-            return known[0] - least_after
-
-        self.from_start = _settle(pm, sources, set(by_node), constraints.blocked_segments, cutoff)
+    def _search_both(self, at_start: dict[str, str], at_goal: dict[str, str]) -> None:
+        """Grow the start's and the goal's searches together, the nearer frontier first,
+        until no lobby either has not reached can lead to a cheaper way than one known.
+        A way by a lift serving both levels costs its two walks and its ride; any other
+        changes lifts, so rides twice at least. A lobby not reached is at least as far
+        as its search's frontier."""
+        s, g = self.from_start, self.to_goal
+        direct = [k for k in at_start if k in at_goal]
+        ride = self.planner.ride_cost(self.sm.site, self.level, self.goal_level)
+        two_calls = 2.0 * self.planner.ride_call_m
+        known, pops = INF, 0
+        while s.frontier < INF or g.frontier < INF:
+            search = s if s.frontier <= g.frontier else g
+            if search.step() is not None:
+                for k in direct:
+                    a, b = s.dist.get(at_start[k]), g.dist.get(at_goal[k])
+                    if a is not None and b is not None:
+                        known = min(known, a + ride + b)
+            pops += 1
+            if known == INF or pops % 8:
+                continue
+            bound = two_calls + min(map(s.value, at_start.values())) + min(
+                map(g.value, at_goal.values())
+            )
+            for k in direct:
+                a, b = at_start[k], at_goal[k]
+                if a not in s.dist or b not in g.dist:
+                    bound = min(bound, s.value(a) + ride + g.value(b))
+            if bound >= known:
+                return
 
     def _neighbours(self, node: tuple[str, str]):
         sm, site, level = self.sm, self.sm.site, self.level
@@ -338,14 +350,58 @@ class _LobbySearch:
         return build_plan(pm, at, self.goal_id, nodes, length, start_xy, max_gap, "graph")
 
 
-@dataclass
-class _Settled:
-    """A corridor search's result: cost (``dist``), metres (``length``) and the node each
-    node was reached from (``pred``; None at a source)."""
+class _Search:
+    """Dijkstra on a level's map from several sources, each with a starting (cost, metres),
+    over corridor lengths, never over a segment of ``blocked``, one node at a time
+    (``step``), towards ``targets``. ``dist``: the cost of each node settled; ``length``:
+    its metres; ``pred``: the node it was reached from (None at a source)."""
 
-    dist: dict[str, float]
-    length: dict[str, float]
-    pred: dict[str, str | None]
+    def __init__(
+        self,
+        pm: PrioriMap,
+        sources: dict[str, tuple[float, float]],
+        targets: set[str],
+        blocked: frozenset[int] = frozenset(),
+    ):
+        self.heap = [(c, n) for n, (c, _) in sources.items()]
+        heapq.heapify(self.heap)
+        self.best = {n: c for n, (c, _) in sources.items()}
+        self.length = {n: m for n, (_, m) in sources.items()}
+        self.pred: dict[str, str | None] = dict.fromkeys(sources)
+        self.dist: dict[str, float] = {}
+        self.left = set(targets)
+        self.adj = _adjacency(pm)
+        self.blocked = blocked
+
+    @property
+    def frontier(self) -> float:
+        """The least cost not yet settled (infinite once every target is settled)."""
+        return self.heap[0][0] if self.heap and self.left else INF
+
+    def value(self, node: str) -> float:
+        """A settled node's cost, else the frontier: as little as it can cost."""
+        return self.dist.get(node, self.frontier)
+
+    def step(self) -> str | None:
+        """Settle the nearest node not settled; return it when it is a target."""
+        heap, dist, best = self.heap, self.dist, self.best
+        while heap:
+            c, n = heapq.heappop(heap)
+            if n in dist:
+                continue
+            dist[n] = c
+            for m, length, segment in self.adj[n]:
+                nc = c + length
+                if nc < best.get(m, INF) and m not in dist and segment not in self.blocked:
+                    best[m] = nc
+                    self.length[m] = self.length[n] + length
+                    self.pred[m] = n
+                    heapq.heappush(heap, (nc, m))
+            if n in self.left:
+                self.left.discard(n)
+                return n
+            return None
+        return None
 
     def path(self, node: str) -> list[str]:
         """The nodes from ``node`` back to the source it was reached from."""
@@ -353,46 +409,6 @@ class _Settled:
         while self.pred[out[-1]] is not None:
             out.append(self.pred[out[-1]])
         return out
-
-
-def _settle(
-    pm: PrioriMap,
-    sources: dict[str, tuple[float, float]],
-    targets: set[str],
-    blocked: frozenset[int] = frozenset(),
-    cutoff: Callable[[str, float], float] | None = None,
-) -> _Settled:
-    """Dijkstra on a level's map from several sources, each with a starting (cost,
-    metres), over corridor lengths, never over a segment of ``blocked``; stops when every
-    target is settled, or past the cost ``cutoff`` returns when a target is settled."""
-    heap = [(c, n) for n, (c, _) in sources.items()]
-    heapq.heapify(heap)
-    best = {n: c for n, (c, _) in sources.items()}
-    metres = {n: m for n, (_, m) in sources.items()}
-    pred: dict[str, str | None] = dict.fromkeys(sources)
-    dist: dict[str, float] = {}
-    left = set(targets)
-    adj = _adjacency(pm)
-    beyond = INF
-    while heap and left:
-        c, n = heapq.heappop(heap)
-        if c > beyond:
-            break
-        if n in dist:
-            continue
-        dist[n] = c
-        if n in left:
-            left.discard(n)
-            if cutoff is not None:
-                beyond = cutoff(n, c)
-        for m, length, segment in adj[n]:
-            nc = c + length
-            if nc < best.get(m, INF) and m not in dist and segment not in blocked:
-                best[m] = nc
-                metres[m] = metres[n] + length
-                pred[m] = n
-                heapq.heappush(heap, (nc, m))
-    return _Settled(dist, metres, pred)
 
 
 INF = float("inf")
