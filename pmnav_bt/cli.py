@@ -214,13 +214,20 @@ def map_draft(
 @app.command("map-import-rmf")
 def map_import_rmf(
     rmf: Path = typer.Argument(..., help="An Open-RMF traffic-editor file (*.building.yaml)."),
-    out: Path = typer.Option(..., "-o", "--out", help="The building file to write (YAML)."),
-    level: str | None = typer.Option(None, help="The level to import (default: the first)."),
+    out: Path = typer.Option(
+        ..., "-o", "--out", help="The building file to write (YAML); a site file for all levels."
+    ),
+    level: str | None = typer.Option(
+        None,
+        help="The level to import (default: a one-level file's level; with several, every "
+        "level, as a site with OUT_<level>.yaml beside it).",
+    ),
     image: Path | None = typer.Option(
         None, "--image", help="Draw the imported map over the level's drawing here (PNG)."
     ),
 ) -> None:
-    """Import one level of an Open-RMF building (also: 'pmnav map import-rmf FILE -o OUT')."""
+    """Import an Open-RMF building: one level, or every level as a site (also: 'pmnav map
+    import-rmf FILE -o OUT')."""
     from pmnav_bt.map.rmf_cli import import_rmf_command
 
     import_rmf_command(rmf, out, level, image)
