@@ -115,23 +115,17 @@ def _site_route(
     overrides: list[str] | None,
 ) -> None:
     """``pmnav plan SITE``: a plan across levels, legs and rides; an image per level."""
+    from pmnav_bt.config import load_config
     from pmnav_bt.map.site import open_site
     from pmnav_bt.map.site_cli import render_site_images
     from pmnav_bt.map.site_map import parse_site
-    from pmnav_bt.planning.plan import MAX_GAP_M
-    from pmnav_bt.planning.site_plan import SitePlanner
+    from pmnav_bt.planning.site_planners import build_site_planner
 
     sm = parse_site(open_site(file))
     level = start_level or sm.site.levels[0].name
-    gap = MAX_GAP_M if max_gap is None else max_gap
-    if planner == "graph":
-        p = SitePlanner(max_gap=gap).plan(sm, level, start, goal)
-    else:
-        from pmnav_bt.config import load_config
-        from pmnav_bt.vlm.site_planner import site_vlm_planner
-
-        sets = [*(overrides or []), *([] if max_gap is None else [f"planner.max_gap={max_gap}"])]
-        p = site_vlm_planner(planner, load_config(config, sets), sm).plan(sm, level, start, goal)
+    sets = [*(overrides or []), *([] if max_gap is None else [f"planner.max_gap={max_gap}"])]
+    cfg = load_config(config, sets)
+    p = build_site_planner(planner, cfg, sm).plan(sm, level, start, goal)
     typer.echo(p.to_json() if as_json else p.text())
     if image is not None:
         paths = {leg.level: list(leg.plan.path) for leg in p.legs}

@@ -320,13 +320,10 @@ class SiteVlmPlanner:
             s.repaired += 1
 
 
-def site_vlm_planner(name: str, cfg, sm: SiteMap) -> SiteVlmPlanner:
-    """The planner across levels for the planner back end ``name`` (only ``vlm`` plans
-    with a model; ``graph`` is ``SitePlanner``)."""
-    if name != "vlm":
-        raise PmNavError(f"planner {name!r} cannot plan across levels: choose graph or vlm")
+def build(cfg, sm: SiteMap) -> SiteVlmPlanner:
+    """The ``vlm`` planner across levels, as the config's ``vlm`` section describes it."""
     from pmnav_bt.backends import BackendDeps
-    from pmnav_bt.vlm.planner import build
+    from pmnav_bt.vlm.planner import build as build_level_planner
 
     deps = BackendDeps(config=cfg, pm=sm.maps[sm.site.levels[0].name])
-    return SiteVlmPlanner(build(deps), SitePlanner(max_gap=cfg.planner.max_gap))
+    return SiteVlmPlanner(build_level_planner(deps), SitePlanner(max_gap=cfg.planner.max_gap))

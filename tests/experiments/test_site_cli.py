@@ -112,3 +112,21 @@ def test_plan_of_a_building_with_start_level_is_unchanged(capsys):
     _, before, _ = run(capsys, *argv)
     _, with_level, _ = run(capsys, *argv, "--start-level", "L1")
     assert with_level == before
+
+
+def test_plan_across_levels_with_a_planner_that_cannot(capsys):
+    argv = ["plan", "hospital_2l", "--from", "start", "--to", "Laboratory", "--planner", "nope"]
+    code, _, err = run(capsys, *argv)
+    assert code == 2
+    assert err.strip().endswith("planner 'nope' cannot plan across levels: choose graph, vlm")
+
+
+def test_plan_across_levels_with_the_vlm(capsys):
+    from pmnav_bt.vlm.scripted_server import ChatServer, Script
+
+    with ChatServer(Script([])) as s:  # answers nothing usable: the graph plans instead
+        argv = ["plan", "hospital_2l", "--from", "start", "--to", "Laboratory", "--planner"]
+        sets = ["--set", f"vlm.base_url={s.base_url}", "--set", "vlm.model=m"]
+        code, out, err = run(capsys, *argv, "vlm", *sets, "--set", "vlm.retries=0")
+    assert code == 0, err
+    assert "ride: {lift1: take the lift to level L2}" in out and "vlm->graph" in out
