@@ -30,7 +30,11 @@ app = typer.Typer(
     help="PM-Nav BT: find a named room in a functional building from a prior floor plan.",
 )
 
-FILE_HELP = "A building file (YAML) or the name of a built-in building (see 'pmnav buildings')."
+FILE_HELP = (
+    "A building or site file (YAML) or the name of a built-in building or site (see "
+    "'pmnav buildings')."
+)
+LEVEL_HELP = "Only this level of a site (a building file's one level is L1)."
 
 
 def _priori_map(file: str):
@@ -58,10 +62,15 @@ def buildings() -> None:
         builtin_buildings,
         load_building,
     )
+    from pmnav_bt.map.site import builtin_sites, load_site
 
     for name in builtin_buildings():
         b = load_building(name)
         typer.echo(f"{name:<16} {b.kind:<9} {len(b.rooms):>3} rooms  {b.description}")
+    for name in builtin_sites():
+        s = load_site(name)
+        rooms = sum(len(lv.building.rooms) for lv in s.levels)
+        typer.echo(f"{name:<16} {'site':<9} {rooms:>3} rooms  {s.description}")
     typer.echo(
         f"\nGenerated families ({', '.join(FAMILIES)}): FAMILY_SEED names one member, FAMILY:N "
         f"the first N; {MIXED_FAMILY}:N takes hospital, school and office in turn. hospital, "
@@ -91,12 +100,18 @@ def backends() -> None:
 def validate(
     file: str = typer.Argument(..., help=FILE_HELP),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as problems (exit 1)."),
+    level: str | None = typer.Option(None, "--level", help=LEVEL_HELP),
 ) -> None:
-    """Check a building file: list every problem (exit 1), then warnings about runs."""
+    """Check a building or site file: list every problem (exit 1), then warnings about runs."""
     from pmnav_bt.map.catalogue import open_building
     from pmnav_bt.map.checks import building_warnings
     from pmnav_bt.map.priori_map import parse_building
+    from pmnav_bt.map.site_cli import names_site, validate_site
     from pmnav_bt.map.unreached import unreached_warnings_of
+
+    if level is not None or names_site(file):
+        validate_site(file, strict, level)
+        return
 
     try:
         b = open_building(file)
@@ -127,10 +142,17 @@ def map_(
     grid: float | None = typer.Option(
         None, "--grid", help="Draw a metre grid on the image, lines this many metres apart."
     ),
+    level: str | None = typer.Option(None, "--level", help=LEVEL_HELP),
 ) -> None:
-    """Print the semantic priori-map (structured text or JSON); optionally draw it."""
+    """Print the semantic priori-map (structured text or JSON); optionally draw it (a site:
+    each level's, with the lifts; one image per level, FILE_LEVEL.png)."""
+    from pmnav_bt.map.site_cli import names_site, show_site_map
+
     if image is not None:
         check_output_file(image, "--image", IMAGE_SUFFIXES)
+    if level is not None or names_site(file):
+        show_site_map(file, level, as_json, image, grid)
+        return
     pm = _priori_map(file)
     typer.echo(json.dumps(pm.to_dict(), indent=2) if as_json else pm.to_text(), nl=not as_json)
     if image is not None:
@@ -192,13 +214,20 @@ def map_draft(
 @app.command("map-import-rmf")
 def map_import_rmf(
     rmf: Path = typer.Argument(..., help="An Open-RMF traffic-editor file (*.building.yaml)."),
-    out: Path = typer.Option(..., "-o", "--out", help="The building file to write (YAML)."),
-    level: str | None = typer.Option(None, help="The level to import (default: the first)."),
+    out: Path = typer.Option(
+        ..., "-o", "--out", help="The building file to write (YAML); a site file for all levels."
+    ),
+    level: str | None = typer.Option(
+        None,
+        help="The level to import (default: a one-level file's level; with several, every "
+        "level, as a site with OUT_<level>.yaml beside it).",
+    ),
     image: Path | None = typer.Option(
         None, "--image", help="Draw the imported map over the level's drawing here (PNG)."
     ),
 ) -> None:
-    """Import one level of an Open-RMF building (also: 'pmnav map import-rmf FILE -o OUT')."""
+    """Import an Open-RMF building: one level, or every level as a site (also: 'pmnav map
+    import-rmf FILE -o OUT')."""
     from pmnav_bt.map.rmf_cli import import_rmf_command
 
     import_rmf_command(rmf, out, level, image)

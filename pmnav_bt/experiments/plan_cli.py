@@ -45,7 +45,15 @@ def route(
         "--from",
         help="Start: a segment (seg13), a waypoint or room ID, or a pose 'x,y[,yaw_deg]'.",
     ),
-    goal: str = typer.Option(..., "--to", help="Goal room: ID, name or alias."),
+    goal: str = typer.Option(
+        ...,
+        "--to",
+        help="Goal room: ID, name or alias; in a site, on any level, or qualified by its "
+        "level: 'L2/room 208' or 'room 208 on L2'.",
+    ),
+    start_level: str | None = typer.Option(
+        None, "--start-level", help="A site's level the start is on (default: its first)."
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print the plan as JSON."),
     image: Path | None = typer.Option(None, "--image", help="Draw the plan on the annotated map."),
     max_gap: float | None = typer.Option(
@@ -68,6 +76,12 @@ def route(
         finite(max_gap, "--max-gap", 0.1, 1000.0)
     if image is not None:
         check_output_file(image, "--image", IMAGE_SUFFIXES)
+    from pmnav_bt.map.site_cli import names_site
+
+    if start_level is not None or names_site(file):
+        opts = (as_json, image, max_gap, planner, config, overrides)
+        _site_route(file, start_level, start, goal, *opts)
+        return
     pm = _priori_map(file)
     if planner == "graph":
         p = (GraphPlanner() if max_gap is None else GraphPlanner(max_gap=max_gap)).plan(
@@ -86,6 +100,38 @@ def route(
 
         render_annotated_map(pm, path=image, path_xy=list(p.path), base_dir=_folder(file))
         typer.echo(f"wrote {image}", err=True)
+
+
+def _site_route(
+    file: str,
+    start_level: str | None,
+    start: str,
+    goal: str,
+    as_json: bool,
+    image: Path | None,
+    max_gap: float | None,
+    planner: str,
+    config: Path | None,
+    overrides: list[str] | None,
+) -> None:
+    """``pmnav plan SITE``: a plan across levels, legs and rides; an image per level."""
+    from pmnav_bt.config import load_config
+    from pmnav_bt.map.site import open_site
+    from pmnav_bt.map.site_cli import render_site_images
+    from pmnav_bt.map.site_map import parse_site
+    from pmnav_bt.planning.site_planners import build_site_planner
+
+    sm = parse_site(open_site(file))
+    level = start_level or sm.site.levels[0].name
+    sets = [*(overrides or []), *([] if max_gap is None else [f"planner.max_gap={max_gap}"])]
+    cfg = load_config(config, sets)
+    p = build_site_planner(planner, cfg, sm).plan(sm, level, start, goal)
+    typer.echo(p.to_json() if as_json else p.text())
+    if image is not None:
+        paths = {leg.level: list(leg.plan.path) for leg in p.legs}
+        one = None if sm.single else (level if len(paths) == 1 else None)
+        for out in render_site_images(sm, image, one, paths):
+            typer.echo(f"wrote {out}", err=True)
 
 
 @app.command("eval")

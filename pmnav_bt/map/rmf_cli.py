@@ -16,6 +16,11 @@ def import_rmf_command(rmf: Path, out: Path, level: str | None, image: Path | No
     check_output_file(out, "--out", (".yaml", ".yml"))
     if image is not None:
         check_output_file(image, "--image", (".png", ".jpg", ".jpeg"))
+    from pmnav_bt.map.rmf_site import is_multi_level
+
+    if level is None and is_multi_level(rmf):
+        _import_site(rmf, out, image)
+        return
     imp = import_rmf(rmf, out, level)
     write_import(imp, out)
     b = imp.building
@@ -38,3 +43,29 @@ def import_rmf_command(rmf: Path, out: Path, level: str | None, image: Path | No
         )
         under = " (over the walls' grid: the drawing is not there)" if plan is None else ""
         typer.echo(f"wrote {image}{under}")
+
+
+def _import_site(rmf: Path, out: Path, image: Path | None) -> None:
+    """Every level of a multi-level RMF building: a building file per level and the site."""
+    from pmnav_bt.map.rmf_site import import_rmf_site
+    from pmnav_bt.map.site_cli import render_site_images
+    from pmnav_bt.map.site_map import parse_site
+
+    imported = import_rmf_site(rmf, out)
+    for name, imp in imported.levels.items():
+        b = imp.building
+        for line in imp.skipped:
+            typer.echo(f"skipped: level {name}: {line}")
+        typer.echo(
+            f"wrote {imp.data['name']} to {out.with_name(f'{out.stem}_{name}.yaml')} (level "
+            f"{name}): {len(b.waypoints)} key waypoints, {len(b.edges)} corridors, "
+            f"{len(b.rooms)} rooms, {len(b.landmarks)} landmarks"
+        )
+    for line in imported.skipped:
+        typer.echo(f"skipped: {line}")
+    site = imported.site
+    lifts = ", ".join(f"{k.id} ({', '.join(k.lobbies)})" for k in site.lifts)
+    typer.echo(f"wrote {out}: site {site.name}, {len(site.levels)} levels, lifts {lifts}")
+    if image is not None:
+        for path in render_site_images(parse_site(site), image):
+            typer.echo(f"wrote {path}")

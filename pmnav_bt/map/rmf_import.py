@@ -20,7 +20,7 @@ Everything left out is listed with its reason in ``Imported.skipped``.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -64,6 +64,7 @@ class Imported:
     named_doors: int
     cut_lanes: int
     spurs: int  # short corridors added to reach doors off the lanes
+    lift_landmarks: dict[str, list[str]] = field(default_factory=dict)  # RMF lift -> ids
 
 
 def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> Imported:
@@ -126,9 +127,11 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
                 {"id": lid, "kind": "sign", "name": _text(name), "pos": _r(lvl.xy[i]),
                  "sign": _words(name)}
             )
+    lift_landmarks: dict[str, list[str]] = {}
     for ld in lvl.lift_doors:
         if reach(ld.pos, f"lift {ld.lift!r} door {ld.door!r}"):
             lid = _unique_id(ld.lift, ids)
+            lift_landmarks.setdefault(ld.lift, []).append(lid)
             landmarks.append(
                 {"id": lid, "kind": "elevator", "name": _text(ld.lift), "pos": _r(ld.pos),
                  "sign": _words(ld.lift)}
@@ -160,7 +163,9 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             f"{path}: level {lvl.name}: the imported building does not validate: "
             f"{err.problems[0]}"
         ) from None
-    return Imported(data, b, plan, lvl, skipped, len(door_names), cor.cuts, spurs)
+    return Imported(
+        data, b, plan, lvl, skipped, len(door_names), cor.cuts, spurs, lift_landmarks
+    )
 
 
 def write_import(imp: Imported, out: str | Path) -> Path:

@@ -84,6 +84,17 @@ def param(params: dict[str, Any], key: str) -> Any:
     return v[1] if isinstance(v, list) and len(v) == 2 else None
 
 
+def level_elevations(path: str | Path) -> dict[str, float]:
+    """Each level's name and elevation (metres; 0 where the file gives none), in file order."""
+    src = str(path)
+    levels = _levels(load_yaml(path, "building"), src)
+    out = {}
+    for name, raw in levels.items():
+        z = raw.get("elevation", 0.0) if isinstance(raw, dict) else 0.0
+        out[str(name)] = _number(z, src, f"levels.{name}.elevation")
+    return out
+
+
 def read_level(path: str | Path, level: str | None = None) -> RmfLevel:
     """Level ``level`` (default: the first) of the RMF building at ``path``, in metres."""
     src = str(path)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -71,6 +72,7 @@ INK_MAX = 90  # grey level below which a background pixel is ink (a wall) tags k
 INK_PENALTY = 48  # candidates (three rings) a tag may move outwards to keep off ink
 HEADER_H = 44
 TITLE_SCALE = 0.8
+MARK = (30, 30, 200)  # BGR: the red of the marks a caller adds (lift links)
 MIN_WIDTH = 640  # px, room for the legend
 MAP_PAD = 80  # px around the building, room for tags outside the walls
 ROOM_DEPTH_M, ROOM_WIDTH_M = 2.8, 3.2
@@ -225,9 +227,13 @@ def _room_box(f: DoorFrame, width: float) -> np.ndarray:
 
 
 def layout_labels(
-    pm: PrioriMap, canvas: Canvas | None = None, background: np.ndarray | None = None
+    pm: PrioriMap,
+    canvas: Canvas | None = None,
+    background: np.ndarray | None = None,
+    marks: Sequence[tuple[tuple[float, float], str]] = (),
 ) -> LabelLayout:
     """Place every tag without overlap; drop segment labels only where no place is free.
+    ``marks``: extra tags (a map point, a text), placed after the landmarks' tags.
 
     Tags also keep off the dark lines (walls) of ``background`` where they can; without
     one, the clean drawing of the building is used.
@@ -240,7 +246,7 @@ def layout_labels(
     occupied = [_marker_boxes(pm, canvas)]
     placed: list[Label] = []
     dropped: list[str] = []
-    for req in _requests(pm, canvas):
+    for req in _requests(pm, canvas, marks):
         box = _place(req, np.vstack(occupied), canvas.map_box, ink)
         if box is None:
             dropped.append(req.text)
@@ -254,9 +260,16 @@ def layout_labels(
     return LabelLayout(canvas, tuple(placed), tuple(dropped))
 
 
-def _requests(pm: PrioriMap, canvas: Canvas) -> list[_Request]:
+def _requests(
+    pm: PrioriMap, canvas: Canvas, marks: Sequence[tuple[tuple[float, float], str]] = ()
+) -> list[_Request]:
     reqs = _waypoint_requests(pm, canvas) + _room_requests(pm, canvas)
-    reqs += _landmark_requests(pm, canvas) + _segment_requests(pm, canvas)
+    reqs += _landmark_requests(pm, canvas)
+    reqs += [
+        _Request(t, "landmark", canvas.to_px(xy)[0], _away(pm, xy), 2 * MARKER_R, None, 0, MARK)
+        for xy, t in marks
+    ]
+    reqs += _segment_requests(pm, canvas)
     return sorted(reqs, key=lambda r: PLACE_ORDER.index(r.kind))
 
 
@@ -286,17 +299,20 @@ def _room_requests(pm: PrioriMap, canvas: Canvas) -> list[_Request]:
 
 
 def _landmark_requests(pm: PrioriMap, canvas: Canvas) -> list[_Request]:
-    out = []
-    for lm in pm.building.landmarks:
-        p = np.asarray(lm.pos, dtype=float)
-        where = pm.locate(*p)
-        off = p - where.point(pm)
-        if np.linalg.norm(off) < 0.2:
-            off = np.array([-math.sin(where.segment.heading), math.cos(where.segment.heading)])
-        out.append(
-            _Request(lm.id, "landmark", canvas.to_px(p)[0], _canvas_angle(off), MARKER_R + 2)
-        )
-    return out
+    return [
+        _Request(lm.id, "landmark", canvas.to_px(lm.pos)[0], _away(pm, lm.pos), MARKER_R + 2)
+        for lm in pm.building.landmarks
+    ]
+
+
+def _away(pm: PrioriMap, xy) -> float:
+    """The canvas direction from a point beside a corridor away from its centre line."""
+    p = np.asarray(xy, dtype=float)
+    where = pm.locate(*p)
+    off = p - where.point(pm)
+    if np.linalg.norm(off) < 0.2:
+        off = np.array([-math.sin(where.segment.heading), math.cos(where.segment.heading)])
+    return _canvas_angle(off)
 
 
 def _segment_requests(pm: PrioriMap, canvas: Canvas) -> list[_Request]:
@@ -422,6 +438,7 @@ def render_annotated_map(
     floor_plan: FloorPlanImage | None = None,
     base_dir: str | Path = ".",
     grid_m: float | None = None,
+    marks: Sequence[tuple[tuple[float, float], str]] = (),
 ) -> np.ndarray:
     """Draw the annotated priori-map (BGR) and write it to ``path`` (PNG) when given.
 
@@ -429,7 +446,9 @@ def render_annotated_map(
     relative to ``base_dir``; over a plan, the corridors are drawn translucent at their
     annotated widths with the doors marked on the annotated walls, so a mismatch with
     the plan shows. ``path_xy`` (map points) is drawn as a blue polyline; ``grid_m``
-    adds a metre grid with lines that many metres apart.
+    adds a metre grid with lines that many metres apart; ``marks`` (a map point and a
+    text) are tags of their own in a strong colour, placed with the others (a level's
+    lift lobbies with the levels they go to).
     """
     canvas, floor_plan, img = _blank_page(pm, scale_px_per_m, floor_plan, base_dir)
     if floor_plan is not None:
@@ -439,7 +458,7 @@ def render_annotated_map(
         _draw_building(img, pm, canvas)
     if grid_m:
         _draw_metre_grid(img, canvas, grid_m)
-    layout = layout_labels(pm, canvas, img)
+    layout = layout_labels(pm, canvas, img, marks)
     _draw_centre_lines(img, pm, canvas)
     if path_xy:
         pts = np.rint(canvas.to_px(path_xy)).astype(np.int32)

@@ -60,3 +60,31 @@ def write_example_rmf(folder: str | Path, data: dict | None = None) -> Path:
     path = Path(folder) / "example.building.yaml"
     path.write_text(yaml.safe_dump(data or example_rmf(), sort_keys=False), encoding="utf-8")
     return path
+
+
+LIFT_DOOR = (25.0, -8.0)  # map frame: the lift's door, in the corridor's south wall
+
+
+def example_rmf_two_levels() -> dict:
+    """The example building with a second level ``L2`` (the same floor 4 m up, its room
+    ``office_2``) and the lift ``lift_a`` south of the corridor, its door at ``LIFT_DOOR``
+    on both levels."""
+    import copy
+
+    data = example_rmf()
+    l2 = copy.deepcopy(data["levels"]["L1"])
+    l2["elevation"] = 4
+    l2["doors"][0][2]["name"] = [1, "office_2"]
+    data["levels"]["L2"] = l2
+    x_px, y_px = LIFT_DOOR[0] / SCALE_M_PER_PX, (-LIFT_DOOR[1] + 1.5) / SCALE_M_PER_PX
+    data["lifts"] = {
+        "lift_a": {
+            "x": x_px,
+            "y": y_px,
+            "yaw": 0.0,
+            "reference_floor_name": "L1",
+            "doors": {"door_a": {"x": 0.0, "y": 1.5, "width": 1.4, "door_type": 2}},
+            "level_doors": {"L1": ["door_a"], "L2": ["door_a"]},
+        }
+    }
+    return data

@@ -63,7 +63,7 @@ def start_description(pm: PrioriMap, sp: StartPoint) -> str:
     return where + facing
 
 
-def _environment_section(pm: PrioriMap) -> str:
+def environment_section(pm: PrioriMap) -> str:
     b = pm.building
     wps = "\n".join(
         f"- {n.id}: {n.kind} at ({n.pos[0]:.1f}, {n.pos[1]:.1f})" for n in pm.key_waypoints
@@ -88,7 +88,7 @@ def plan_text(pm: PrioriMap, sp: StartPoint, goal_id: str, inputs: str) -> str:
     if inputs == "h-pm":
         section = template("priori_map_section").substitute(priori_map=pm.to_text().strip())
     else:
-        section = _environment_section(pm)
+        section = environment_section(pm)
     fields = dict(
         kind=b.kind,
         building=b.name,

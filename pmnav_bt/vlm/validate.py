@@ -46,6 +46,7 @@ class IssueKind(str, Enum):
     NOT_CONNECTED = "not_connected"  # consecutive steps not joined by one corridor stretch
     WRONG_ACTION = "wrong_action"  # the action disagrees with the headings
     WRONG_GOAL = "wrong_goal"  # the plan does not end at the goal (with arrive)
+    WRONG_LIFT = "wrong_lift"  # across levels: a ride on no lift, or one not joining the levels
     AVOIDED_LANDMARK = "avoided_landmark"  # a landmark the replan must avoid
     BLOCKED_SEGMENT = "blocked_segment"  # the way uses a segment found blocked
     DETOUR = "detour"  # valid, but much longer than the shortest route

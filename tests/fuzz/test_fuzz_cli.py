@@ -45,6 +45,36 @@ def test_plan_start_any_text(capsys, spec):
         one_line(err, "pmnav: error:")
 
 
+def qualified(t: tuple[str, str]) -> str:
+    """A level and a name as a person might join them: 'L2/x' or 'x on L2'."""
+    level, name = t
+    return f"{level}/{name}" if len(name) % 2 else f"{name} on {level}"
+
+
+@FUZZ
+@given(
+    goal=st.one_of(
+        st.text(max_size=60),
+        st.tuples(st.sampled_from(["L1", "l2", "L9", "", " "]), st.text(max_size=20)).map(
+            qualified
+        ),
+    ),
+    level=st.sampled_from(["L1", "L2", "l2", "L9", "L1/x", "../L1"]),
+)
+def test_plan_across_levels_any_goal_and_level(capsys, goal, level):
+    """A site's goal (qualified or not) and start level as anyone may type them."""
+    TRIED["CLI: plan across levels, any goal"] += 1
+    if goal.startswith("-"):
+        goal = " " + goal
+    argv = ["plan", "hospital_2l", "--from", "start", "--to", goal, "--start-level", level]
+    code, out, err = pmnav_cli(capsys, *argv)
+    if code != 0:
+        assert code == 2
+        one_line(err, "pmnav: error:")
+    else:
+        assert out.startswith("Plan in hospital_2l")
+
+
 @FUZZ
 @given(
     option=st.sampled_from(["-n", "--jobs", "--seed"]),

@@ -30,6 +30,13 @@ def test_builtin_buildings_are_package_data():
     assert list((ROOT / "pmnav_bt" / "data" / "buildings").glob("*.yaml"))
 
 
+def test_builtin_sites_and_their_levels_are_package_data():
+    cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    data = cfg["package-data"]["pmnav_bt.data"]
+    assert "sites/*.yaml" in data and "sites/*/*.yaml" in data
+    assert list((ROOT / "pmnav_bt" / "data" / "sites").glob("*/*.yaml"))
+
+
 def test_the_core_imports_no_tree_simulator_or_ros_at_import_time():
     import subprocess
     import sys
