@@ -21,11 +21,11 @@ $(VENV)/.installed: pyproject.toml
 	$(BIN)/pip install --quiet --no-deps rapidocr-onnxruntime==1.4.4
 	touch $@
 
-# The ROS 2 interface package (NavigateToRoom action), built with rosidl + ament_cmake from
-# PyPI into the venv (~35 s). Needs cmake and a C++ compiler; without them pmnav-ros runs
-# with its goal topics only and the action tests are skipped.
-$(VENV)/.interfaces: $(VENV)/.installed interfaces/build.sh $(wildcard interfaces/pmnav_interfaces/*.*) $(wildcard interfaces/pmnav_interfaces/action/*)
-	interfaces/build.sh $(VENV) && touch $@ || echo "make: pmnav_interfaces not built (see above); the action is unavailable"
+# The ROS 2 interface packages (Open-RMF's rmf_lift_msgs, the NavigateToRoom action), built
+# with rosidl + ament_cmake from PyPI into the venv (~80 s). Needs cmake and a C++ compiler;
+# without them pmnav-ros runs with its goal topics only and the action and lift tests are skipped.
+$(VENV)/.interfaces: $(VENV)/.installed interfaces/build.sh $(wildcard interfaces/*.cmake interfaces/*/*.* interfaces/*/action/* interfaces/*/msg/*)
+	interfaces/build.sh $(VENV) && touch $@ || echo "make: interface packages not built (see above); the action and lifts are unavailable"
 
 demo: setup
 	mkdir -p $(OUT)
