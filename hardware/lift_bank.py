@@ -20,14 +20,14 @@ What one lift does (Open-RMF's AGV mode, the mode a robot uses):
   (closed, moving or open), the motion (up, down, stopped), the session, the levels.
 
 Time comes from ``clock`` (seconds); ``step()`` advances every lift to ``clock()``.
-Levels are listed from the lowest to the highest.
+Each lift serves its own levels, listed from the lowest to the highest.
 """
 
 from __future__ import annotations
 
 import random
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from pmnav_bt.errors import PmNavError
@@ -48,6 +48,7 @@ class _Cabin:
     how far open (0 closed .. 1 open)."""
 
     name: str
+    levels: tuple[str, ...]  # lowest first
     position: float
     destination: int
     door: float = 0.0
@@ -59,12 +60,12 @@ class _Cabin:
 
 
 class LiftBank:
-    """Simulated lifts that all serve ``levels`` (lowest first); see the module doc."""
+    """Simulated lifts: ``lifts`` maps each lift's name to the levels it serves, lowest
+    first; see the module doc."""
 
     def __init__(
         self,
-        lifts: Sequence[str],
-        levels: Sequence[str],
+        lifts: Mapping[str, Sequence[str]],
         *,
         start_level: str = "",
         ride_s_per_level: float = RIDE_S_PER_LEVEL,
@@ -75,16 +76,19 @@ class LiftBank:
         clock: Callable[[], float] = time.monotonic,
         log: Callable[[str], None] = lambda _line: None,
     ) -> None:
-        self.levels = tuple(levels)
-        names = tuple(lifts)
-        if not names or not self.levels:
-            raise PmNavError("a lift bank needs at least one lift and one level")
-        for what, items in (("lift", names), ("level", self.levels)):
-            dup = sorted({x for x in items if items.count(x) > 1})
-            if dup or not all(items):
-                raise PmNavError(f"{what} names must be unique and not empty: {list(items)}")
-        if start_level and start_level not in self.levels:
-            raise PmNavError(f"start level {start_level!r} is not one of {list(self.levels)}")
+        if not lifts:
+            raise PmNavError("a lift bank needs at least one lift")
+        if not all(lifts):
+            raise PmNavError(f"lift names must not be empty: {list(lifts)}")
+        for name, levels in lifts.items():
+            levels = tuple(levels)
+            if not levels or not all(levels) or len(set(levels)) < len(levels):
+                raise PmNavError(
+                    f"lift {name}: level names must be unique and not empty: {list(levels)}"
+                )
+            if start_level and start_level not in levels:
+                raise PmNavError(f"lift {name}: start level {start_level!r} is not one of "
+                                 f"{list(levels)}")  # fmt: skip
         for name, v in (("ride_s_per_level", ride_s_per_level), ("door_s", door_s),
                         ("dwell_s", dwell_s), ("call_delay_s", call_delay_s)):  # fmt: skip
             if not v >= 0.0:
@@ -92,11 +96,13 @@ class LiftBank:
         self.ride_s, self.door_s, self.dwell_s = ride_s_per_level, door_s, dwell_s
         self.call_delay_s = call_delay_s
         self.clock, self.log = clock, log
-        start = self.levels.index(start_level) if start_level else 0
         self._t = clock()
-        self._cabins = {n: _Cabin(n, float(start), start) for n in names}
+        self._cabins = {}
+        for name, levels in lifts.items():
+            start = tuple(levels).index(start_level) if start_level else 0
+            self._cabins[name] = _Cabin(name, tuple(levels), float(start), start)
         # one seeded stream per lift: a lift's delays do not depend on the others' calls
-        self._rng = {n: random.Random(f"{seed}/{n}") for n in names}
+        self._rng = {n: random.Random(f"{seed}/{n}") for n in lifts}
 
     @property
     def lifts(self) -> tuple[str, ...]:
@@ -112,15 +118,15 @@ class LiftBank:
         c = self._cabin(lift)
         if c is None or not session:
             return
-        if level not in self.levels:
-            self.log(f"lift {lift}: no level {level!r} (levels {', '.join(self.levels)})")
+        if level not in c.levels:
+            self.log(f"lift {lift}: no level {level!r} (levels {', '.join(c.levels)})")
             return
         if c.session and c.session != session:
             if c.refused != session:  # a requester asks again on every state: log it once
                 c.refused = session
                 self.log(f"lift {lift}: busy with session {c.session!r}; {session!r} must wait")
             return
-        dest = self.levels.index(level)
+        dest = c.levels.index(level)
         if not c.session:
             c.session, c.refused = session, ""
             c.start_at = self._t + self._rng[lift].uniform(0.0, self.call_delay_s)
@@ -156,12 +162,12 @@ class LiftBank:
             motion = LiftMotion.UP if c.destination > c.position else LiftMotion.DOWN
         return LiftState(
             lift=lift,
-            current_level=self.levels[int(c.position + 0.5)],  # the nearest level
-            destination_level=self.levels[c.destination],
+            current_level=c.levels[int(c.position + 0.5)],  # the nearest level
+            destination_level=c.levels[c.destination],
             door=door,
             motion=motion,
             session=c.session,
-            available_levels=self.levels,
+            available_levels=c.levels,
             stamp=self._t,
         )
 

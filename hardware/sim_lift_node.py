@@ -10,8 +10,10 @@ level, the door's travel and dwell) driven by the wall clock:
 - out ``/lift_states`` (rmf_lift_msgs/LiftState): every lift's state at ``publish_hz``
   (2 Hz, as RMF's simulated lifts) and at once when it changes.
 
-Run: ``pmnav-sim-lift --ros-args -p lifts:=lift1 -p levels:=L1,L2,L3`` (or ``python -m
-pmnav_bt.hardware.sim_lift_node``); ``--help`` lists the parameters.
+The lifts: a site's (``-p site:=hospital_2l``: each lift serves the levels of its lobbies,
+lowest first by elevation), or ``lifts`` that all serve ``levels``. Run: ``pmnav-sim-lift
+--ros-args -p site:=hospital_2l`` (or ``python -m pmnav_bt.hardware.sim_lift_node``);
+``--help`` lists the parameters.
 """
 
 from __future__ import annotations
@@ -22,8 +24,9 @@ from pmnav_bt.errors import PmNavError
 from pmnav_bt.hardware.lift_bank import CALL_DELAY_S, DOOR_S, DWELL_S, RIDE_S_PER_LEVEL
 
 PARAMETERS = {
-    "lifts": ("lift1", "the lifts' names, comma-separated (LiftRequest.lift_name)"),
-    "levels": ("L1,L2", "the levels every lift serves, lowest first, comma-separated"),
+    "site": ("", "site file or built-in site whose lifts to simulate; empty: lifts and levels"),
+    "lifts": ("lift1", "without a site: the lifts' names, comma-separated (LiftRequest.lift_name)"),
+    "levels": ("L1,L2", "without a site: the levels every lift serves, lowest first"),
     "start_level": ("", "where the cabins stand at the start; empty: the lowest level"),
     "ride_s_per_level": (RIDE_S_PER_LEVEL, "seconds from one level to the next"),
     "door_s": (DOOR_S, "seconds the door takes to open, or to close"),
@@ -40,6 +43,25 @@ def _names(text: str, what: str) -> list[str]:
     if not names:
         raise PmNavError(f"parameter {what!r}: expected comma-separated names, got {text!r}")
     return names
+
+
+def bank_lifts(p: dict, given: set[str]) -> dict[str, list[str]]:
+    """Each lift's levels, lowest first: the site's lifts (the levels of their lobbies, by
+    elevation), or every one of ``lifts`` serving ``levels``. ``given``: the parameters
+    set on the command line (a site names its own lifts: ``lifts``/``levels`` beside it
+    are an error)."""
+    if not p["site"]:
+        levels = _names(p["levels"], "levels")
+        return {name: levels for name in _names(p["lifts"], "lifts")}
+    from pmnav_bt.map.site import load_site
+
+    both = sorted(given & {"lifts", "levels"})
+    if both:
+        raise PmNavError(f"parameter 'site' names the lifts and their levels; leave out {both}")
+    site = load_site(p["site"])
+    if not site.lifts:
+        raise PmNavError(f"parameter 'site': {site.name} has no lifts")
+    return {lift.id: sorted(lift.levels, key=site.rank) for lift in site.lifts}
 
 
 class SimLiftNode:
@@ -59,9 +81,9 @@ class SimLiftNode:
                 raise PmNavError(f"parameter {name!r}: expected 0.1 to 1000, got {p[name]:g}")
         self._Request = request_type
         clock = node.get_clock()
+        lifts = bank_lifts(p, set(getattr(node, "_parameter_overrides", {}) or {}))
         self.bank = LiftBank(
-            _names(p["lifts"], "lifts"),
-            _names(p["levels"], "levels"),
+            lifts,
             start_level=str(p["start_level"]).strip(),
             ride_s_per_level=float(p["ride_s_per_level"]),
             door_s=float(p["door_s"]),
@@ -79,9 +101,9 @@ class SimLiftNode:
         )
         node.create_timer(1.0 / float(p["step_hz"]), self._publish_changed)
         node.create_timer(1.0 / float(p["publish_hz"]), self._publish_all)
+        served = "; ".join(f"{name} ({', '.join(levels)})" for name, levels in lifts.items())
         self.log.info(
-            f"simulated lifts {', '.join(self.bank.lifts)} serving {', '.join(self.bank.levels)} "
-            f"on {rmf_lift.REQUESTS_TOPIC} -> {rmf_lift.STATES_TOPIC}"
+            f"simulated lifts {served} on {rmf_lift.REQUESTS_TOPIC} -> {rmf_lift.STATES_TOPIC}"
         )
 
     def _on_request(self, msg) -> None:
@@ -114,16 +136,15 @@ class SimLiftNode:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Console script ``pmnav-sim-lift``: ``pmnav-sim-lift --ros-args -p lifts:=lift1
-    -p levels:=L1,L2,L3``."""
+    """Console script ``pmnav-sim-lift``: ``pmnav-sim-lift --ros-args -p site:=hospital_2l``
+    or ``-p lifts:=lift1,lift2 -p levels:=L1,L2,L3``."""
     from pmnav_bt.hardware.params import usage, wants_help
     from pmnav_bt.hardware.runtime import run_node
 
     args = list(sys.argv if argv is None else argv)
     if wants_help(args):
-        print(usage("pmnav-sim-lift", (__doc__ or "").split("\n\n")[0], PARAMETERS,
-                    "pmnav-sim-lift --ros-args -p lifts:=lift1,lift2 -p levels:=L1,L2,L3 "
-                    "-p call_delay_s:=5"))  # fmt: skip
+        example = "pmnav-sim-lift --ros-args -p site:=hospital_2l -p call_delay_s:=5"
+        print(usage("pmnav-sim-lift", (__doc__ or "").split("\n\n")[0], PARAMETERS, example))
         sys.exit(0)
     run_node("pmnav-sim-lift", "sim_lift", args, lambda node, _runtime: SimLiftNode(node))
 

@@ -22,7 +22,8 @@ class Clock:
 
 def bank(clock, **kw):
     args = dict(ride_s_per_level=2.0, door_s=1.0, dwell_s=3.0, call_delay_s=0.0)
-    return LiftBank(["lift1", "lift2"], ["L1", "L2", "L3"], clock=clock, **(args | kw))
+    levels = ["L1", "L2", "L3"]
+    return LiftBank({"lift1": levels, "lift2": levels}, clock=clock, **(args | kw))
 
 
 def at(clock, b, t, lift="lift1"):
@@ -119,14 +120,32 @@ def test_unknown_levels_and_lifts_are_logged_and_ignored():
 @pytest.mark.parametrize(
     "kw, match",
     [
-        (dict(lifts=["a", "a"]), "lift names must be unique"),
-        (dict(levels=["L1", ""]), "level names must be unique and not empty"),
-        (dict(levels=[]), "at least one lift and one level"),
-        (dict(start_level="L7"), "start level 'L7' is not one of"),
+        (dict(lifts={"": ["L1"]}), "lift names must not be empty"),
+        (dict(lifts={"a": ["L1", "L1"]}), "lift a: level names must be unique and not empty"),
+        (dict(lifts={"a": []}), "lift a: level names must be unique and not empty"),
+        (dict(lifts={}), "at least one lift"),
+        (dict(start_level="L3"), "lift b: start level 'L3' is not one of"),
         (dict(ride_s_per_level=-1.0), "ride_s_per_level must be 0 or more"),
     ],
 )
 def test_bad_banks_are_refused_in_one_line(kw, match):
-    args = dict(lifts=["lift1"], levels=["L1", "L2"]) | kw
+    args = dict(lifts={"a": ["L1", "L2", "L3"], "b": ["L1", "L2"]}) | kw
     with pytest.raises(PmNavError, match=match):
-        LiftBank(args.pop("lifts"), args.pop("levels"), **args)
+        LiftBank(args.pop("lifts"), **args)
+
+
+def test_the_node_takes_a_sites_lifts_or_its_own_list():
+    from pmnav_bt.hardware.sim_lift_node import PARAMETERS, bank_lifts
+
+    p = {name: default for name, (default, _) in PARAMETERS.items()}
+    assert bank_lifts(p | {"lifts": "a, b", "levels": "G,M"}, set()) == {
+        "a": ["G", "M"], "b": ["G", "M"]
+    }  # fmt: skip
+    site = p | {"site": "hospital_2l"}
+    assert bank_lifts(site, {"site"}) == {"lift1": ["L1", "L2"], "lift2": ["L1", "L2"]}
+    with pytest.raises(PmNavError, match=r"leave out \['levels'\]"):
+        bank_lifts(site, {"site", "levels"})
+    with pytest.raises(PmNavError, match="fig2_hospital has no lifts"):
+        bank_lifts(p | {"site": "fig2_hospital"}, {"site"})
+    with pytest.raises(PmNavError, match="parameter 'lifts': expected comma-separated"):
+        bank_lifts(p | {"lifts": " , "}, {"lifts"})

@@ -113,8 +113,8 @@ def test_ride_and_session_conflict_over_dds(lifts):
 
 def test_pmnav_ros_hears_the_lifts_with_the_lifts_parameter(domain_id, tmp_path, probe):
     """``pmnav-ros -p lifts:=true`` runs the lift client: its status says what each lift
-    said on /lift_states."""
-    sim = Proc("pmnav_bt.hardware.sim_lift_node", dict(levels="G,M"), domain_id,
+    of the simulated two-level hospital said on /lift_states."""
+    sim = Proc("pmnav_bt.hardware.sim_lift_node", dict(site="hospital_2l"), domain_id,
                tmp_path / "sim_lift.log")  # fmt: skip
     ctl = Proc("pmnav_bt.hardware.node", {"lifts": True}, domain_id, tmp_path / "pmnav.log")
     try:
@@ -122,7 +122,7 @@ def test_pmnav_ros_hears_the_lifts_with_the_lifts_parameter(domain_id, tmp_path,
             lambda: (probe.status or {}).get("lifts", {}).get(LIFT), 90.0, "lift1 in the status",
             procs=(sim, ctl),
         )  # fmt: skip
-        assert st == "at G, to G, door closed, stopped, session none"
+        assert st == "at L1, to L1, door closed, stopped, session none"
     finally:
         ctl.stop()
         sim.stop()
