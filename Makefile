@@ -21,13 +21,12 @@ $(VENV)/.installed: pyproject.toml
 	$(BIN)/pip install --quiet --no-deps rapidocr-onnxruntime==1.4.4
 	touch $@
 
-# The ROS 2 interface package (NavigateToRoom action), built with rosidl + ament_cmake from
-# PyPI into the venv (~35 s). Needs cmake and a C++ compiler; without them pmnav-ros runs
-# with its goal topics only and the action tests are skipped.
-$(VENV)/.interfaces: $(VENV)/.installed interfaces/build.sh $(wildcard interfaces/pmnav_interfaces/*.*) $(wildcard interfaces/pmnav_interfaces/action/*)
+# The ROS 2 interface packages (Open-RMF's rmf_lift_msgs, the NavigateToRoom action, the
+# Create 3's hazard messages), built with rosidl + ament_cmake from PyPI into the venv
+# (~2 min). Needs cmake and a C++ compiler; without them pmnav-ros runs with its goal
+# topics only and the action, hazard and lift tests are skipped.
+$(VENV)/.interfaces: $(VENV)/.installed interfaces/build.sh $(wildcard interfaces/cmake/*.cmake interfaces/*/*.* interfaces/*/action/* interfaces/*/msg/*)
 	interfaces/build.sh $(VENV) && touch $@ || echo "make: interface packages not built (see above); what needs them is unavailable"
-# irobot_create_msgs: the Create 3's hazard messages (without it the body ignores hazards)
-$(VENV)/.interfaces: interfaces/cmake/pypi_wheels.cmake $(wildcard interfaces/irobot_create_msgs/*.* interfaces/irobot_create_msgs/msg/*)
 
 demo: setup
 	mkdir -p $(OUT)

@@ -9,6 +9,9 @@
   --help) and ``recorder`` (--record FILE.mcap); ``goal``: ``pmnav-ros-goal``;
   ``launcher``: ``pmnav-launch``, what launch/pmnav.launch.py does without launch_ros;
 - ``sim_create3``: ``pmnav-sim-create3``, the pybullet simulator behind the robot's topics;
+- lifts over Open-RMF's lift protocol: ``rmf_lift`` (topics, rmf_lift_msgs conversions),
+  ``lift_client`` (``RosLiftClient``, a ``seams.Lift``; ``pmnav-ros -p lifts:=true``),
+  ``lift_bank`` (simulated lifts in time) and ``sim_lift_node`` (``pmnav-sim-lift``);
 - ``env``, ``runtime``, ``qos``, ``messages``, ``testing``: environment, executor, QoS,
   message conversions, subprocess helpers.
 

@@ -1,6 +1,6 @@
 """The ``navigate_to_room`` action (pmnav_interfaces/action/NavigateToRoom), like Nav2's
 NavigateToPose: a goal (a room, or a pose taken to the nearest door), feedback at least
-once a second (phase, plan step, distance remaining, recoveries, elapsed, pose),
+once a second (phase, plan step, distance remaining, recoveries, elapsed, pose, level),
 cancel, and a result with a numeric ``error_code`` and an ``error_msg``.
 
 The execute callback is a coroutine: it hands a GoalRequest to the mission loop (which
@@ -60,6 +60,7 @@ def feedback_message(p: dict, pose_msg=None):
     fb.distance_remaining = float("nan") if d is None else float(d)
     fb.number_of_recoveries = int(p.get("recoveries", 0))
     fb.navigation_time = _duration(float(p.get("elapsed", 0.0)))
+    fb.level = str(p.get("level", ""))
     if pose_msg is not None:
         fb.current_pose = pose_msg
     return fb

@@ -90,6 +90,7 @@ def _feedback_dict(fb) -> dict:
         "distance_remaining": float(fb.distance_remaining),
         "recoveries": int(fb.number_of_recoveries),
         "elapsed": nav.sec + nav.nanosec * 1e-9,
+        "level": fb.level,
     }
 
 
@@ -118,7 +119,7 @@ def _result_dict(goal: str, res, status: int) -> dict:
 
 
 class _Progress:
-    """Prints feedback lines: on a new step or phase, else at most every ``every`` s."""
+    """Prints feedback lines: on a new step, phase or level, else at most every ``every`` s."""
 
     def __init__(self, quiet: bool, every: float = 2.0) -> None:
         self.quiet, self.every = quiet, every
@@ -130,7 +131,7 @@ class _Progress:
         if self.quiet:
             return
         fb = _feedback_dict(msg.feedback)
-        key = (fb["phase"], fb["current_step"])
+        key = (fb["phase"], fb["current_step"], fb["level"])
         now = time.monotonic()
         if key != self._last[1] or now - self._last[0] >= self.every:
             self._last = (now, key)

@@ -17,7 +17,9 @@ API (all standard messages; names relative to the node's namespace):
   failure ``{"code", "message"}`` when recoveries failed after it, else null.
 - out ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, ``status_hz``) and ``status``
   (std_msgs/String, JSON): ready or the missing inputs, idle/running, the goal,
-  sensor ages, the current fault.
+  sensor ages, the current fault; with ``lifts``, what each lift last said.
+- with ``lifts``: the building's lifts over Open-RMF's ``/lift_requests`` and
+  ``/lift_states`` (``hardware/lift_client.py``, a ``seams.Lift``: ``self.lift``).
 - out ``tree`` (std_msgs/String, JSON): one snapshot per tick (statuses, feedback,
   blackboard changes, the view entry; the format of ``pmnav tree replay``);
   ``tree/structure`` (latched) holds the tree's nodes.
@@ -107,6 +109,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "view_port": (0, "serve the live web view (pmnav view) on this port; 0: none"),
     "view_host": ("127.0.0.1", "address of the web view; only loopback unless view_allow_remote"),
     "view_allow_remote": (False, "let view_host be an address other machines reach"),
+    "lifts": (
+        False, "use the building's lifts: requests on /lift_requests, states from "
+        "/lift_states (Open-RMF's rmf_lift_msgs; hardware/lift_client.py)",
+    ),
     "status_hz": (1.0, "status topic rate"),
     "viz_hz": (2.0, "pose, trajectory and map -> odom publish rate"),
 }
@@ -288,6 +294,7 @@ class PmNavController:
         node.create_subscription(PoseStamped, "goal_pose", self._on_goal_pose, ev)
         node.create_subscription(Empty, "cancel", self._on_cancel, ev)
         node.create_timer(1.0 / max(0.1, float(p["status_hz"])), self._publish_status)
+        self.lift = self._lift_client(p)
         self.action = None
         if action_server.available():
             self.action = action_server.NavigateActionServer(
@@ -319,6 +326,17 @@ class PmNavController:
 
     def _stamp(self):
         return self.node.get_clock().now().to_msg()
+
+    def _lift_client(self, p: dict[str, Any]):
+        """The lift system over Open-RMF's topics (``seams.Lift``) with ``lifts``, else None."""
+        if not p["lifts"]:
+            return None
+        from pmnav_bt.hardware.lift_client import RosLiftClient
+
+        try:
+            return RosLiftClient(self.node)
+        except PmNavError as err:
+            raise PmNavError(f"parameter 'lifts': {err}") from None
 
     def _start_view(self, p: dict[str, Any]):
         """The web view's server and the queue the snapshots reach it by (None, None
@@ -603,6 +621,8 @@ class PmNavController:
             "fault": str(fault) if fault is not None else None,
             "motion": self.base.motion_status().value,
         }
+        if self.lift is not None:
+            status["lifts"] = self.lift.summary()
         per = sorted(self.base.cmd_periods()[-1000:])
         if per:
             status["cmd_period_ms"] = {

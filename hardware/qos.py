@@ -14,6 +14,10 @@
   (RViz, a test) needs once: the plan, the map markers, segmentation labels,
   the tree's structure.
 - ``events()``: reliable, volatile, keep last 10: goals, results, status, snapshots.
+- ``lift_requests()``: reliable, transient local, keep last 100: Open-RMF's lift requests,
+  as its fleet adapter and lift supervisor publish them (a lift adapter subscribes
+  volatile, which matches); ``lift_states()``: reliable, volatile, keep last 100, as
+  RMF's lifts publish their states and its adapters read them.
 """
 
 from __future__ import annotations
@@ -46,6 +50,14 @@ def latched():
 
 def events(depth: int = 10):
     return _reliable(depth=depth, transient_local=False)
+
+
+def lift_requests():
+    return _reliable(depth=100, transient_local=True)
+
+
+def lift_states():
+    return _reliable(depth=100, transient_local=False)
 
 
 def _reliable(depth: int, transient_local: bool):

@@ -84,7 +84,8 @@ def _plan_distance(plan, index: int, pose: Pose2D | None) -> float:
 def progress(bb: Callable[[str], Any], map_pose: Pose2D | None, elapsed: float) -> dict:
     """Feedback fields from the blackboard reader ``bb(key)`` and the estimated map pose.
 
-    phase: localizing (no map_T_odom yet), planning (no plan), navigating.
+    phase: localizing (no map_T_odom yet), planning (no plan), navigating. level: the
+    blackboard's ``level`` (the site's level the robot is on; "" in a one-level building).
     """
     plan = bb("plan")
     m = bb("map_T_odom")
@@ -99,6 +100,7 @@ def progress(bb: Callable[[str], Any], map_pose: Pose2D | None, elapsed: float) 
         "distance_remaining": math.nan,
         "recoveries": replans + max(0, fixes - 1),
         "elapsed": elapsed,
+        "level": str(bb("level") or ""),
     }
     if plan is not None:
         n = len(plan.steps)
@@ -115,6 +117,8 @@ def progress(bb: Callable[[str], Any], map_pose: Pose2D | None, elapsed: float) 
 def progress_line(p: dict) -> str:
     """One line for people: ``navigating step 3/7 {room8: go straight}, 21.4 m to go, ...``."""
     parts = [p.get("phase", "")]
+    if p.get("level"):
+        parts.append(f"level {p['level']}")
     if p.get("step_text") and not p.get("step_count"):
         parts.append(p["step_text"])
     if p.get("step_count"):

@@ -8,7 +8,8 @@
 # (rosidl generators, ament_cmake, catkin_pkg). The Python packages land in PREFIX's
 # site-packages, their libraries in PREFIX/lib (on the path the ROS wheels' bootstrapper
 # sets). Each package is built on its own: one that fails is named at the end (exit 1),
-# and the others are installed all the same.
+# and the others are installed all the same. PMNAV_INTERFACES_BUILD: the folder the
+# builds and their logs go to (default: build/).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 prefix="$(cd "${1:-$here/../.venv}" && pwd)"
@@ -16,6 +17,7 @@ py="$prefix/bin/python"
 builds="${PMNAV_INTERFACES_BUILD:-$here/../build}"
 # The packages, built in this order (a folder here each):
 packages=(
+    rmf_lift_msgs       # Open-RMF's LiftRequest/LiftState (Apache-2.0, see its NOTICE.md)
     pmnav_interfaces    # the NavigateToRoom action
     irobot_create_msgs  # the Create 3's hazard messages (iRobot's definitions, BSD-3-Clause)
 )

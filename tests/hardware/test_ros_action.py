@@ -151,6 +151,7 @@ class TestLaunched:
         nav = [fb for _, fb in feedback if fb.phase == "navigating"]
         assert nav[0].step_count >= 1 and nav[0].current_step >= 1
         assert nav[-1].distance_remaining < nav[0].distance_remaining
+        assert {fb.level for _, fb in feedback} == {""}  # one level: no level named
         state["succeeded"] = True
 
     def test_cancel_midway_stops_the_base(self, launched):
@@ -308,6 +309,7 @@ def test_unknown_parameter_names_the_closest(domain_id, tmp_path):
         "pmnav_bt.hardware.sim_create3",
         "pmnav_bt.hardware.goal",
         "pmnav_bt.hardware.launcher",
+        "pmnav_bt.hardware.sim_lift_node",
     ],  # fmt: skip
 )
 def test_help_prints_usage_without_starting_a_node(module, ros_required):

@@ -80,13 +80,17 @@ def _plan():
 def test_progress_reads_step_distance_and_recoveries():
     bb = {"plan": _plan(), "map_T_odom": (0, 0, 0), "step_index": 0, "replans": 1}
     bb["fix_attempts"] = 2
+    bb["level"] = "L2"
     p = progress(bb.get, Pose2D(4.0, 0.0, 0.0), 12.0)
     assert p["phase"] == "navigating" and (p["current_step"], p["step_count"]) == (1, 2)
     assert p["distance_remaining"] == pytest.approx(6.0 + 5.0 + 1.0)
     assert p["recoveries"] == 2 and p["step_text"] == "{a: go straight}"
-    assert "step 1/2 {a: go straight}, 12.0 m to go, 2 recoveries" in progress_line(p)
+    assert p["level"] == "L2"
+    line = progress_line(p)
+    assert "navigating, level L2, step 1/2 {a: go straight}, 12.0 m to go, 2 recoveries" in line
     p = progress({}.get, None, 1.0)
     assert p["phase"] == "localizing" and math.isnan(p["distance_remaining"])
+    assert p["level"] == "" and "level" not in progress_line(p)  # one level: none named
 
 
 def test_diagnostics_levels(ros_required):
