@@ -23,6 +23,7 @@ those after it on the level reached (``ctx_to``). Timeouts are clock seconds of 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 
@@ -31,6 +32,7 @@ from py_trees.behaviours import Failure as AlwaysFail
 from py_trees.common import Access
 from py_trees.composites import Selector
 
+from pmnav_bt.backends import Backends
 from pmnav_bt.behaviours.belief import FixFromBelief, UpdateBelief
 from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
@@ -50,9 +52,12 @@ from pmnav_bt.behaviours.lift import (
 from pmnav_bt.behaviours.recovery import FailureIs, Spin, Wait
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.map.building import Building
+from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.seams import Lift
 from pmnav_bt.trees.localize import active_localize_subtree, panorama_subtree
+from pmnav_bt.trees.map_watch import watch_misreads
 from pmnav_bt.trees.mission import sequence
+from pmnav_bt.trees.runner import make_context
 
 
 def lift_subtree(
@@ -134,3 +139,28 @@ def lift_subtree(
             ),
         ],
     )
+
+
+def level_context(
+    ctx: Context,
+    pm: PrioriMap,
+    seed: int = 0,
+    *,
+    on_robot: bool = False,
+    backends: Backends | None = None,
+    grid=None,
+) -> Context:
+    """``ctx`` on another level: the same body, worker, trace, odometer, budget and map
+    updates; that level's map, back ends (the grounder reads that level's signs), detour
+    check and walls (``make_context``'s wiring: ``backends``, ``grid`` as there)."""
+    level = make_context(
+        ctx.base, pm, ctx.config, seed, ctx.budget_actions, on_robot=on_robot, backends=backends,
+        grid=grid,
+    )  # fmt: skip
+    level.worker.shutdown()
+    level = dataclasses.replace(
+        level, worker=ctx.worker, trace=ctx.trace, odometer=ctx.odometer,
+        map_updates=ctx.map_updates, misreads=None,
+    )  # fmt: skip
+    watch_misreads(level)
+    return level

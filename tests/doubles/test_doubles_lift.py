@@ -7,11 +7,11 @@ import dataclasses
 import math
 
 import pytest
+from building_kit import as_floor
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.lift import Ride
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.map.building import Building
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.lift_doorway import doorway
 from pmnav_bt.map.priori_map import parse_building
@@ -24,17 +24,6 @@ START = Pose2D(4.5, 0.0, math.pi)  # straight_office, just past Lift A, facing i
 MAX_TICKS = 8000
 
 
-def floor(building: Building, n: int) -> Building:
-    """``building`` as floor ``n`` of a tower: the same corridors, its rooms numbered
-    n01... ("301" on the third floor, "401" on the fourth), as real floors are."""
-    data = building.model_dump()
-    data["name"] = f"{building.name}_{n}"
-    for room in data["rooms"]:
-        room["sign"] = f"{n}{room['sign'][1:]}"
-        room["name"] = room["name"].replace(room["name"].split()[-1], room["sign"])
-    return Building.model_validate(data)
-
-
 @pytest.fixture(scope="module")
 def building():
     return load_building("straight_office")  # its rooms are 301..., the third floor
@@ -42,7 +31,7 @@ def building():
 
 @pytest.fixture(scope="module")
 def levels(building):
-    return {"L3": building, "L4": floor(building, 4), "L5": floor(building, 5)}
+    return {"L3": building, "L4": as_floor(building, 4), "L5": as_floor(building, 5)}
 
 
 def ride_rig(make_rig, levels, *, arrive_reads: str = "L4", overrides=(), **lift):
