@@ -250,7 +250,7 @@ def _loc(loc: tuple) -> str:
     return out
 
 
-def _pydantic_problems(err: ValidationError) -> list[Problem]:
+def pydantic_problems(err: ValidationError) -> list[Problem]:
     problems = []
     for e in err.errors():
         msg = e["msg"]
@@ -401,7 +401,7 @@ def building_from_data(data: Any, source: str = "<data>", base_dir: Path | None 
     try:
         b = Building.model_validate(data)
     except ValidationError as err:
-        raise BuildingFileError(source, _pydantic_problems(err)) from None
+        raise BuildingFileError(source, pydantic_problems(err)) from None
     problems = semantic_problems(b, base_dir)
     if problems:
         raise BuildingFileError(source, problems)

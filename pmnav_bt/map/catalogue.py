@@ -71,15 +71,22 @@ def open_building(name_or_path: str | Path) -> Building:
     map is refused by each of them alike, not only by the ones that draw or drive in it."""
     path = resolve_building_path(name_or_path)
     b = read_building_file(path)
-    if b.floor_plan is not None:
-        from pmnav_bt.map.floorplan import FloorPlanError, load_floor_plan  # imports cv2
-
-        try:
-            load_floor_plan(b, path.parent)
-        except FloorPlanError as err:
-            field = "floor_plan.ros_map" if b.floor_plan.ros_map else "floor_plan.image"
-            raise BuildingFileError(str(path), [Problem(field, str(err))]) from None
+    check_floor_plan(b, path)
     return b
+
+
+def check_floor_plan(b: Building, path: Path) -> None:
+    """Open and decode the floor plan of the building read from ``path``, when it has one;
+    a broken image or ROS map is a BuildingFileError naming the field."""
+    if b.floor_plan is None:
+        return
+    from pmnav_bt.map.floorplan import FloorPlanError, load_floor_plan  # imports cv2
+
+    try:
+        load_floor_plan(b, path.parent)
+    except FloorPlanError as err:
+        field = "floor_plan.ros_map" if b.floor_plan.ros_map else "floor_plan.image"
+        raise BuildingFileError(str(path), [Problem(field, str(err))]) from None
 
 
 def builtin_buildings() -> list[str]:

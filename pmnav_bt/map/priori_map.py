@@ -31,7 +31,7 @@ MERGE_TOLERANCE = 0.6
 _NATURAL = re.compile(r"(\d+)")
 
 
-def _clipped(text: str, n: int = 40) -> str:
+def clipped(text: str, n: int = 40) -> str:
     """``text`` cut to ``n`` characters for a message (a typed name can be any length)."""
     return text if len(text) <= n else text[: n - 3] + "..."
 
@@ -158,7 +158,7 @@ class PrioriMap:
                 )
         names = [s.name for s in self.segments]
         raise UnknownNameError(
-            f"unknown segment {_clipped(str(ref))!r}: this map has seg1 to seg{len(names)}",
+            f"unknown segment {clipped(str(ref))!r}: this map has seg1 to seg{len(names)}",
             names[:5],
         )
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import networkx as nx
 import numpy as np
 
-from pmnav_bt.errors import PlanningError
+from pmnav_bt.errors import PlanningError, UnknownNameError
 from pmnav_bt.geometry import Action, heading, relative_action, wrap_angle
 from pmnav_bt.map.landmark_kinds import landmark_shape
 from pmnav_bt.map.priori_map import PrioriMap
@@ -52,6 +52,27 @@ class GraphPlanner:
         intermediate step and no segment in ``constraints.blocked_segments``."""
         goal_id = resolve_room(pm, goal)
         sp = start if isinstance(start, StartPoint) else resolve_start(pm, start)
+        return self._route_plan(pm, sp, goal_id, constraints)
+
+
+    def plan_to_landmark(
+        self,
+        pm: PrioriMap,
+        start: SeamStart | StartPoint,
+        landmark_id: str,
+        constraints: PlanConstraints = PlanConstraints(),
+    ) -> Plan:
+        """Plan from ``start`` to the landmark ``landmark_id`` (an id of the map, such as a
+        lift's lobby), as ``plan`` plans to a room: the last step arrives at it."""
+        place = pm.places.get(landmark_id)
+        if place is None or landmark_id not in pm.nodes[place.node].landmarks:
+            raise UnknownNameError(f"no landmark {landmark_id!r} in {pm.building.name}")
+        sp = start if isinstance(start, StartPoint) else resolve_start(pm, start)
+        return self._route_plan(pm, sp, landmark_id, constraints)
+
+    def _route_plan(
+        self, pm: PrioriMap, sp: StartPoint, goal_id: str, constraints: PlanConstraints
+    ) -> Plan:
         blocked = constraints.blocked_segments
         graph = pm.graph
         if blocked:
@@ -158,6 +179,8 @@ def _target_of(
     b = pm.building
     if goal_id in n.rooms:
         return goal_id, b.room(goal_id).door
+    if goal_id in n.landmarks:  # a landmark goal: a leg of a plan across levels ends at a lift
+        return goal_id, b.landmark(goal_id).pos
     for rid in n.rooms:
         if rid not in avoid:
             return rid, b.room(rid).door
@@ -321,14 +344,15 @@ def build_plan(
             )
         )
         prev_cum = cum[i]
-    room = pm.building.room(goal_id)
+    goal_room = goal_id in pm.nodes[pm.places[goal_id].node].rooms
+    goal = pm.building.room(goal_id) if goal_room else pm.building.landmark(goal_id)
     return Plan(
         building=pm.building.name,
         start=PlanStart(
             sp.description, sp.segment.name, (float(start_xy[0]), float(start_xy[1])), sp.heading
         ),
         goal=goal_id,
-        goal_name=room.display_name,
+        goal_name=goal.display_name,
         steps=tuple(steps),
         nodes=tuple(nodes),
         path=tuple((float(p[0]), float(p[1])) for p in [start_xy] + [pm.node_xy(n) for n in nodes]),
@@ -336,4 +360,5 @@ def build_plan(
         initial_action=initial,
         planner=planner,
         notes=tuple(notes),
+        goal_kind="room" if goal_room else "landmark",
     )

@@ -65,11 +65,11 @@ class PlanStart:
 
 @dataclass(frozen=True)
 class Plan:
-    """A global plan from a start to a goal room."""
+    """A global plan from a start to a goal room (or a landmark: a lift's lobby)."""
 
     building: str
     start: PlanStart
-    goal: str  # room id
+    goal: str  # room id (a landmark id where goal_kind is "landmark")
     goal_name: str
     steps: tuple[PlanStep, ...]
     nodes: tuple[str, ...]  # the map nodes passed, in order
@@ -78,6 +78,7 @@ class Plan:
     initial_action: Action  # to face the first segment from the start heading
     planner: str = "graph"
     notes: tuple[str, ...] = field(default=())
+    goal_kind: str = "room"  # "landmark": a leg of a plan across levels, to a lift's lobby
 
     def text(self) -> str:
         """Human-readable plan, one step per line."""
@@ -123,7 +124,7 @@ class Plan:
             "building": self.building,
             "planner": self.planner,
             "start": start,
-            "goal": {"room": self.goal, "name": self.goal_name},
+            "goal": {self.goal_kind: self.goal, "name": self.goal_name},
             "length_m": round(self.length, 3),
             "initial_action": self.initial_action.value,
             "steps": steps,

@@ -17,7 +17,8 @@ import numpy as np
 from pmnav_bt.cli_values import MAX_POSE_COORD_M
 from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.map.building import Building
-from pmnav_bt.map.priori_map import PrioriMap, Segment
+from pmnav_bt.map.priori_map import PrioriMap, Segment, clipped
+from pmnav_bt.map.site_map import SiteMap
 from pmnav_bt.seams import Entity, EntityKind, PlanStart, Pose2D
 
 
@@ -65,6 +66,73 @@ def resolve_room(pm: PrioriMap, name: str) -> str:
     cands = sorted({labels[i] for k in close for i in keys[k]})
     hint = f"; closest: {', '.join(cands)}" if cands else ""
     raise UnknownNameError(f"no room called {name!r} in {pm.building.name}{hint}", cands)
+
+
+def resolve_site_room(sm: SiteMap, name: str) -> tuple[str, str]:
+    """The level and the ID of the room a person means by ``name`` in a site of several
+    levels: a name found on one level only ("pharmacy"), or qualified by its level
+    ("L2/toilets", "toilets on L2", "toilets on level L2"). A name on several levels is an
+    UnknownNameError that lists them and how to qualify it."""
+    site = sm.site
+    if sm.single:
+        level = site.levels[0].name
+        return level, resolve_room(sm.maps[level], name)
+    qualified = _qualified(sm, name)
+    if qualified is not None:
+        level, room = qualified
+        return level, resolve_room(sm.maps[level], room)
+    key = normalise(name)
+    found = {lv: ids for lv, pm in sm.maps.items() if (ids := _index(pm)[0].get(key, set()))}
+    if len(found) == 1:
+        level = next(iter(found))
+        return level, resolve_room(sm.maps[level], name)
+    shown = clipped(name)
+    if found:
+        where = "; ".join(
+            f"{lv} ({', '.join(sorted(_index(sm.maps[lv])[1][i] for i in ids))})"
+            for lv, ids in found.items()
+        )
+        lv = next(iter(found))
+        raise UnknownNameError(
+            f"room name {shown!r} is on {len(found)} levels: {where}; give its level: "
+            f"'{lv}/{shown}' or '{shown} on {lv}'",
+            [f"{lv}/{i}" for lv, ids in found.items() for i in sorted(ids)],
+        )
+    cands: list[str] = []
+    for lv, pm in sm.maps.items():
+        try:
+            resolve_room(pm, name)
+        except UnknownNameError as err:
+            if "is a landmark" in str(err):
+                raise UnknownNameError(f"{str(err)} (on level {lv})") from None
+            cands += [f"{lv}/{c}" for c in err.candidates]
+    hint = f"; closest: {', '.join(cands[:8])}" if cands else ""
+    raise UnknownNameError(f"no room called {shown!r} on any level of {site.name}{hint}", cands)
+
+
+_ON_LEVEL = re.compile(r"(?is)\s*(.+?)\s+on\s+(?:level\s+)?(\S+)\s*")
+
+
+def _qualified(sm: SiteMap, name: str) -> tuple[str, str] | None:
+    """(level, room name) of a name qualified by a level of the site, else None."""
+    head, sep, tail = name.partition("/")
+    if sep and head.strip() and tail.strip():
+        level = _site_level(sm, head.strip())
+        if level is not None:
+            return level, tail.strip()
+    m = _ON_LEVEL.fullmatch(name)
+    if m:
+        level = _site_level(sm, m.group(2))
+        if level is not None:
+            return level, m.group(1)
+    return None
+
+
+def _site_level(sm: SiteMap, text: str) -> str | None:
+    try:
+        return sm.site.level(text).name
+    except UnknownNameError:
+        return None
 
 
 @dataclass(frozen=True)

@@ -18,12 +18,14 @@ import pytest
 from fuzzkit import TRIED
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from site_kit import two_level_site
 
 from pmnav_bt.config import load_config
 from pmnav_bt.errors import BuildingFileError, ConfigError, PmNavError
 from pmnav_bt.map.building import building_from_data
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.floorplan import FloorPlanError, load_ros_map, read_image
+from pmnav_bt.map.site import load_site, site_from_data
 from pmnav_bt.sim.episodes import EPISODES_SCHEMA_VERSION, EpisodeFileError, load_episodes
 from pmnav_bt.treelog import read_tree_log
 
@@ -127,6 +129,45 @@ def test_building_with_one_odd_value(where, value):
     for w in b.waypoints:
         assert all(math.isfinite(v) and abs(v) <= 1000 for v in w.pos)
     assert 0 < b.corridor_width <= 50 and 0 < b.wall_height <= 20
+
+
+# -- site files (levels and lifts) ---------------------------------------------------------
+
+SITE = two_level_site()
+SITE_LEAVES = [p for p in _leaf_paths(SITE) if p]
+
+
+@FUZZ
+@given(where=st.sampled_from(SITE_LEAVES), value=ODD_VALUES)
+def test_site_with_one_odd_value(where, value):
+    TRIED["site data: one value replaced"] += 1
+    data = copy.deepcopy(SITE)
+    d = data
+    for k in where[:-1]:
+        d = d[k]
+    d[where[-1]] = value
+    try:
+        site = site_from_data(data, "s.yaml")
+    except BuildingFileError as err:
+        _one_line_naming(err, "s.yaml")
+        return
+    # What loads holds together: every lobby is a lift landmark of its level.
+    for lift in site.lifts:
+        assert len(lift.lobbies) >= 2
+        for level, lobby in lift.lobbies.items():
+            assert site.level(level).building.landmark(lobby).kind == "elevator"
+
+
+@FUZZ
+@given(text=YAMLISH)
+def test_site_from_yamlish_text(tmp_path, text):
+    TRIED["site file: YAML-like text"] += 1
+    f = tmp_path / "s.yaml"
+    f.write_text("site_version: 1\n" + text, encoding="utf-8")
+    try:
+        load_site(f)
+    except BuildingFileError as err:
+        _one_line_naming(err, "s.yaml")
 
 
 # -- config ------------------------------------------------------------------------------
