@@ -134,8 +134,12 @@ def run_tree(
     sync_workers: bool = True,
     tick_durations: list[float] | None = None,
     view: ViewRecorder | None = None,
+    build: Callable[[Context, str], py_trees.trees.BehaviourTree] | None = None,
 ) -> RunOutcome:
     """Build the tree for ``goal`` and tick it until it succeeds or fails.
+
+    ``build``: how to build it (default ``build_tree``, the config's tree variant; the
+    mission across levels: ``trees.site.build_site_tree``), after the blackboard is cleared.
 
     ``tick_durations`` (optional) collects the wall time of every tick, in seconds.
     ``log``: write the tree log here, each tick's ``view`` entry made by ``view`` (default
@@ -144,7 +148,7 @@ def run_tree(
     py_trees.blackboard.Blackboard.clear()
     if log is not None and view is None:
         view = ViewRecorder(ctx)
-    tree = build_tree(ctx, goal)
+    tree = (build or build_tree)(ctx, goal)
     if log is not None:
         tree.add_post_tick_handler(SnapshotLogger(tree, log, ctx.now, view=view, goal=goal))
     period = 1.0 / ctx.config.tree.tick_hz
