@@ -50,6 +50,14 @@ class Doorway:
         d = wall + CABIN_DEPTH_M / 2.0
         return self.centre[0] + d * self.into[0], self.centre[1] + d * self.into[1]
 
+    def cabin_corners(self, wall: float = DOORWAY_WALL_M) -> list[tuple[float, float]]:
+        """The cabin's floor, four corners (for drawing it)."""
+        u = np.asarray(self.into)
+        v = np.array([-u[1], u[0]]) * CABIN_WIDTH_M / 2.0
+        near = np.asarray(self.centre) + u * wall
+        far = near + u * CABIN_DEPTH_M
+        return [(float(q[0]), float(q[1])) for q in (near - v, far - v, far + v, near + v)]
+
     def cabin_pose(self, wall: float = DOORWAY_WALL_M) -> Pose2D:
         """The robot in the middle of the cabin, turned round to face the doors."""
         x, y = self.cabin_centre(wall)
