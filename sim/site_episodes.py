@@ -27,6 +27,11 @@ from pmnav_bt.seams import Pose2D
 from pmnav_bt.sim.episodes import _candidates
 
 CROSS_LEVEL = "cross_level"  # the tier of an episode whose goal is on another level
+# The actions a lift ride adds to an episode's budget (eval/task.py's rule for the legs):
+# to the lobby, into the cabin, round, out, and on arrival a localization from scratch
+# (a panorama of 6-12 views and a fix, as at the start). One ride in hospital_2l's
+# realistic world took 66 (the lobby to the fix on the next level).
+RIDE_ACTIONS = 100
 
 
 class SiteEpisodeError(PmNavError):
@@ -56,7 +61,8 @@ class SiteEpisode:
 
     @property
     def step_budget(self) -> int:
-        return action_budget(self.route_length)
+        """The default budget rule on the legs' corridors, and ``RIDE_ACTIONS`` a ride."""
+        return action_budget(self.route_length) + RIDE_ACTIONS * self.rides
 
 
 def site_map(site: str | Site) -> SiteMap:

@@ -135,11 +135,14 @@ def run_tree(
     tick_durations: list[float] | None = None,
     view: ViewRecorder | None = None,
     build: Callable[[Context, str], py_trees.trees.BehaviourTree] | None = None,
+    ended_on: Callable[[], Context] | None = None,
 ) -> RunOutcome:
     """Build the tree for ``goal`` and tick it until it succeeds or fails.
 
     ``build``: how to build it (default ``build_tree``, the config's tree variant; the
-    mission across levels: ``trees.site.build_site_tree``), after the blackboard is cleared.
+    mission across levels: ``trees.site.build_site_tree``), after the blackboard is cleared;
+    ``ended_on``: the context of the level the run ended on, whose map explains a failure
+    (default ``ctx``).
 
     ``tick_durations`` (optional) collects the wall time of every tick, in seconds.
     ``log``: write the tree log here, each tick's ``view`` entry made by ``view`` (default
@@ -185,8 +188,9 @@ def run_tree(
             or _blackboard("failure")
             or Failure(FailureCode.TIMEOUT, f"no result after {tree.count} ticks")
         )
-        if ctx.misreads is not None:  # what was read where the target was not found
-            failure = ctx.misreads.explain(failure, _target_entity(ctx))
+        end = ended_on() if ended_on is not None else ctx
+        if end.misreads is not None:  # what was read where the target was not found
+            failure = end.misreads.explain(failure, _target_entity(end))
     return RunOutcome(
         success=status == py_trees.common.Status.SUCCESS,
         failure=failure,

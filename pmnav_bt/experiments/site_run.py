@@ -42,7 +42,7 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
     from pmnav_bt.sim.lift import SimLift
     from pmnav_bt.sim.odometry import NoisyOdometry
     from pmnav_bt.sim.robot import COLLISION_HEIGHT
-    from pmnav_bt.sim.site_episodes import site_map, site_plan
+    from pmnav_bt.sim.site_episodes import RIDE_ACTIONS, site_map, site_plan
     from pmnav_bt.sim.world import SimWorld
     from pmnav_bt.trees.lift import level_context
     from pmnav_bt.trees.runner import action_budget, make_context, run_tree
@@ -87,7 +87,7 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
                 geodesic = goal_geodesic(pm, ep.goal, feet, floor=w.floor_space())
                 shortest += geodesic.distance(at)
         pm0 = sm.maps[ep.start_level]
-        budget = action_budget(config, ep.route_length)
+        budget = action_budget(config, ep.route_length) + RIDE_ACTIONS * ep.rides
         ctx = make_context(base, pm0, config, seed=ep.seed, budget=budget, deferred_work=True)
         contexts = {ep.start_level: ctx}
         for name, pm in sm.maps.items():
@@ -107,6 +107,7 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
             outcome = run_tree(
                 ctx, plan.goal, log=log, on_tick=record,
                 build=lambda c, g: build_site_tree(contexts, sm, plan, lift),
+                ended_on=lambda: contexts[body.level],
             )  # fmt: skip
         final, level, stats = body.world_pose(), body.level, body.stats
         contacts = sum(w.people.contacts for w in worlds.values())

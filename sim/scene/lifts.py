@@ -16,7 +16,7 @@ in it is the lift's business (``pmnav_bt.sim.lift``).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -26,7 +26,7 @@ from pmnav_bt.map.landmark_kinds import ELEVATOR_PANEL_M, ELEVATOR_WIDTH_M
 from pmnav_bt.map.lift_doorway import CABIN_DEPTH_M, CABIN_WIDTH_M, DOORWAY_WALL_M
 from pmnav_bt.seams import WALL_LABEL, Pose2D
 from pmnav_bt.sim._pybullet import p
-from pmnav_bt.sim.scene.host import BoxWorld
+from pmnav_bt.sim.scene.host import BoxWorld, Doorway
 
 CABIN_RGBA = (0.78, 0.80, 0.82, 1.0)  # brushed steel
 # The cart of a cabin that comes full: a hospital linen or meal trolley, 0.8 m square and
@@ -65,6 +65,21 @@ class CabinWorld(BoxWorld, Protocol):
     def add_obstacle(self, x: float, y: float, size: float, height: float = 1.0) -> int: ...
 
     def remove_obstacle(self, body: int) -> None: ...
+
+
+def open_stretches(doorways: Iterable[Doorway], a, b) -> list[tuple[float, float]]:
+    """The stretches (from, to metres from ``a``) of the wall face from ``a`` to ``b`` that
+    no doorway of ``doorways`` goes through: where a surface may cover the wall."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    length = float(np.linalg.norm(b - a))
+    t = (b - a) / length
+    cuts = []
+    for d in doorways:
+        u = np.asarray(d.centre, float) - a
+        s = float(u @ t)
+        if abs(u[0] * t[1] - u[1] * t[0]) < 0.01 and 0.0 <= s <= length:
+            cuts.append(s)
+    return doorway_cut(length, cuts)
 
 
 @dataclass
