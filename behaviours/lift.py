@@ -32,6 +32,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
@@ -39,12 +40,19 @@ from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import heading, se2_compose, se2_inverse
+from pmnav_bt.geometry import heading, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.lift_doorway import CABIN_DEPTH_M, DOORWAY_WALL_M, Doorway
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.pose.correction import PoseTracker
-from pmnav_bt.seams import CREATE3_RADIUS_M, Lift, LiftDoor, LiftMotion, MotionStatus
+from pmnav_bt.seams import (
+    CREATE3_RADIUS_M,
+    Lift,
+    LiftDoor,
+    LiftMotion,
+    MotionStatus,
+    Pose2D,
+)
 
 # Through the doorway at a walking pace for a tight place: a third of the Create 3's limit.
 DOORWAY_SPEED = 0.1  # m/s
@@ -54,6 +62,9 @@ DOORWAY_TIMEOUT_S = 40.0
 # The cabin has room when depth shows its floor free this far past the robot's footprint
 # at the cabin's middle, the width of the robot and this margin each side.
 CABIN_MARGIN_M = 0.1
+# The way into the cabin is looked for over these bearings of the 60-degree camera.
+SCAN_HALF = math.radians(27.5)
+SCAN_STEP = math.radians(2.5)
 # The estimate on arrival: the cabin on the new level's map, as sure as the ride put the
 # robot there (it drove in on the old level's estimate, a few tenths of a metre off).
 ARRIVAL_SIGMA_M = 0.5
@@ -182,23 +193,54 @@ class WaitForLift(PmNavBehaviour):
         return Status.RUNNING
 
 
-def cabin_reach(d: Doorway) -> float:
-    """How far from the lobby point the cabin's floor must be free: to its middle, and a
-    robot's radius and a margin past it."""
-    to_wall = math.dist(d.lobby, d.centre)
-    return to_wall + DOORWAY_WALL_M + CABIN_DEPTH_M / 2.0 + CREATE3_RADIUS_M + CABIN_MARGIN_M
+@dataclass(frozen=True)
+class CabinLook:
+    """What depth shows through a lift's open doors: ``way`` in (the bearing, rad from the
+    frame's heading, and the metres along it to the cabin's middle), None when there is
+    none; ``beyond``: whether anything is seen past the doors' plane (an open doorway in
+    view: no way in then means a full cabin, not a wall)."""
+
+    way: tuple[float, float] | None
+    beyond: bool
+
+
+def look_into_cabin(obs, est: Pose2D, d: Doorway) -> CabinLook:
+    """Scan the frame's bearings (``SCAN_HALF``, every ``SCAN_STEP``) for a way into the
+    cabin's middle: one along which depth shows the floor free (the robot's width and
+    ``CABIN_MARGIN_M`` each side) to the middle's depth and a radius and margin past it.
+    The way is the middle of those that pass, so that an estimate a little off along the
+    corridor still finds the doorway (the doors are 1.6 m wide). ``est``: the map pose
+    the frame was taken from."""
+    u = np.asarray(d.into, float)
+    to_wall = float(np.dot(np.subtract(d.centre, (est.x, est.y)), u))
+    middle = to_wall + DOORWAY_WALL_M + CABIN_DEPTH_M / 2.0
+    half = CREATE3_RADIUS_M + CABIN_MARGIN_M
+    passing, deepest = [], 0.0
+    for b in np.arange(-SCAN_HALF, SCAN_HALF + 1e-9, SCAN_STEP):
+        off = wrap_angle(est.yaw + b - d.yaw_in)
+        if abs(off) >= math.radians(60.0):
+            continue
+        reach = middle / math.cos(off)
+        free = free_distance(obs, float(b), half_width=half)
+        deepest = max(deepest, min(free, 10.0) * math.cos(off))
+        if free >= reach + half:
+            passing.append((float(b), reach))
+    way = passing[len(passing) // 2] if passing else None
+    return CabinLook(way, deepest > to_wall + DOORWAY_WALL_M + 0.2)
 
 
 class CabinHasRoom(PmNavBehaviour):
-    """Look into the open cabin: SUCCESS when depth shows its floor free from the doors to
-    past its middle, as wide as the robot and a margin (``cabin_reach``); else FAILURE
-    (LIFT_FULL), counting the full cabins of this ride in ``lift_full_seen`` and saying how
-    many of ``tries`` are spent. The frame is taken and judged in the worker.
+    """Look into the open cabin (``look_into_cabin``): SUCCESS with a way in, written to
+    ``cabin_way``; FAILURE (LIFT_FULL) when depth sees into the cabin but no way to its
+    middle, counting the full cabins of this ride in ``lift_full_seen`` and saying how many
+    of ``tries`` are spent; FAILURE (TARGET_NOT_FOUND) when no open doorway is in view
+    (the robot is not in front of the doors: its estimate is off). The frame is taken and
+    judged in the worker.
 
-    Reads and writes ``lift_full_seen``; reads ``map_T_odom``."""
+    Reads and writes ``lift_full_seen``; reads ``map_T_odom``; writes ``cabin_way``."""
 
     READS = ("lift_full_seen", "map_T_odom")
-    WRITES = ("lift_full_seen",)
+    WRITES = ("lift_full_seen", "cabin_way")
     JOBS = ("_job",)
 
     def __init__(self, name: str, ctx: Context, ride: Ride, tries: int):
@@ -207,33 +249,36 @@ class CabinHasRoom(PmNavBehaviour):
 
     def initialise(self) -> None:
         base, tf, d = self.ctx.base, self.get("map_T_odom"), self.ride.board
-        half = CREATE3_RADIUS_M + CABIN_MARGIN_M
 
         def look(cancelled):
             obs = base.observe()
-            est = map_pose(tf, obs.pose)
-            bearing = heading((est.x, est.y), d.cabin_centre()) - est.yaw
-            return obs, free_distance(obs, bearing, half_width=half)
+            return look_into_cabin(obs, map_pose(tf, obs.pose), d)
 
         self._job = self.ctx.worker.submit(look)
 
     def update(self) -> Status:
-        status, done = self.poll(self._job, "looking into the lift")
+        status, look = self.poll(self._job, "looking into the lift")
         if status is not None:
             return status
-        obs, free = done
-        need = cabin_reach(self.ride.board)
-        if free >= need:
-            self.feedback_message = f"room in {self.ride.name} ({free:.1f} m free)"
+        r = self.ride
+        if look.way is not None:
+            self.bb.set("cabin_way", look.way)
+            b, m = look.way
+            self.feedback_message = f"room in {r.name}: {m:.1f} m in at {math.degrees(b):+.0f} deg"
             return Status.SUCCESS
+        if not look.beyond:
+            return self.fail(
+                FailureCode.TARGET_NOT_FOUND,
+                f"no open door of {r.name} in view at its lobby on level {r.from_level}, "
+                "though the lift says it is open",
+            )
         seen = (self.get("lift_full_seen") or 0) + 1
         self.bb.set("lift_full_seen", seen)
-        self.ctx.log("lift_full", self.ride.lift, free=free, times=seen)
+        self.ctx.log("lift_full", r.lift, times=seen)
         return self.fail(
             FailureCode.LIFT_FULL,
-            f"{self.ride.name} came full to level {self.ride.from_level} "
-            f"({seen} of {self.tries} times; floor free {free:.1f} m in, "
-            f"{need:.1f} m needed)",
+            f"{r.name} came full to level {r.from_level} ({seen} of {self.tries} times: "
+            "no room in it for the robot)",
         )
 
 
@@ -251,22 +296,30 @@ class ReleaseLift(PmNavBehaviour):
 
 
 class DriveThrough(PmNavBehaviour):
-    """Drive straight ahead ``distance`` m on odometry at ``DOORWAY_SPEED``, through the
-    lift's doorway (in: from the lobby to the cabin's middle; out: back to the lobby).
-    FAILURE (BLOCKED) when the body stops against something or the drive takes longer
-    than ``DOORWAY_TIMEOUT_S``."""
+    """Drive ``distance`` m on odometry at ``DOORWAY_SPEED``, through the lift's doorway:
+    in, along the way ``CabinHasRoom`` found (``cabin_way``: its bearing and distance),
+    else straight ahead; out, straight ahead back to the lobby. FAILURE (BLOCKED) when the
+    body stops against something or the drive takes longer than ``DOORWAY_TIMEOUT_S``.
 
+    Reads ``cabin_way`` (with ``way=True``)."""
+
+    READS = ("cabin_way",)
     STOPS_BASE = True
 
-    def __init__(self, name: str, ctx: Context, ride: Ride, distance: float, where: str):
+    def __init__(
+        self, name: str, ctx: Context, ride: Ride, distance: float, where: str, way: bool = False
+    ):
         super().__init__(name, ctx)
-        self.ride, self.distance, self.where = ride, distance, where
+        self.ride, self.distance, self.where, self.way = ride, distance, where, way
 
     def initialise(self) -> None:
         p = self.ctx.base.pose()
+        bearing, distance = 0.0, self.distance
+        if self.way and self.get("cabin_way") is not None:
+            bearing, distance = self.get("cabin_way")
         self._goal = (
-            p.x + self.distance * math.cos(p.yaw),
-            p.y + self.distance * math.sin(p.yaw),
+            p.x + distance * math.cos(p.yaw + bearing),
+            p.y + distance * math.sin(p.yaw + bearing),
         )
         self._t0 = self.ctx.now()
         self._sent = False

@@ -116,7 +116,9 @@ def lift_subtree(
         f"{name}Ride",
         ToLobby(f"{name}ToLobby", ctx_from, ride),
         board,
-        DriveThrough(f"{name}IntoCabin", ctx_from, ride, into_cabin(ride.board), "into"),
+        DriveThrough(
+            f"{name}IntoCabin", ctx_from, ride, into_cabin(ride.board), "into", way=True
+        ),
         Spin(f"{name}TurnRound", ctx_from, math.pi),
         CallLift(f"{name}AskForLevel", ctx_from, lift, ride, ride.to_level),
         WaitForLift(f"{name}RideToLevel", ctx_from, lift, ride, ride.to_level, cfg.lift_ride_s),

@@ -6,8 +6,8 @@ asks for another level or ends (``release``). What it can be told to do wrong:
 
 - ``never``: it never comes (the state keeps its door shut where it stands);
 - ``full_times``: the first so many calls are answered by a cabin with no room in it:
-  people or a cart standing in it, a ``FakeObstacle`` at ``cabin`` that a ``FakeBase``
-  draws in its depth frames (they leave with the cabin when the session ends);
+  people standing across its middle (``FakeObstacle``s behind ``doorway``, drawn in a
+  ``FakeBase``'s depth frames; they leave with the cabin when the session ends);
 - ``wrong_level``: a ride with the robot in the cabin ends on this level, while the
   lift's state says it reached the one asked (``true_level``: where the cabin really is).
 
@@ -18,8 +18,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from pmnav_bt.map.lift_doorway import Doorway
 from pmnav_bt.seams import LiftDoor, LiftMotion, LiftState
 from pmnav_bt.testing.doubles import FakeBase, FakeClock, FakeObstacle
+
+# The people of a full cabin: five abreast across its middle, wall to wall.
+CROWD = (-0.8, -0.4, 0.0, 0.4, 0.8)  # metres across the cabin from its middle
 
 
 @dataclass
@@ -35,7 +39,7 @@ class FakeLift:
     full_times: int = 0
     wrong_level: str | None = None
     base: FakeBase | None = None
-    cabin: tuple[float, float] | None = None
+    doorway: Doorway | None = None
     requests: list[tuple[float, str, str]] = field(default_factory=list)  # (t, level, session)
     releases: list[tuple[float, str]] = field(default_factory=list)  # (t, session)
 
@@ -52,7 +56,7 @@ class FakeLift:
         self._due: float | None = None
         self._calls = 0
         self._riding = False  # the request in hand moves the robot with the cabin
-        self._crowd: FakeObstacle | None = None
+        self._crowd: list[FakeObstacle] = []
         self.clock.on_wait(self._advance)
 
     # -- seams.Lift --------------------------------------------------------------------------
@@ -86,9 +90,9 @@ class FakeLift:
         self._door = LiftDoor.CLOSED
         self._due = None
         self._motion = LiftMotion.STOPPED
-        if self._crowd is not None and self.base is not None:
-            self.base.obstacles.remove(self._crowd)
-        self._crowd = None
+        for person in self._crowd:
+            self.base.obstacles.remove(person)
+        self._crowd = []
 
     def state(self, lift: str) -> LiftState | None:
         self._check(lift)
@@ -118,6 +122,7 @@ class FakeLift:
         self._motion = LiftMotion.STOPPED
         self._door = LiftDoor.OPEN
         full = not self._riding and self._calls <= self.full_times
-        if full and self.base is not None and self.cabin is not None:
-            self._crowd = FakeObstacle.standing(*self.cabin, radius=0.35)
-            self.base.obstacles.append(self._crowd)
+        if full and self.base is not None and self.doorway is not None:
+            (x, y), (ux, uy) = self.doorway.cabin_centre(), self.doorway.into
+            self._crowd = [FakeObstacle.standing(x - uy * a, y + ux * a, 0.3) for a in CROWD]
+            self.base.obstacles.extend(self._crowd)

@@ -47,7 +47,7 @@ def ride_rig(make_rig, levels, *, arrive_reads: str = "L4", overrides=(), **lift
     ride = Ride("lift_a", "Lift A", "L3", "L4", board, alight, session="test")
     fake = FakeLift(
         rig.base.clock, levels=("L3", "L4", "L5"), name="lift_a", base=rig.body,
-        cabin=board.cabin_centre(), **lift,
+        doorway=board, **lift,
     )  # fmt: skip
     tree = lift_subtree(rig.ctx, ctx_to, fake, ride, levels)
     return rig, tree, fake, ride
@@ -95,7 +95,8 @@ def test_a_lift_that_comes_full_every_time_fails_lift_full_after_the_tries(make_
     assert "Lift A" in f.message and "2 of 2" in f.message
     assert [r[1] for r in lift.requests] == ["L3", "L3"]
     assert rig.get("lift_full_seen") == 2
-    assert math.dist((rig.true_pose().x, rig.true_pose().y), lift.cabin) > 1.5  # never got in
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), lift.doorway.cabin_centre()) > 1.5  # never got in
 
 
 def test_a_lift_full_once_is_let_go_and_the_next_one_taken(make_rig, levels):

@@ -12,12 +12,11 @@ from blackboard_kit import writer
 from building_kit import as_floor
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.lift import Ride, cabin_reach
+from pmnav_bt.behaviours.lift import Ride, look_into_cabin
 from pmnav_bt.config import load_config
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.lift_doorway import DOORWAY_WALL_M, doorway
 from pmnav_bt.map.priori_map import parse_building
-from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.seams import LiftDoor, Pose2D
 from pmnav_bt.sim.levels import LevelBody
 from pmnav_bt.sim.lift import SimLift
@@ -60,29 +59,50 @@ def test_a_world_without_lifts_has_no_cabin_and_an_unknown_lift_is_refused(level
         SimWorld(levels["L3"], lifts={"stairs1"})
 
 
-def test_depth_sees_shut_doors_an_open_cabin_and_a_full_one(worlds, levels):
+def test_depth_sees_shut_doors_an_open_cabin_a_full_one_and_the_way_in(worlds, levels):
     body = LevelBody(worlds, "L3", Pose2D(0.0, 0.0, 0.0), width=160, height=120)
+    cabin = worlds["L3"].cabins["elevator1"]
     try:
-        cabin = worlds["L3"].cabins["elevator1"]
         d = doorway(parse_building(levels["L3"]), "elevator1")
-        body.carry("L3", Pose2D(*d.lobby, d.yaw_in))
 
-        def free() -> float:
-            return free_distance(body.observe(), 0.0, half_width=0.27)
+        def look(off: float = 0.0):
+            """From the lobby ``off`` m along the corridor, facing the doors, the robot
+            believing it is at the lobby itself."""
+            at = Pose2D(d.lobby[0] + off, d.lobby[1], d.yaw_in)
+            body.carry("L3", at)
+            return look_into_cabin(body.observe(), Pose2D(*d.lobby, d.yaw_in), d)
 
-        need = cabin_reach(d)
-        shut = free()
+        shut = look()
+        assert shut.way is None and not shut.beyond  # the doors: no doorway in view
         cabin.set_door(True)
-        wide_open = free()
+        straight = look()
+        assert straight.way is not None and abs(straight.way[0]) < math.radians(5)
+        assert straight.way[1] == pytest.approx(math.dist(d.lobby, d.cabin_centre()), abs=0.05)
+        aside = look(off=-0.6)  # 0.6 m west of where it believes: the way in is to its right
+        assert aside.way is not None and aside.way[0] < -math.radians(10)
         cabin.fill()
-        full = free()
-        assert shut < 1.3 < need <= wide_open and full < need
+        full = look()
+        assert full.way is None and full.beyond
         assert body.world.clearance(*cabin.middle, 0.17) < 0  # the cart stands there
         cabin.empty()
         assert body.world.clearance(*cabin.middle, 0.17) > 0  # room to stand in the cabin
     finally:
-        worlds["L3"].cabins["elevator1"].set_door(False)
+        cabin.set_door(False)
+        cabin.empty()
         body.close()
+
+
+def test_the_doorway_stays_open_under_the_realistic_walls(levels):
+    cfg = load_config(overrides=["world.preset=realistic", "world.people_per_100m=0"])
+    with SimWorld(levels["L3"], scene=cfg.world, seed=3, lifts={"elevator1"}) as w:
+        d = doorway(parse_building(levels["L3"]), "elevator1")
+        w.cabins["elevator1"].set_door(True)
+        body = LevelBody({"L3": w}, "L3", Pose2D(*d.lobby, d.yaw_in), width=160, height=120)
+        try:
+            look = look_into_cabin(body.observe(), Pose2D(*d.lobby, d.yaw_in), d)
+            assert look.way is not None
+        finally:
+            body.close()
 
 
 def test_one_ride_takes_the_robot_in_on_one_level_and_out_on_the_next(worlds, levels):
