@@ -47,6 +47,10 @@ KEYS = (
     "pose_tracker",  # PoseTracker: map_T_odom's uncertainty, for verification and snapping
     "drive_end",  # DriveEnd | None: how the last localization drive ended (follow_lead)
     "corridor_drive",  # CorridorDrive: the localization drive under way (follow_lead)
+    # lifts (behaviours/lift.py, trees/lift.py)
+    "level",  # str: the level the robot is on, after a lift ride (the site's level name)
+    "lift_full_seen",  # int: lifts that came full on this ride so far
+    "cabin_way",  # (bearing rad, metres): the way into the lift's cabin depth showed
     # the map-less baseline (trees/mapless.py)
     "goal_entity",  # Entity: the goal room, from the sign vocabulary
     "grid",  # ExplorationGrid: what it has seen and where it has been (odometry frame)

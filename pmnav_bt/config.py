@@ -292,6 +292,21 @@ class TreeConfig(_Section):
     )
     max_linear: float = Field(CREATE3_MAX_LINEAR, gt=0.0, le=5.0, description="m/s (Create 3)")
     max_angular: float = Field(CREATE3_MAX_ANGULAR, gt=0.0, le=10.0, description="rad/s (Create 3)")
+    lift_wait_s: float = Field(
+        180.0, gt=0.0, le=3600.0, description="clock seconds a lift may take to open its door at "
+        "the lobby after a call (LIFT_NOT_COMING); a hospital's lifts at a busy hour take 1-3 min",
+    )
+    lift_ride_s: float = Field(
+        120.0, gt=0.0, le=3600.0, description="clock seconds from asking for a level inside the "
+        "cabin to its door open there (LIFT_NOT_COMING)",
+    )
+    lift_full_tries: int = Field(
+        3, ge=1, le=20, description="lifts that come full let go before giving up (LIFT_FULL)"
+    )
+    lift_full_wait_s: float = Field(
+        20.0, ge=0.0, le=600.0, description="clock seconds to wait after letting a full lift go, "
+        "before calling it again",
+    )
 
 
 class SimConfig(_Section):
@@ -419,6 +434,10 @@ class WorldConfig(_Section):
     camera_exposure: list[float] = _pair("camera_exposure", "exposure gain per episode")
     camera_exposure_time: float = Field(
         0.0, ge=0.0, le=0.2, description="s the shutter is open (motion blur while turning)"
+    )
+    lift_full_p: float = Field(
+        0.0, ge=0.0, le=1.0, description="probability that a lift answering a call comes with no "
+        "room in it (people and a cart; sim/lift.py; 0 in both presets)",
     )
     stale_map: float = Field(
         0.0, ge=0.0, le=1.0, description="probability that the world differs from the map the "

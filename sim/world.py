@@ -21,6 +21,7 @@ import math
 import os
 import tempfile
 import threading
+from collections.abc import Collection
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -74,6 +75,7 @@ from pmnav_bt.sim.scene.appearance import WALL_THICKNESS, appearance_of
 from pmnav_bt.sim.scene.clutter import ClutterItem, place_clutter
 from pmnav_bt.sim.scene.doors import DoorLeaf, DoorState, build_leaf, door_states
 from pmnav_bt.sim.scene.fire_doors import FireDoor, build_fire_doors
+from pmnav_bt.sim.scene.lifts import Cabin, build_cabin, doorway_cut, doorway_s
 from pmnav_bt.sim.scene.people import Crowd, populate
 from pmnav_bt.sim.scene.plates import make_line_plate
 from pmnav_bt.sim.scene.sign_mounting import SIGN_DEPTH, SIGN_GAP, mount_signage
@@ -179,7 +181,9 @@ class SimWorld:
     ``base_dir`` is the folder the floor plan path is relative to (default: the
     building file's folder). ``scene`` (the config's ``world`` section; default: the clean
     preset) says what fills the building beyond its file, drawn from the episode's
-    ``seed`` (``pmnav_bt.sim.scene``).
+    ``seed`` (``pmnav_bt.sim.scene``). ``lifts``: the lift landmarks (ids) with a cabin
+    behind their doors (``sim/scene/lifts.py``; ``cabins``): a level of a site, whose
+    lifts the robot rides (``pmnav_bt.sim.lift``).
     """
 
     def __init__(
@@ -192,6 +196,7 @@ class SimWorld:
         base_dir: str | Path | None = None,
         scene: WorldConfig | None = None,
         seed: int = 0,
+        lifts: Collection[str] = (),
     ) -> None:
         if walls not in WALL_SOURCES:
             raise SimError(f"walls {walls!r}: choose {' or '.join(WALL_SOURCES)}")
@@ -202,6 +207,13 @@ class SimWorld:
         self.wall_source = walls
         self.scene = scene if scene is not None else WorldConfig()
         self.seed = int(seed)
+        self.lift_lobbies = frozenset(lifts)
+        lift_ids = {lm.id for lm in building.landmarks if landmark_shape(lm.kind) is ELEVATOR}
+        unknown = sorted(self.lift_lobbies - lift_ids)
+        if unknown:
+            raise SimError(f"{building.name}: no lift landmark {unknown[0]!r} for a cabin")
+        self.cabins: dict[str, Cabin] = {}  # lift landmark id -> its cabin (``lifts``)
+        self._elevator_leaves: dict[str, list[int]] = {}
         self.appearance = appearance_of(self)
         self._grid_plan = self._load_grid_plan(base_dir) if walls == "grid" else None
         self._mounts = GridMounts(self._grid_plan) if self._grid_plan is not None else None
@@ -575,6 +587,7 @@ class SimWorld:
             self._build_door(room.id, room.door)
         for lm in b.landmarks:
             self._build_landmark(lm)
+        self._build_cabins()
         self._build_signage()
         if self._grid_plan is not None:
             self._build_grid_walls()
@@ -601,6 +614,12 @@ class SimWorld:
         grid = self.wall_source == "grid"
         self.walls.extend(annotated_walls(self.free_space))
         self._placer = WallPlacer(self.walls)
+        doorways: dict[tuple, list[float]] = {}  # a lift's doorway through its wall
+        for lm in self.building.landmarks:
+            if lm.id in self.lift_lobbies:
+                wi, s_wall = self._placer.nearest(lm.pos)
+                w = self.walls[wi]
+                doorways.setdefault((w.a, w.b), []).append(doorway_s(s_wall))
         for ring in free_space_rings(self.free_space):
             n = len(ring)
             pts = [np.asarray(q, float) for q in ring]
@@ -621,6 +640,10 @@ class SimWorld:
                 half_len = length / 2.0 + (ext_a + ext_b) / 2.0
                 if grid:  # the annotated walls only carry the doors and signs
                     continue
+                opened = doorways.get((ring[i], ring[(i + 1) % n]))
+                if opened:
+                    self._wall_pieces(a, tan, inward, doorway_cut(length, opened, ext_a, ext_b))
+                    continue
                 self.add_box(
                     (mid[0], mid[1], h / 2.0),
                     (half_len, t / 2.0, h / 2.0),
@@ -639,6 +662,25 @@ class SimWorld:
                     collision=False,
                 )
         self.annotated_walls = len(self.walls)
+
+    def _wall_pieces(self, a, tan, inward, pieces: list[tuple[float, float]]) -> None:
+        """A wall (with its skirting) from ``a`` along ``tan`` as the ``pieces`` (from, to
+        metres along it) left round a lift's doorway (``sim/scene/lifts.py``)."""
+        h, t = self.building.wall_height, WALL_THICKNESS
+        yaw = math.atan2(tan[1], tan[0])
+        for lo, hi in pieces:
+            mid = a + tan * (lo + hi) / 2.0
+            wall = mid - inward * t / 2.0
+            self.add_box(
+                (wall[0], wall[1], h / 2.0), ((hi - lo) / 2.0, t / 2.0, h / 2.0), yaw,
+                self.appearance.wall, WALL,
+            )  # fmt: skip
+            sk = mid + inward * 0.005
+            self.add_box(
+                (sk[0], sk[1], SKIRTING_HEIGHT / 2.0),
+                ((hi - lo) / 2.0, 0.005, SKIRTING_HEIGHT / 2.0),
+                yaw, self.appearance.skirting, WALL, solid=False, collision=False,
+            )  # fmt: skip
 
     # -- placing things on walls ---------------------------------------------------------
 
@@ -826,8 +868,9 @@ class SimWorld:
         wi, s = self._snap(landmark_item(lm.id), lm.pos, total / 2.0)
         s_door = s + ELEVATOR_PANEL_M / 2.0  # the call panel sits on the viewer's right (-s)
         half = ELEVATOR_WIDTH_M / 4.0
+        leaves = self._elevator_leaves.setdefault(lm.id, [])
         for side in (-1, 1):
-            self._wall_box(
+            leaves.append(self._wall_box(
                 wi,
                 s_door + side * (half + 0.01),
                 0.03,
@@ -836,7 +879,7 @@ class SimWorld:
                 ELEVATOR_HEIGHT,
                 METAL_RGBA,
                 label,
-            )
+            ))
             self._wall_box(
                 wi,
                 s_door + side * (ELEVATOR_WIDTH_M + fw) / 2.0,
@@ -847,7 +890,8 @@ class SimWorld:
                 STEEL_DARK_RGBA,
                 label,
             )
-        self._wall_box(wi, s_door, 0.025, 0.04, 0.0, ELEVATOR_HEIGHT, STEEL_DARK_RGBA, label)
+        seam = self._wall_box(wi, s_door, 0.025, 0.04, 0.0, ELEVATOR_HEIGHT, STEEL_DARK_RGBA, label)
+        leaves.append(seam)  # where the leaves meet: it slides with them
         self._wall_box(
             wi,
             s_door,
@@ -871,6 +915,24 @@ class SimWorld:
             (0.0, ELEVATOR_HEIGHT + fw),
             lm.sign_text,
         )
+
+    def _build_cabins(self) -> None:
+        """A cabin behind each of ``lift_lobbies`` (``sim/scene/lifts.py``), where the walls
+        left its doorway: the lift's doors must hang where the wall nearest the landmark
+        has them (``_build_walls``), not moved along it for want of room."""
+        for lid in sorted(self.lift_lobbies):
+            wi, s = self._where[landmark_label(lid)]
+            near, s_near = self._placer.nearest(self.building.landmark(lid).pos)
+            if (wi, round(s, 3)) != (near, round(s_near, 3)):
+                raise SimError(
+                    f"{self.building.name}: lift {lid} hangs {abs(s - s_near):.2f} m from its "
+                    "point (no room on the wall there), so its cabin has no doorway; move it"
+                )
+            w = self.walls[wi]
+            centre = w.point(doorway_s(s))
+            self.cabins[lid] = build_cabin(
+                self, lid, _xy(centre), w.normal, self._elevator_leaves[lid]
+            )
 
     def _build_stairs(self, lm: Landmark, label: str) -> WallItem:
         wi, s = self._snap(landmark_item(lm.id), lm.pos, STAIRS.span_m / 2.0)

@@ -162,6 +162,22 @@ def build_coarse_only_tree(ctx: Context, goal: str) -> py_trees.trees.BehaviourT
 
 
 def _pmnav_tree(ctx: Context, goal: str, refine: bool) -> py_trees.trees.BehaviourTree:
+    mission = sequence(
+        "Mission",
+        CheckGoal("CheckGoal", ctx),
+        localize_subtree(ctx),
+        navigate_subtree(ctx, refine),
+        Arrive("Arrive", ctx),
+    )
+    return monitored_mission(ctx, "PM-Nav", mission, goal)
+
+
+def navigate_subtree(
+    ctx: Context, refine: bool = True, name: str = "Navigate"
+) -> py_trees.behaviour.Behaviour:
+    """Plan from the estimate and follow the plan step by step, recovering and replanning
+    (``tree.replans`` times) by the failure code: the tree between localizing and
+    arriving (a leg of a mission across levels, ``trees/site.py``, too)."""
     cfg = ctx.config.tree
     follow = Selector(
         "FollowPlan",
@@ -178,8 +194,8 @@ def _pmnav_tree(ctx: Context, goal: str, refine: bool) -> py_trees.trees.Behavio
         FailureIsSuccess("TryRelocalize", localize_subtree(ctx, "Relocalize")),
         AlwaysFail(name="Replan"),
     )
-    navigate = Retry(
-        "Navigate",
+    return Retry(
+        name,
         Selector(
             "PlanOrRecover",
             memory=True,
@@ -195,11 +211,3 @@ def _pmnav_tree(ctx: Context, goal: str, refine: bool) -> py_trees.trees.Behavio
         ),
         num_failures=cfg.replans + 1,
     )
-    mission = sequence(
-        "Mission",
-        CheckGoal("CheckGoal", ctx),
-        localize_subtree(ctx),
-        navigate,
-        Arrive("Arrive", ctx),
-    )
-    return monitored_mission(ctx, "PM-Nav", mission, goal)

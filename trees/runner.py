@@ -134,8 +134,15 @@ def run_tree(
     sync_workers: bool = True,
     tick_durations: list[float] | None = None,
     view: ViewRecorder | None = None,
+    build: Callable[[Context, str], py_trees.trees.BehaviourTree] | None = None,
+    ended_on: Callable[[], Context] | None = None,
 ) -> RunOutcome:
     """Build the tree for ``goal`` and tick it until it succeeds or fails.
+
+    ``build``: how to build it (default ``build_tree``, the config's tree variant; the
+    mission across levels: ``trees.site.build_site_tree``), after the blackboard is cleared;
+    ``ended_on``: the context of the level the run ended on, whose map explains a failure
+    (default ``ctx``).
 
     ``tick_durations`` (optional) collects the wall time of every tick, in seconds.
     ``log``: write the tree log here, each tick's ``view`` entry made by ``view`` (default
@@ -144,7 +151,7 @@ def run_tree(
     py_trees.blackboard.Blackboard.clear()
     if log is not None and view is None:
         view = ViewRecorder(ctx)
-    tree = build_tree(ctx, goal)
+    tree = (build or build_tree)(ctx, goal)
     if log is not None:
         tree.add_post_tick_handler(SnapshotLogger(tree, log, ctx.now, view=view, goal=goal))
     period = 1.0 / ctx.config.tree.tick_hz
@@ -181,8 +188,9 @@ def run_tree(
             or _blackboard("failure")
             or Failure(FailureCode.TIMEOUT, f"no result after {tree.count} ticks")
         )
-        if ctx.misreads is not None:  # what was read where the target was not found
-            failure = ctx.misreads.explain(failure, _target_entity(ctx))
+        end = ended_on() if ended_on is not None else ctx
+        if end.misreads is not None:  # what was read where the target was not found
+            failure = end.misreads.explain(failure, _target_entity(end))
     return RunOutcome(
         success=status == py_trees.common.Status.SUCCESS,
         failure=failure,

@@ -179,6 +179,9 @@ def run(
     overrides: list[str] | None = SET_OPT,
 ) -> None:
     """Run one PM-Nav episode and print its result; write the tree log and trajectory plot.
+    In a site of several levels (--building hospital_2l), the goal may be on another
+    level than the start ("L2/x,y,yaw_deg"; default: the first level's start): the robot
+    rides the lift, and a trajectory plot is drawn per level.
 
     With --view, a browser page shows the run live; on a terminal it stays up after the
     run until Ctrl-C."""
@@ -189,6 +192,12 @@ def run(
     cli_values.index(index)
     cfg = run_config(config, overrides)
     check_output_dir(out)
+    if episode_file is None and goal is not None:
+        from pmnav_bt.experiments.site_run import run_site, site_of_levels
+
+        if site_of_levels(building):  # a site: its levels joined by lifts
+            run_site(building, goal, start, seed, cfg, out)
+            return
     if episode_file is not None:
         from pmnav_bt.sim.episodes import episode_map, load_episodes
 

@@ -42,6 +42,7 @@ from shapely.geometry import LineString
 
 from pmnav_bt.seams import CEILING_LABEL, FLOOR_LABEL, WALL_LABEL
 from pmnav_bt.sim._pybullet import p
+from pmnav_bt.sim.scene.lifts import open_stretches
 from pmnav_bt.sim.textures import write_png
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -486,24 +487,37 @@ def _texture_walls(world: SceneWorld, surface: Surface, rng: np.random.Generator
     su = surface.size_m[0]
     for w in world.walls:
         n = np.asarray(w.normal, float)
-        a = np.asarray(w.a, float) + n * SURFACE_OFFSET_M
-        b = np.asarray(w.b, float) + n * SURFACE_OFFSET_M
-        # Seen from the corridor (looking along -n) b is on the left: b, a, a-top, b-top
-        # runs counter-clockwise, as the sign quads do.
-        corners = [np.append(b, 0.0), np.append(a, 0.0), np.append(a, h), np.append(b, h)]
-        u = w.length / su
         k = float(1.0 - rng.uniform(0.0, shade))
-        _quad(
-            world,
-            corners,
-            [[0.0, 0.0], [u, 0.0], [u, 1.0], [0.0, 1.0]],
-            (float(n[0]), float(n[1]), 0.0),
-            tex,
-            WALL_LABEL,
-            (k, k, k, 1.0),
-        )
+        ends = np.asarray(w.a, float), np.asarray(w.b, float)
+        length = w.length
+        # a lift's doorway stays open (sim/scene/lifts.py): the face either side of it
+        for s0, s1 in open_stretches(world.cabins.values(), w.a, w.b):
+            a = _along(ends, length, s0) + n * SURFACE_OFFSET_M
+            b = _along(ends, length, s1) + n * SURFACE_OFFSET_M
+            # Seen from the corridor (looking along -n) b is on the left: b, a, a-top, b-top
+            # runs counter-clockwise, as the sign quads do.
+            corners = [np.append(b, 0.0), np.append(a, 0.0), np.append(a, h), np.append(b, h)]
+            ub, ua = (length - s1) / su, (length - s0) / su  # one texture along the wall
+            _quad(
+                world,
+                corners,
+                [[ub, 0.0], [ua, 0.0], [ua, 1.0], [ub, 1.0]],
+                (float(n[0]), float(n[1]), 0.0),
+                tex,
+                WALL_LABEL,
+                (k, k, k, 1.0),
+            )
     for body in boxes:
         _hide(world, body)
+
+
+def _along(ends: tuple[np.ndarray, np.ndarray], length: float, s: float) -> np.ndarray:
+    """The point ``s`` m from the first of a wall's ``ends`` (its ends themselves exactly)."""
+    if s <= 0.0:
+        return ends[0]
+    if s >= length:
+        return ends[1]
+    return ends[0] + (ends[1] - ends[0]) * (s / length)
 
 
 def _segment_boxes(world: SceneWorld) -> list[int]:

@@ -32,6 +32,14 @@ class Crossing(Protocol):
     line: tuple[tuple[float, float], tuple[float, float]]
 
 
+class Doorway(Protocol):
+    """A way through a corridor wall (a lift's cabin, ``lifts.Cabin``): its centre on the
+    wall's face and the direction through it, away from the corridor."""
+
+    centre: tuple[float, float]
+    into: tuple[float, float]
+
+
 class Segment(Protocol):
     @property
     def length(self) -> float: ...
@@ -52,6 +60,7 @@ class SceneWorld(Protocol):
     landmarks: Mapping[str, Mounted]
     landmark_signs: Mapping[str, Mounted]
     fire_doors: Mapping[str, Crossing]
+    cabins: Mapping[str, Doorway]  # lift landmark id -> the doorway to its cabin
 
     def rng(self, part: str) -> np.random.Generator: ...
 

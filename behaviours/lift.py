@@ -1,0 +1,453 @@
+"""Lift leaves: ride a lift from one level to another, as a robot that cannot press a
+button does it: through the building's lift system (``seams.Lift``, Open-RMF's lift
+request and state), with its eyes for what the lift system cannot say.
+
+A ride (``Ride``) is one lift between two levels: the lift's doorway on each
+(``pmnav_bt.map.lift_doorway``), and the session the robot asks for the lift by. The
+leaves, in the order ``trees/lift.py`` strings them:
+
+- ``ToLobby``: to the lobby point in front of the doors, facing them;
+- ``CallLift``: ask for the lift at a level (again with another level to ride);
+- ``WaitForLift``: until the lift says it is at that level with its door open for us
+  (LIFT_NOT_COMING after a clock timeout);
+- ``CabinHasRoom``: depth says whether the cabin's floor is free (LIFT_FULL, counted);
+- ``ReleaseLift``: end the session (a full cabin goes on without us; off at the far end);
+- ``DriveThrough``: straight through the doorway, into the cabin's middle or out to the
+  lobby, on odometry (the doorway is 1.6 m wide, the robot 0.34 m);
+- ``OnNewLevel``: in the cabin on the far level: the old level's estimate, plan and what
+  was found blocked are dropped; the estimate restarts at the cabin on the new level's
+  map, with the lift's word as its only evidence (a prior, ``ARRIVAL_SIGMA_M``), for
+  the re-localization to confirm;
+- ``CheckLevel``: the signs read on arrival name places of the level asked, not of
+  another (WRONG_LEVEL).
+
+Failure texts name the lift and the levels as the building does (``Ride.name``, the
+level names of the site file).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from py_trees.common import Status
+
+from pmnav_bt.behaviours.common import PmNavBehaviour
+from pmnav_bt.behaviours.context import Context, map_pose
+from pmnav_bt.behaviours.localize import forget_stale_sightings
+from pmnav_bt.control import goto_command
+from pmnav_bt.failures import FailureCode
+from pmnav_bt.geometry import heading, se2_compose, se2_inverse, wrap_angle
+from pmnav_bt.map.building import Building
+from pmnav_bt.map.lift_doorway import CABIN_DEPTH_M, DOORWAY_WALL_M, Doorway
+from pmnav_bt.perception.geometry import free_distance
+from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.seams import (
+    CREATE3_RADIUS_M,
+    Lift,
+    LiftDoor,
+    LiftMotion,
+    MotionStatus,
+    Pose2D,
+)
+
+# Through the doorway at a walking pace for a tight place: a third of the Create 3's limit.
+DOORWAY_SPEED = 0.1  # m/s
+# A drive through the doorway that has not covered its distance after this long gives up
+# (blocked): 2.5 m at 0.1 m/s takes 25 s.
+DOORWAY_TIMEOUT_S = 40.0
+# The cabin has room when depth shows its floor free this far past the robot's footprint
+# at the cabin's middle, the width of the robot and this margin each side.
+CABIN_MARGIN_M = 0.1
+# The way into the cabin is looked for over these bearings of the 60-degree camera.
+SCAN_HALF = math.radians(27.5)
+SCAN_STEP = math.radians(2.5)
+# The estimate on arrival: the cabin on the new level's map, as sure as the ride put the
+# robot there (it drove in on the old level's estimate, a few tenths of a metre off).
+ARRIVAL_SIGMA_M = 0.5
+# Signs of another level read on arrival: this many, and more than of the level asked,
+# say the lift stopped at the wrong floor (one could be a misread).
+WRONG_LEVEL_SIGNS = 2
+# What belongs to the level left behind: the estimate, the plan and what was found there.
+OLD_LEVEL_KEYS = (
+    "plan",
+    "step_index",
+    "target",
+    "views",
+    "choice",
+    "bearing",
+    "sighting",
+    "last_action",
+    "avoid_landmarks",
+    "blocked_segments",
+    "blocked_suspects",
+    "blocked_ways",
+    "way_shut",
+    "belief",
+    "fix_attempts",
+    "drive_end",
+    "corridor_drive",
+)
+
+
+@dataclass(frozen=True)
+class Ride:
+    """One lift ride: ``lift`` as the lift system knows it, ``name`` as people call it
+    ("Lift A"), from ``from_level`` to ``to_level`` (the site's level names), through
+    ``board`` (its doorway on the first level's map) and ``alight`` (on the second's),
+    asked for by ``session``."""
+
+    lift: str
+    name: str
+    from_level: str
+    to_level: str
+    board: Doorway
+    alight: Doorway
+    session: str = "pmnav"
+
+
+class ToLobby(PmNavBehaviour):
+    """Drive to the lobby point in front of the lift's doors (on the corridor's centre
+    line) and turn to face them, on the map estimate. Reads ``map_T_odom``."""
+
+    READS = ("map_T_odom",)
+    STOPS_BASE = True
+
+    def __init__(self, name: str, ctx: Context, ride: Ride):
+        super().__init__(name, ctx)
+        self.ride = ride
+
+    def initialise(self) -> None:
+        self._at = False
+
+    def update(self) -> Status:
+        est = map_pose(self.get("map_T_odom"), self.ctx.base.pose())
+        d = self.ride.board
+        if not self._at:
+            v, w, self._at = goto_command(est, *d.lobby, self.ctx.limits)
+            self.ctx.base.set_velocity(v, w)
+            if not self._at:
+                return Status.RUNNING
+        if not self.face(heading((est.x, est.y), d.centre), est):
+            return Status.RUNNING
+        self.feedback_message = f"at the doors of {self.ride.name}"
+        return Status.SUCCESS
+
+
+class CallLift(PmNavBehaviour):
+    """Ask the lift system for the ride's lift at ``level`` (to come there, or with the
+    robot inside to go there), door open, for the ride's session. SUCCESS at once."""
+
+    def __init__(self, name: str, ctx: Context, lift: Lift, ride: Ride, level: str):
+        super().__init__(name, ctx)
+        self.lift, self.ride, self.level = lift, ride, level
+
+    def update(self) -> Status:
+        self.lift.request(self.ride.lift, self.level, self.ride.session)
+        self.ctx.log("lift_call", self.ride.lift, level=self.level)
+        self.feedback_message = f"asked for {self.ride.name} at level {self.level}"
+        return Status.SUCCESS
+
+
+class WaitForLift(PmNavBehaviour):
+    """Wait, stopped, until the lift says it stands at ``level`` with its door open for the
+    ride's session; FAILURE (LIFT_NOT_COMING) after ``timeout_s`` seconds of the tree's
+    clock."""
+
+    def __init__(
+        self, name: str, ctx: Context, lift: Lift, ride: Ride, level: str, timeout_s: float
+    ):
+        super().__init__(name, ctx)
+        self.lift, self.ride, self.level, self.timeout_s = lift, ride, level, timeout_s
+
+    def initialise(self) -> None:
+        self.ctx.base.stop()
+        self._t0 = self.ctx.now()
+
+    def update(self) -> Status:
+        st = self.lift.state(self.ride.lift)
+        waited = self.ctx.now() - self._t0
+        if (
+            st is not None
+            and st.current_level == self.level
+            and st.door == LiftDoor.OPEN
+            and st.motion == LiftMotion.STOPPED
+            and st.session == self.ride.session
+        ):
+            self.ctx.log("lift_open", self.ride.lift, level=self.level, waited=waited)
+            self.feedback_message = f"{self.ride.name} open at level {self.level}"
+            return Status.SUCCESS
+        if waited > self.timeout_s:
+            seen = "no word from it" if st is None else (
+                f"it is at level {st.current_level}, door {st.door.value}"
+            )
+            return self.fail(
+                FailureCode.LIFT_NOT_COMING,
+                f"{self.ride.name} did not open its door at level {self.level} in "
+                f"{self.timeout_s:.0f} s ({seen})",
+            )
+        self.feedback_message = f"waiting for {self.ride.name} at level {self.level}"
+        return Status.RUNNING
+
+
+@dataclass(frozen=True)
+class CabinLook:
+    """What depth shows through a lift's open doors: ``way`` in (the bearing, rad from the
+    frame's heading, and the metres along it to the cabin's middle), None when there is
+    none; ``beyond``: whether anything is seen past the doors' plane (an open doorway in
+    view: no way in then means a full cabin, not a wall)."""
+
+    way: tuple[float, float] | None
+    beyond: bool
+
+
+def look_into_cabin(obs, est: Pose2D, d: Doorway) -> CabinLook:
+    """Scan the frame's bearings (``SCAN_HALF``, every ``SCAN_STEP``) for a way into the
+    cabin's middle: one along which depth shows the floor free (the robot's width and
+    ``CABIN_MARGIN_M`` each side) to the middle's depth and a radius and margin past it.
+    The way is the middle of those that pass, so that an estimate a little off along the
+    corridor still finds the doorway (the doors are 1.6 m wide). ``est``: the map pose
+    the frame was taken from."""
+    u = np.asarray(d.into, float)
+    to_wall = float(np.dot(np.subtract(d.centre, (est.x, est.y)), u))
+    middle = to_wall + DOORWAY_WALL_M + CABIN_DEPTH_M / 2.0
+    half = CREATE3_RADIUS_M + CABIN_MARGIN_M
+    passing, deepest = [], 0.0
+    for b in np.arange(-SCAN_HALF, SCAN_HALF + 1e-9, SCAN_STEP):
+        off = wrap_angle(est.yaw + b - d.yaw_in)
+        if abs(off) >= math.radians(60.0):
+            continue
+        reach = middle / math.cos(off)
+        free = free_distance(obs, float(b), half_width=half)
+        deepest = max(deepest, min(free, 10.0) * math.cos(off))
+        if free >= reach + half:
+            passing.append((float(b), reach))
+    way = passing[len(passing) // 2] if passing else None
+    return CabinLook(way, deepest > to_wall + DOORWAY_WALL_M + 0.2)
+
+
+class CabinHasRoom(PmNavBehaviour):
+    """Look into the open cabin (``look_into_cabin``): SUCCESS with a way in, written to
+    ``cabin_way``; FAILURE (LIFT_FULL) when depth sees into the cabin but no way to its
+    middle, counting the full cabins of this ride in ``lift_full_seen`` and saying how many
+    of ``tries`` are spent; FAILURE (TARGET_NOT_FOUND) when no open doorway is in view
+    (the robot is not in front of the doors: its estimate is off). The frame is taken and
+    judged in the worker.
+
+    Reads and writes ``lift_full_seen``; reads ``map_T_odom``; writes ``cabin_way``."""
+
+    READS = ("lift_full_seen", "map_T_odom")
+    WRITES = ("lift_full_seen", "cabin_way")
+    JOBS = ("_job",)
+
+    def __init__(self, name: str, ctx: Context, ride: Ride, tries: int):
+        super().__init__(name, ctx)
+        self.ride, self.tries = ride, tries
+
+    def initialise(self) -> None:
+        base, tf, d = self.ctx.base, self.get("map_T_odom"), self.ride.board
+
+        def look(cancelled):
+            obs = base.observe()
+            return look_into_cabin(obs, map_pose(tf, obs.pose), d)
+
+        self._job = self.ctx.worker.submit(look)
+
+    def update(self) -> Status:
+        status, look = self.poll(self._job, "looking into the lift")
+        if status is not None:
+            return status
+        r = self.ride
+        if look.way is not None:
+            self.bb.set("cabin_way", look.way)
+            b, m = look.way
+            self.feedback_message = f"room in {r.name}: {m:.1f} m in at {math.degrees(b):+.0f} deg"
+            return Status.SUCCESS
+        if not look.beyond:
+            return self.fail(
+                FailureCode.TARGET_NOT_FOUND,
+                f"no open door of {r.name} in view at its lobby on level {r.from_level}, "
+                "though the lift says it is open",
+            )
+        seen = (self.get("lift_full_seen") or 0) + 1
+        self.bb.set("lift_full_seen", seen)
+        self.ctx.log("lift_full", r.lift, times=seen)
+        return self.fail(
+            FailureCode.LIFT_FULL,
+            f"{r.name} came full to level {r.from_level} ({seen} of {self.tries} times: "
+            "no room in it for the robot)",
+        )
+
+
+class ReleaseLift(PmNavBehaviour):
+    """End the ride's session with the lift system (others may use the lift). SUCCESS."""
+
+    def __init__(self, name: str, ctx: Context, lift: Lift, ride: Ride):
+        super().__init__(name, ctx)
+        self.lift, self.ride = lift, ride
+
+    def update(self) -> Status:
+        self.lift.release(self.ride.lift, self.ride.session)
+        self.ctx.log("lift_release", self.ride.lift)
+        return Status.SUCCESS
+
+
+class DriveThrough(PmNavBehaviour):
+    """Drive ``distance`` m on odometry at ``DOORWAY_SPEED``, through the lift's doorway:
+    in, along the way ``CabinHasRoom`` found (``cabin_way``: its bearing and distance),
+    else straight ahead; out, straight ahead back to the lobby. FAILURE (BLOCKED) when the
+    body stops against something or the drive takes longer than ``DOORWAY_TIMEOUT_S``.
+
+    Reads ``cabin_way`` (with ``way=True``)."""
+
+    READS = ("cabin_way",)
+    STOPS_BASE = True
+
+    def __init__(
+        self, name: str, ctx: Context, ride: Ride, distance: float, where: str, way: bool = False
+    ):
+        super().__init__(name, ctx)
+        self.ride, self.distance, self.where, self.way = ride, distance, where, way
+
+    def initialise(self) -> None:
+        p = self.ctx.base.pose()
+        bearing, distance = 0.0, self.distance
+        if self.way and self.get("cabin_way") is not None:
+            bearing, distance = self.get("cabin_way")
+        self._goal = (
+            p.x + distance * math.cos(p.yaw + bearing),
+            p.y + distance * math.sin(p.yaw + bearing),
+        )
+        self._t0 = self.ctx.now()
+        self._sent = False
+
+    def update(self) -> Status:
+        base = self.ctx.base
+        if self._sent and base.motion_status() == MotionStatus.BLOCKED:
+            return self._blocked("stopped against something")
+        if self.ctx.now() - self._t0 > DOORWAY_TIMEOUT_S:
+            base.stop()
+            return self._blocked(f"not through after {DOORWAY_TIMEOUT_S:.0f} s")
+        v, w, done = goto_command(base.pose(), *self._goal, self.ctx.limits, tol=0.05)
+        if done:
+            base.stop()
+            self.feedback_message = f"{self.where} {self.ride.name}"
+            return Status.SUCCESS
+        base.set_velocity(min(v, DOORWAY_SPEED), w)
+        self._sent = True
+        return Status.RUNNING
+
+    def _blocked(self, why: str) -> Status:
+        return self.fail(FailureCode.BLOCKED, f"the doorway of {self.ride.name}: {why}")
+
+
+def into_cabin(d: Doorway) -> float:
+    """From the lobby point to the cabin's middle (m)."""
+    return math.dist(d.lobby, d.cabin_centre())
+
+
+class OnNewLevel(PmNavBehaviour):
+    """The robot stands in the cabin on the ride's far level, facing the doors. Everything
+    of the level left (``OLD_LEVEL_KEYS``: the plan, what was found blocked, the belief) is
+    dropped, and the estimate restarts on the new level's map at the cabin's middle facing
+    out (``map_T_odom``, with ``ARRIVAL_SIGMA_M`` in ``pose_tracker``): the lift's word,
+    which the re-localization then checks against the signs. ``ctx`` is the new level's.
+
+    Writes ``level``, ``map_T_odom``, ``pose_tracker``, ``recent_sightings``,
+    ``lift_full_seen`` and every key of ``OLD_LEVEL_KEYS`` (cleared)."""
+
+    WRITES = (
+        "level", "map_T_odom", "pose_tracker", "recent_sightings", "lift_full_seen",
+        *OLD_LEVEL_KEYS,
+    )  # fmt: skip
+
+    def __init__(self, name: str, ctx: Context, ride: Ride):
+        super().__init__(name, ctx)
+        self.ride = ride
+
+    def update(self) -> Status:
+        for key in OLD_LEVEL_KEYS:
+            self.bb.set(key, None)
+        forget_stale_sightings(self)
+        odom = self.ctx.base.pose()
+        cabin = self.ride.alight.cabin_pose()
+        tf = se2_compose(
+            (cabin.x, cabin.y, cabin.yaw), se2_inverse((odom.x, odom.y, odom.yaw))
+        )
+        self.bb.set("map_T_odom", tf)
+        self.bb.set(
+            "pose_tracker",
+            PoseTracker(
+                map_T_odom=tf, sigma0=ARRIVAL_SIGMA_M, odometer0=self.ctx.odometer.distance
+            ),
+        )
+        self.bb.set("level", self.ride.to_level)
+        self.bb.set("lift_full_seen", 0)
+        self.ctx.log("level", self.ride.to_level, lift=self.ride.lift, map_pose=[cabin.x, cabin.y])
+        self.feedback_message = f"level {self.ride.to_level}, in {self.ride.name}"
+        return Status.SUCCESS
+
+
+def sign_key(text: str) -> str:
+    """A sign's text as compared across levels: letters and digits, case folded."""
+    return re.sub(r"[^0-9a-z]+", "", text.casefold())
+
+
+def level_signs(levels: Mapping[str, Building]) -> dict[str, frozenset[str]]:
+    """Each level's sign texts (``sign_key``) that no other level has: the ones that tell
+    the levels apart (a "Toilets" plate on every floor tells nothing)."""
+    texts = {
+        name: frozenset(
+            sign_key(t)
+            for t in [r.sign_text for r in b.rooms] + [lm.sign_text for lm in b.landmarks]
+            if sign_key(t)
+        )
+        for name, b in levels.items()
+    }
+    return {
+        name: own - frozenset().union(*(t for n, t in texts.items() if n != name))
+        for name, own in texts.items()
+    }
+
+
+class CheckLevel(PmNavBehaviour):
+    """The signs read on arrival (the panorama in ``views``) belong to the level the lift
+    was asked for: FAILURE (WRONG_LEVEL) when at least ``WRONG_LEVEL_SIGNS`` of them, and
+    more than of the level asked, are signs only another level has (``level_signs``, by
+    their text). SUCCESS otherwise, also when nothing telling was read. Reads ``views``."""
+
+    READS = ("views",)
+
+    def __init__(self, name: str, ctx: Context, ride: Ride, levels: Mapping[str, Building]):
+        super().__init__(name, ctx)
+        self.ride = ride
+        self.own = level_signs(levels)
+
+    def update(self) -> Status:
+        read = {
+            d.label
+            for v in self.get("views") or []
+            for d in v.detections or ()
+            if sign_key(d.label)
+        }
+        count = {
+            level: sorted(t for t in read if sign_key(t) in own) for level, own in self.own.items()
+        }
+        here = len(count.get(self.ride.to_level, ()))
+        level, texts = max(
+            ((n, t) for n, t in count.items() if n != self.ride.to_level),
+            key=lambda nt: len(nt[1]),
+            default=(None, []),
+        )
+        if level is not None and len(texts) >= WRONG_LEVEL_SIGNS and len(texts) > here:
+            shown = ", ".join(f'"{t}"' for t in texts[:3])
+            return self.fail(
+                FailureCode.WRONG_LEVEL,
+                f"{self.ride.name} stopped at the wrong floor: the signs read on leaving it "
+                f"({shown}) are level {level}'s, not level {self.ride.to_level}'s",
+            )
+        self.feedback_message = f"{here} sign(s) of level {self.ride.to_level} read"
+        return Status.SUCCESS

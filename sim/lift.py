@@ -1,0 +1,243 @@
+"""The simulator's lift system (``seams.Lift``): cabins that come when called, open their
+doors, ride between level worlds with the robot in them, and sometimes come full.
+
+Each lift (``SimLift.add``) has a cabin on every level it serves (``sim/scene/lifts.py``:
+the recess behind the lift landmark's doors in that level's ``SimWorld``). A request
+for a level, by a session, is answered as a building's lift answers a call: after a
+call delay (the lift serves other calls first: ``CALL_DELAY_S``, drawn per call from
+the world's seeded stream ``rng("lift")``), the door shuts if it stood open
+(``DOOR_S``), the cabin rides (``LEVEL_S`` a level), the door opens (``DOOR_S``) and
+stays open while the session holds the lift at that level. A session's request for
+another level from inside the cabin shuts the door and rides at once. When the session
+ends (``release``) the door shuts after ``DWELL_S``.
+
+A call is answered full with probability ``world.lift_full_p``: the cabin opens with a
+cart in it (people with their trolley, ``Cabin.fill``) and, let go, rides off with it to
+another level. A robot standing on the cabin's floor when it leaves rides with it: at
+the far level the lift hands it to ``rider.carry`` at the same place in that level's
+cabin. Time is the simulation's clock (a clock listener), never wall time.
+
+Timings: a lift door of 1.6 m, two panels opening from the centre, opens or shuts in
+2.5-3.5 s; one storey (about 4 m) at 1 m/s takes some 4 s, with 2 s to start and 2 s to
+level; a door held by no one shuts after about 5 s; at a busy hour a hospital lift
+answers a call in up to a minute or more (``tree.lift_wait_s`` is 3 min).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Protocol
+
+import numpy as np
+
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.geometry import se2_compose, se2_inverse
+from pmnav_bt.seams import LiftDoor, LiftMotion, LiftState, Pose2D
+from pmnav_bt.sim.clock import SimClock
+from pmnav_bt.sim.scene.lifts import Cabin
+
+DOOR_S = 3.0
+LEVEL_S = 8.0
+DWELL_S = 5.0
+CALL_DELAY_S = (0.0, 40.0)
+
+
+class LiftError(PmNavError):
+    """A request names a lift or a level the lift system does not have."""
+
+
+class Rider(Protocol):
+    """What the lift needs of the robot: which level's world it is in, where in it, and
+    how to move it to another level's world (``sim.levels.LevelBody``)."""
+
+    level: str
+
+    def world_pose(self) -> Pose2D: ...
+
+    def carry(self, level: str, pose: Pose2D) -> None: ...
+
+
+class Phase(str, Enum):
+    """What a lift is doing."""
+
+    IDLE = "idle"  # at a level, door shut, nothing asked
+    CALLED = "called"  # serving other calls first (the call delay)
+    CLOSING = "closing"
+    RIDING = "riding"
+    OPENING = "opening"
+    OPEN = "open"
+
+
+@dataclass
+class _Car:
+    """One lift's state: where its cabin is and what it is doing until ``until``."""
+
+    id: str
+    name: str
+    cabins: dict[str, Cabin]  # by level, in the levels' order
+    level: str
+    dest: str
+    phase: Phase = Phase.IDLE
+    until: float = math.inf
+    session: str = ""
+    full: bool = False
+    carrying: bool = False
+    levels: tuple[str, ...] = field(default=())
+
+
+class SimLift:
+    """The lift system of a simulated building of several levels (``seams.Lift``; see the
+    module). ``clock``: the simulation's; ``rider``: the robot; ``full_p``: how often a
+    call is answered full; ``rng``: the seeded stream of call delays and full cabins."""
+
+    def __init__(
+        self, clock: SimClock, rider: Rider, rng: np.random.Generator, full_p: float = 0.0
+    ) -> None:
+        self.clock, self.rider, self.rng, self.full_p = clock, rider, rng, float(full_p)
+        self._cars: dict[str, _Car] = {}
+        clock.add_listener(self._advance)
+
+    def add(self, lift: str, name: str, cabins: Mapping[str, Cabin], at: str) -> None:
+        """A lift ``lift`` (``name`` as people call it) with its cabin on each level it
+        serves (``cabins``, in the levels' order from the lowest), standing at ``at``."""
+        if at not in cabins:
+            raise LiftError(f"lift {lift}: it does not serve level {at!r}")
+        self._cars[lift] = _Car(lift, name, dict(cabins), at, at, levels=tuple(cabins))
+
+    def close(self) -> None:
+        """Stop following the clock."""
+        self.clock.remove_listener(self._advance)
+
+    # -- seams.Lift ----------------------------------------------------------------------------
+
+    def request(self, lift: str, level: str, session: str) -> None:
+        car = self._car(lift, level)
+        call = car.session != session
+        car.session = session
+        if car.level == level and car.phase in (Phase.OPENING, Phase.OPEN):
+            return  # here already: the door stays open for the session
+        car.dest = level
+        now = self.clock.now()
+        if call:
+            car.full = bool(self.rng.random() < self.full_p)
+            car.phase, car.until = Phase.CALLED, now + float(self.rng.uniform(*CALL_DELAY_S))
+        elif car.phase == Phase.OPEN:
+            car.phase, car.until = Phase.CLOSING, now + DOOR_S
+            car.cabins[car.level].set_door(False)
+
+    def release(self, lift: str, session: str) -> None:
+        car = self._car(lift)
+        if session != car.session:
+            return
+        car.session = ""
+        if car.phase == Phase.CALLED:
+            car.phase, car.until = Phase.IDLE, math.inf
+        elif car.phase == Phase.OPEN:
+            car.until = self.clock.now() + DWELL_S
+
+    def state(self, lift: str) -> LiftState | None:
+        car = self._car(lift)
+        door = {Phase.OPEN: LiftDoor.OPEN, Phase.OPENING: LiftDoor.MOVING}.get(
+            car.phase, LiftDoor.MOVING if car.phase == Phase.CLOSING else LiftDoor.CLOSED
+        )
+        motion = LiftMotion.STOPPED
+        if car.phase == Phase.RIDING:
+            up = car.levels.index(car.dest) > car.levels.index(car.level)
+            motion = LiftMotion.UP if up else LiftMotion.DOWN
+        return LiftState(
+            lift=car.id,
+            current_level=car.level,
+            destination_level=car.dest,
+            door=door,
+            motion=motion,
+            session=car.session,
+            available_levels=car.levels,
+            stamp=self.clock.now(),
+        )
+
+    # -- the lift's own time ---------------------------------------------------------------------
+
+    def _car(self, lift: str, level: str | None = None) -> _Car:
+        car = self._cars.get(lift)
+        if car is None:
+            raise LiftError(f"no lift {lift!r} here; lifts: {', '.join(sorted(self._cars))}")
+        if level is not None and level not in car.cabins:
+            raise LiftError(f"{car.name} does not serve level {level!r}")
+        return car
+
+    def _advance(self, h: float) -> None:
+        """Clock listener: end each lift's phase whose time is up."""
+        now = self.clock.now() + h
+        for car in self._cars.values():
+            while car.until <= now:
+                self._next(car, car.until)
+
+    def _next(self, car: _Car, t: float) -> None:
+        cabin = car.cabins[car.level]
+        if car.phase == Phase.CALLED:
+            car.phase, car.until = self._leave_or_open(car, t)
+        elif car.phase == Phase.CLOSING:
+            car.phase, car.until = self._leave_or_open(car, t, closed=True)
+        elif car.phase == Phase.RIDING:
+            self._arrive(car)
+            car.phase, car.until = Phase.OPENING, t + DOOR_S
+        elif car.phase == Phase.OPENING:
+            cabin.set_door(True)
+            car.phase, car.until = Phase.OPEN, t + DWELL_S if not car.session else math.inf
+        elif car.phase == Phase.OPEN:  # no one holds it: shut; people riding on go on
+            cabin.set_door(False)
+            if car.full:
+                car.dest = self._elsewhere(car)
+            car.phase, car.until = Phase.CLOSING, t + DOOR_S
+        else:
+            car.until = math.inf
+
+    def _leave_or_open(self, car: _Car, t: float, closed: bool = False) -> tuple[Phase, float]:
+        """The door shut (or the call's delay over): ride to the destination, or open here."""
+        cabin = car.cabins[car.level]
+        if cabin.is_open:
+            cabin.set_door(False)
+            return Phase.CLOSING, t + DOOR_S
+        if car.dest == car.level:
+            if closed and not car.session:
+                return Phase.IDLE, math.inf
+            if car.full and not cabin.cart:
+                cabin.fill()  # they got in on the way: no room for the robot
+            return Phase.OPENING, t + DOOR_S
+        rider = self.rider
+        car.carrying = rider.level == car.level and cabin.holds(*_xy(rider.world_pose()))
+        cabin.empty()
+        storeys = abs(car.levels.index(car.dest) - car.levels.index(car.level))
+        return Phase.RIDING, t + LEVEL_S * storeys
+
+    def _arrive(self, car: _Car) -> None:
+        """At the destination: the robot carried into this level's cabin, the cart too."""
+        here, there = car.cabins[car.level], car.cabins[car.dest]
+        car.level = car.dest
+        if car.carrying:
+            f0, f1 = here.frame, there.frame
+            rel = se2_compose(
+                se2_inverse((f0.x, f0.y, f0.yaw)), _tuple(self.rider.world_pose())
+            )
+            x, y, yaw = se2_compose((f1.x, f1.y, f1.yaw), rel)
+            self.rider.carry(car.level, Pose2D(x, y, yaw))
+            car.carrying = False
+        elif car.full and not car.session:
+            car.full = False  # the people got out where they were going
+        if car.full:
+            there.fill()
+
+    def _elsewhere(self, car: _Car) -> str:
+        others: Sequence[str] = [lv for lv in car.levels if lv != car.level]
+        return others[int(self.rng.integers(len(others)))] if others else car.level
+
+
+def _xy(p: Pose2D) -> tuple[float, float]:
+    return p.x, p.y
+
+
+def _tuple(p: Pose2D) -> tuple[float, float, float]:
+    return p.x, p.y, p.yaw

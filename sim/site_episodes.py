@@ -1,0 +1,151 @@
+"""Episodes across levels (issue 40): a start on one level of a site, a goal room on
+another, reached by lift (the tier ``cross_level``).
+
+A ``SiteEpisode`` names its site (a site file or a built-in site), the start level and
+pose (that level's map frame, on a corridor centre line, along the corridor), the goal
+room and its level. Its route is the ``SitePlan`` from the start (``planning/site_plan.py``):
+``route_length`` is the corridor metres of its legs together, the rides not counted.
+Generation is seeded: the same site, n and seed give the same episodes.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from pmnav_bt.errors import PmNavError
+from pmnav_bt.eval.task import action_budget
+from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.map.site import Site, load_site
+from pmnav_bt.map.site_map import SiteMap, parse_site
+from pmnav_bt.planning.resolve import resolve_site_room, resolve_start
+from pmnav_bt.planning.site_plan import SitePlan, SitePlanner
+from pmnav_bt.seams import Pose2D
+from pmnav_bt.sim.episodes import _candidates
+
+CROSS_LEVEL = "cross_level"  # the tier of an episode whose goal is on another level
+# The actions a lift ride adds to an episode's budget (eval/task.py's rule for the legs):
+# to the lobby, into the cabin, round, out, and on arrival a localization from scratch
+# (a panorama of 6-12 views and a fix, as at the start). One ride in hospital_2l's
+# realistic world took 66 (the lobby to the fix on the next level).
+RIDE_ACTIONS = 100
+
+
+class SiteEpisodeError(PmNavError):
+    """A site episode cannot be made: a one-level site, an unknown start or goal."""
+
+
+@dataclass(frozen=True)
+class SiteEpisode:
+    """One task across levels (see the module)."""
+
+    id: str
+    site: str
+    start_level: str
+    start_x: float
+    start_y: float
+    start_yaw: float
+    goal: str  # room id on ``goal_level``
+    goal_level: str
+    route_length: float
+    seed: int
+    rides: int
+    tier: str = CROSS_LEVEL
+
+    @property
+    def start_pose(self) -> Pose2D:
+        return Pose2D(self.start_x, self.start_y, self.start_yaw)
+
+    @property
+    def step_budget(self) -> int:
+        """The default budget rule on the legs' corridors, and ``RIDE_ACTIONS`` a ride."""
+        return action_budget(self.route_length) + RIDE_ACTIONS * self.rides
+
+
+def site_map(site: str | Site) -> SiteMap:
+    """The priori-maps of a site of several levels (a name or a path, or a Site)."""
+    s = site if isinstance(site, Site) else load_site(site)
+    if len(s.levels) < 2:
+        raise SiteEpisodeError(f"{s.name} has one level: its episodes are 'pmnav sim episodes'")
+    return parse_site(s)
+
+
+def site_plan(sm: SiteMap, ep: SiteEpisode) -> SitePlan:
+    """The route of ``ep`` across levels."""
+    return SitePlanner().plan(sm, ep.start_level, ep.start_pose, f"{ep.goal_level}/{ep.goal}")
+
+
+def custom_site_episode(
+    site: str, goal: str, start: str | None = None, seed: int = 0
+) -> SiteEpisode:
+    """An episode for ``pmnav sim run`` in a site: ``goal`` as a person names it (on any
+    level, qualified where it is on several: "L2/toilets"); ``start`` a start on a level
+    ("L2/x,y,yaw_deg", "L2/start"; unqualified: on the first level), by default the first
+    level's start waypoint, facing along its corridor."""
+    sm = site_map(site)
+    level, _, where = (start or "").rpartition("/")
+    level = sm.site.level(level).name if level else sm.site.levels[0].name
+    pm = sm.maps[level]
+    sp = resolve_start(pm, where or _start_waypoint(sm, level))
+    a, b = pm.node_xy(sp.segment.a), pm.node_xy(sp.segment.b)
+    xy = a + sp.t * (b - a)
+    yaw = sp.heading if sp.heading is not None else sp.segment.heading
+    if not where:  # a little into the corridor, not against the end wall
+        xy = xy + 0.5 * np.array([math.cos(yaw), math.sin(yaw)])
+    goal_level, room = resolve_site_room(sm, goal)
+    ident = f"{sm.site.name}-{goal_level}-{room}"
+    return _episode(sm, ident, level, xy, yaw, goal_level, room, seed)
+
+
+def _start_waypoint(sm: SiteMap, level: str) -> str:
+    b = sm.maps[level].building
+    w = next((w for w in b.waypoints if w.kind.value == "start"), b.waypoints[0])
+    return w.id
+
+
+def _episode(sm, ident, level, xy, yaw, goal_level, room, seed) -> SiteEpisode:
+    pose = Pose2D(float(xy[0]), float(xy[1]), float(yaw))
+    plan = SitePlanner().plan(sm, level, pose, f"{goal_level}/{room}")
+    return SiteEpisode(
+        id=ident,
+        site=sm.site.name,
+        start_level=level,
+        start_x=pose.x,
+        start_y=pose.y,
+        start_yaw=pose.yaw,
+        goal=room,
+        goal_level=goal_level,
+        route_length=plan.length,
+        seed=int(seed),
+        rides=len(plan.rides),
+    )
+
+
+def generate_site_episodes(site: str | Site, n: int, seed: int = 0) -> list[SiteEpisode]:
+    """``n`` episodes across levels: the start level, then a goal level other than it and a
+    goal room there, then a start on the start level's centre lines (clear of junctions and
+    ends, as the one-level tiers' starts) facing either way, all drawn from ``seed``."""
+    if n < 0:
+        raise SiteEpisodeError(f"the number of episodes must be >= 0, not {n}")
+    sm = site_map(site)
+    names = list(sm.site.level_names)
+    rng = np.random.default_rng([seed, zlib.crc32(sm.site.name.encode()), 40])
+    out: list[SiteEpisode] = []
+    while len(out) < n:
+        level = names[int(rng.integers(len(names)))]
+        others = [lv for lv in names if lv != level]
+        goal_level = others[int(rng.integers(len(others)))]
+        rooms = sorted(r.id for r in sm.maps[goal_level].building.rooms)
+        room = rooms[int(rng.integers(len(rooms)))]
+        pm = sm.maps[level]
+        xy, seg_idx, _ = _candidates(pm)
+        i = int(rng.integers(len(xy)))
+        seg = pm.segments[int(seg_idx[i])]
+        yaw = wrap_angle(seg.heading + (math.pi if rng.random() < 0.5 else 0.0))
+        ident = f"{sm.site.name}-{CROSS_LEVEL}-s{seed}-{len(out):03d}"
+        ep_seed = int(rng.integers(2**31 - 1))
+        out.append(_episode(sm, ident, level, np.round(xy[i], 3), yaw, goal_level, room, ep_seed))
+    return out
