@@ -15,8 +15,8 @@ from pmnav_bt.perception.corner import (
     is_open_way,
     is_opening,
 )
-from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.perception.depth import plate_pose, surfaces
+from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.seams import CameraIntrinsics, Observation, Pose2D
 
 K = CameraIntrinsics.from_hfov(320, 240, math.radians(60.0))
