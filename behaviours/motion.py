@@ -25,9 +25,10 @@ from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
 from pmnav_bt.map.wording import shut_way_words
-from pmnav_bt.perception.corner import is_corner, is_opening, mask_ratios
+from pmnav_bt.perception.corner import band_reach, is_corner, is_open_way, mask_ratios
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.perception.movers import moved
+from pmnav_bt.pose.visibility import Visibility
 from pmnav_bt.seams import MotionStatus
 from pmnav_bt.tree_variants import DetourCheck
 from pmnav_bt.way_ahead import Hold, Verdict, WayShut, judge
@@ -56,6 +57,8 @@ MOVER_REACH_M = 0.5  # what moved this far beyond the thing in the way counts (i
 # Something that moves (a person) is passed this much wider and farther than clutter: a
 # person steps and turns (0.3 m of personal space), and is never brushed past.
 PERSON_SPACE_M = 0.3
+# The opening check looks this far along the map's floor (beyond what the band can show).
+FLOOR_RUN_MOST_M = 10.0
 
 
 class DriveTo(PmNavBehaviour):
@@ -459,36 +462,57 @@ class TurnOnto(PmNavBehaviour):
 
 
 class CheckOpening(PmNavBehaviour):
-    """Fork choice / turn check: the way now ahead is an open corridor (floor in the band).
+    """Fork choice / turn check: the way now ahead is open as far as the map says.
 
-    Reads ``target``. FAILURE (TARGET_NOT_FOUND) when a wall fills the way ahead.
+    The paper's check: floor in the lower-central band (``is_opening``). That band sees
+    the floor only from some metres out; where the map's floor along the plan's way out
+    of the target ends sooner (``floor_run``), depth decides instead (``is_open_way``).
+    Reads ``target``, ``plan``, ``map_T_odom``. FAILURE (TARGET_NOT_FOUND) when a wall
+    fills the way ahead.
     """
 
-    READS = ("target",)
+    READS = ("target", "plan", "map_T_odom")
     JOBS = ("_job",)
 
     def initialise(self) -> None:
         base, grounder = self.ctx.base, self.ctx.grounder
+        t = self.get("target")
+        est = map_pose(self.get("map_T_odom"), base.pose())
+        self._run = floor_run(self.ctx, t.position, out_heading(self.get("plan"), t), est)
 
         def look(cancelled):
             obs = base.observe()
-            return mask_ratios(obs, grounder)
+            free = None if obs.depth is None else free_distance(obs, 0.0)
+            return mask_ratios(obs, grounder), free, band_reach(obs)
 
         self._job = self.ctx.worker.submit(look)
 
     def update(self) -> Status:
-        status, ratios = self.poll(self._job, "checking the way ahead")
+        status, seen = self.poll(self._job, "checking the way ahead")
         if status is not None:
             return status
+        ratios, free, reach = seen
         t = self.get("target")
-        if not is_opening(ratios):
+        depth = "" if free is None else f"; depth {free:.1f} m free, the map {self._run:.1f} m"
+        if not is_open_way(ratios, free, self._run, reach):
             return self.fail(
                 FailureCode.TARGET_NOT_FOUND,
                 f"no corridor to take at {t.landmark} (floor {ratios.floor:.2f}, "
-                f"wall {ratios.wall:.2f})",
+                f"wall {ratios.wall:.2f}{depth})",
             )
-        self.feedback_message = f"open (floor {ratios.floor:.2f})"
+        self.feedback_message = f"open (floor {ratios.floor:.2f}{depth})"
         return Status.SUCCESS
+
+
+def floor_run(ctx: Context, position, heading: float, est) -> float:
+    """How far (m, at most ``FLOOR_RUN_MOST_M`` past ``position``) the map's floor runs
+    along ``heading`` (the plan's way out of the waypoint at ``position``), counted from
+    level with the estimated pose ``est``: the wall model the localization weighs depth
+    against (``ctx.walls``: the building's grid where it has one, else its corridors)."""
+    floor = ctx.walls.floor(ctx.pm, Visibility.of(ctx.pm))
+    run = floor.reach(np.asarray(position, float), np.array([heading]), FLOOR_RUN_MOST_M)
+    behind = (position[0] - est.x) * math.cos(heading) + (position[1] - est.y) * math.sin(heading)
+    return float(run[0]) + behind
 
 
 class Arrive(PmNavBehaviour):

@@ -406,16 +406,18 @@ def goal_door(pm: PrioriMap, room: str) -> tuple[float, float]:
 
 
 def goal_door_in_world(world, pm: PrioriMap, room: str) -> tuple[float, float]:
-    """The door point of a room where ``world`` (a SimWorld) has the door: the file's door
-    point, moved as far as the simulator moved the door onto the grid's real wall
-    (``SimWorld.moved_items``; none with the annotated walls). Success is measured here:
-    a person judging the run stands at the door the building has, not at the annotation."""
-    door = goal_door(pm, room)
+    """The door point of a room where ``world`` (a SimWorld) has the door: with grid walls,
+    the centre of the door the simulator hung on the grid's real wall
+    (``SimWorld.moved_items``); else the file's door point. Success is measured here: a
+    person judging the run stands at the door the building has, not at the annotation.
+    (Not the file's point moved by the door's shift off its annotated wall: a door point
+    already in the real wall, as an imported RMF door's is, would move as far again,
+    behind the wall, by the gap between the annotated wall and the real one.)"""
     rid = resolve_room(pm, room)
     for m in world.moved_items:
         if m.kind == "door" and m.id == rid:
-            return door[0] + m.shift[0], door[1] + m.shift[1]
-    return door
+            return m.placed
+    return goal_door(pm, room)
 
 
 def goal_stop_point(pm: PrioriMap, room: str) -> tuple[float, float]:

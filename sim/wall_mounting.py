@@ -26,6 +26,9 @@ ITEM_CLEAR_FRONT = 0.3  # ... and in front of it, where a ragged wall bulges pas
 DOOR_OPENING_MAX_M = 0.6  # a room behind a door wall at most this thick is opened into
 DOORWAY_DEPTH_M = 0.3  # else the opening is a doorway this deep (a room the scan never saw)
 MOVED_M = 0.1  # items moved less than this (two grid cells) count as in place
+# A file point this close to the real wall's face (or inside the wall: a drawn wall is
+# about 0.15 m thick, the point on its centre line) is where the item is on that wall.
+IN_WALL_M = 0.3
 
 
 @dataclass(frozen=True)
@@ -66,18 +69,49 @@ class GridMounts:
         self.parent: dict[int, int] = {}  # mounted wall segment -> its annotated one
         self.missed: set[int] = set()  # mounted segments where no real wall was found
 
-    def real_wall(self, a, b, normal, s: float, half: float) -> tuple[tuple, tuple, tuple, bool]:
+    def real_wall(
+        self, a, b, normal, s: float, half: float, at=None
+    ) -> tuple[tuple, tuple, tuple, bool]:
         """Ends and normal of the real wall through the item at ``s`` on annotated wall
-        ``a``-``b`` (``half`` its half width), and whether a wall was found there."""
+        ``a``-``b`` (``half`` its half width), and whether a wall was found there.
+
+        ``at``: the item's file point. Where it lies in the real wall or on its face
+        (within ``IN_WALL_M``: an imported RMF door, drawn where the door is), the item
+        hangs there, not where its annotated wall puts it: one width per corridor cannot
+        follow a hall's walls, and an item is kept within its annotated wall's ends, which
+        the corridors' outline cuts short where corridors meet (a door moved a metre or
+        more along the real wall, or onto another wall)."""
         a, b, n = (np.asarray(v, float) for v in (a, b, normal))
         tan = (b - a) / np.linalg.norm(b - a)
-        m: WallMount | None = self.walls.mount(a + s * tan, n, half)
+        m: WallMount | None = None
+        if at is not None:
+            face = self._face(np.asarray(at, float), n)
+            if face is not None:
+                m = self.walls.mount(np.asarray(at, float), face, half, search=IN_WALL_M)
+        if m is None:
+            m = self.walls.mount(a + s * tan, n, half)
         if m is None:
             return _xy(a), _xy(b), _xy(n), False
         nn = np.asarray(m.normal)
         tt = np.array([nn[1], -nn[0]])  # the real wall's direction, same sense as a -> b
         start = np.asarray(m.point) - s * tt
         return _xy(start), _xy(start + float(np.linalg.norm(b - a)) * tt), _xy(nn), True
+
+    def _face(self, pt: np.ndarray, normal: np.ndarray) -> np.ndarray | None:
+        """The unit normal of the real wall face nearest ``pt`` (towards the free space),
+        that face within ``IN_WALL_M`` and not facing away from the annotated ``normal``'s
+        corridor; None when ``pt`` is not in or on a real wall."""
+        angles = np.radians(np.arange(0.0, 360.0, 10.0))
+        ways = np.stack([np.cos(angles), np.sin(angles)], 1)
+        ways = ways[ways @ normal > -0.5]
+        step = self.walls.plan.resolution / 2.0
+        for r in np.arange(0.0, IN_WALL_M + 1e-9, step):
+            free = self.walls.free_at(pt[None, :] + r * ways)
+            if r == 0.0 and free.any():
+                return None  # on the free floor: not in a wall
+            if free.any():
+                return ways[free].mean(axis=0) / np.linalg.norm(ways[free].mean(axis=0))
+        return None
 
     def record(self, mounted: int, annotated: int, found: bool) -> None:
         self.parent[mounted] = annotated

@@ -701,16 +701,17 @@ class SimWorld:
         placed = self._placer.place(what, pt, half)
         for problem in placed.problems:
             log.warning("%s", problem)
-        return self._mount(placed.wall, placed.s, half), placed.s
+        return self._mount(placed.wall, placed.s, half, pt), placed.s
 
-    def _mount(self, wi: int, s: float, half: float) -> int:
-        """Where the item at ``s`` on annotated wall ``wi`` hangs: with grid walls, on a wall
-        segment of its own through the grid's real wall there (``GridMounts``), measured in
-        the same ``s`` and sharing the annotated wall's occupied stretches; else on ``wi``."""
+    def _mount(self, wi: int, s: float, half: float, pt: tuple[float, float]) -> int:
+        """Where the item at ``s`` on annotated wall ``wi`` (its file point ``pt``) hangs:
+        with grid walls, on a wall segment of its own through the grid's real wall there
+        (``GridMounts``), measured in the same ``s`` and sharing the annotated wall's
+        occupied stretches; else on ``wi``."""
         if self._mounts is None:
             return wi
         w = self.walls[wi]
-        a, b, normal, found = self._mounts.real_wall(w.a, w.b, w.normal, s, half)
+        a, b, normal, found = self._mounts.real_wall(w.a, w.b, w.normal, s, half, at=pt)
         self.walls.append(WallSegment(a, b, normal))
         mounted = len(self.walls) - 1
         self._placer.share(mounted, wi)

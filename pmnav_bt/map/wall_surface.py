@@ -83,7 +83,7 @@ class RealWalls:
         self.plan = plan
         self.free = grid_free_space(plan) if free is None else free
 
-    def _free_at(self, xy: np.ndarray) -> np.ndarray:
+    def free_at(self, xy: np.ndarray) -> np.ndarray:
         """Free (bool) at map points ``xy`` (..., 2); outside the image is not free."""
         flat = xy.reshape(-1, 2)
         cell = self.plan.world_to_cell(flat)
@@ -103,7 +103,7 @@ class RealWalls:
         n = np.asarray(normal, float)
         step = self.plan.resolution / 2.0
         t = np.arange(-search - step, search + step + 1e-9, step)
-        free = self._free_at(pts[:, None, :] - t[None, :, None] * n)
+        free = self.free_at(pts[:, None, :] - t[None, :, None] * n)
         ends = free[:, :-1] & ~free[:, 1:]  # free, then not free: a surface (away from corridor)
         where = (t[:-1] + t[1:]) / 2.0
         # Nearest the annotation; a wall behind wins a tie with one in front.

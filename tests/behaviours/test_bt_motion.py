@@ -244,8 +244,8 @@ def test_turn_onto_turns_to_the_plan_heading_after_the_target(make_rig):
 def test_check_opening_at_turn1(make_rig, yaw, opening):
     # turn1: the corridor goes north (where it came from) and east; walls south and west.
     rig = make_rig(Pose2D(0.0, 0.0, yaw))
-    _, step = turn1(rig)
-    rig.set(target=step)
+    plan, step = turn1(rig)
+    rig.set(plan=plan, target=step)
     release = rig.hold_worker()
     check = CheckOpening("ForkChoice", rig.ctx)
     assert rig.tick(check) == Status.RUNNING  # the frame is taken in the worker

@@ -148,7 +148,8 @@ def test_the_way_watch_reports_a_silent_camera_not_an_obstacle(make_rig, pm):
 def test_check_opening_fails_when_a_wall_fills_the_way(make_rig, pm):
     for open_ahead, status in ((True, Status.SUCCESS), (False, Status.FAILURE)):
         r = make_rig(EAST, grounder=ScriptedGrounder(pm, open_ahead=open_ahead))
-        r.set(target=r.ctx.planner.plan(r.pm, "start", "room13").steps[0])
+        plan = r.ctx.planner.plan(r.pm, "start", "room13")
+        r.set(plan=plan, target=plan.steps[0])
         assert r.run(CheckOpening("ForkChoice", r.ctx))[-1] == status
         assert r.ctx.grounder.calls == ["surfaces"]
 

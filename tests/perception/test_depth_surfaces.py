@@ -7,8 +7,16 @@ import math
 import numpy as np
 import pytest
 
-from pmnav_bt.perception.corner import MaskRatios, central_band, is_corner, is_opening
+from pmnav_bt.perception.corner import (
+    MaskRatios,
+    band_reach,
+    central_band,
+    is_corner,
+    is_open_way,
+    is_opening,
+)
 from pmnav_bt.perception.depth import plate_pose, surfaces
+from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.seams import CameraIntrinsics, Observation, Pose2D
 
 K = CameraIntrinsics.from_hfov(320, 240, math.radians(60.0))
@@ -62,6 +70,35 @@ def test_the_mask_ratio_rule_tells_a_corner_from_a_corridor():
     assert is_corner(ratios(surfaces(obs_of(corridor_depth(1.8)[0]))))
     long = ratios(surfaces(obs_of(corridor_depth(15.0)[0])))
     assert is_opening(long) and not is_corner(long)
+
+
+def test_the_band_shows_a_quarter_floor_where_the_floor_runs_its_reach():
+    reach = band_reach(obs_of(corridor_depth(15.0)[0]))
+    assert 4.5 < reach < 5.5  # the 1.6 m, 60 deg, 320 x 240 camera: about 4.9 m
+    for ahead, share in ((reach - 0.3, False), (reach + 0.3, True)):
+        assert is_opening(ratios(surfaces(obs_of(corridor_depth(ahead)[0])))) == share
+
+
+@pytest.mark.parametrize(
+    "ahead, run, open_",
+    [
+        (2.9, 2.9, True),  # a short leg to the next turn: the wall stands where the map's
+        (2.2, 2.9, True),  # ... floor ends, or a little nearer (the estimate is off)
+        (1.0, 2.9, False),  # a wall half a corridor ahead: a wrong turn
+        (3.0, 10.0, False),  # the map's corridor goes on: the band decides, and says no
+        (12.0, 10.0, True),  # ... and yes
+    ],
+)
+def test_a_way_the_map_ends_short_is_judged_by_depth(ahead, run, open_):
+    """The band sees no floor nearer than 3.7 m, so a way the map itself ends within the
+    band's reach (a short leg, a lane towards a hall's far wall) is open when depth shows
+    the floor free to about where the map's ends."""
+    obs = obs_of(corridor_depth(ahead)[0])
+    r = ratios(surfaces(obs))
+    free = free_distance(obs, 0.0)
+    assert free == pytest.approx(ahead, abs=0.1)
+    assert is_open_way(r, free, run, band_reach(obs)) == open_
+    assert not is_open_way(r, None, run, band_reach(obs)) or is_opening(r)  # no depth
 
 
 def test_no_return_pixels_are_neither_and_the_rule_still_holds():

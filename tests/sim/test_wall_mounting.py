@@ -217,6 +217,28 @@ def test_success_is_measured_at_the_door_the_world_has(worlds):
     assert scored(0.6, door)
 
 
+def test_a_door_point_already_in_the_real_wall_is_where_success_is_measured(narrow):
+    """An imported RMF door's point is the door's centre in the real wall, while the
+    corridor is annotated narrower: the door hangs there (not where its annotated wall,
+    cut short at the corridor's end, would keep it), and success is measured there, not
+    as far again behind the wall (the annotated wall's gap to the real one)."""
+    from pmnav_bt.map.priori_map import parse_building
+    from pmnav_bt.sim.episodes import goal_door_in_world
+
+    data = yaml.safe_load(narrow.read_text())
+    data["rooms"][0]["door"] = [5.0, REAL_HALF]
+    # Near the corridor's end: its annotated wall ends at 12.8 m, and a door kept within
+    # it would hang at 12.22 m, 0.4 m along the real wall from where the door is.
+    data["rooms"][1]["door"] = [12.6, REAL_HALF]
+    real = narrow.with_name("door_in_the_real_wall.yaml")
+    real.write_text(yaml.safe_dump(data))
+    with SimWorld(real, walls="grid", ceiling=False) as w:
+        pm = parse_building(w.building)
+        for room, x in (("room1", 5.0), ("room2", 12.6)):
+            assert tuple(w.doors[room].centre) == pytest.approx((x, REAL_HALF), abs=0.06)
+            assert goal_door_in_world(w, pm, room) == pytest.approx((x, REAL_HALF), abs=0.06)
+
+
 def test_sim_show_says_what_moved_and_draws_the_grid_walls(narrow, tmp_path):
     args = ["show", str(narrow), "--out", str(tmp_path), "--width", "64", "--height", "48"]
     res = CliRunner().invoke(app, [*args, "--set", "sim.walls=grid"])
