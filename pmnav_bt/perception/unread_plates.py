@@ -34,7 +34,8 @@ from pmnav_bt.perception.sign_match import Evidence
 from pmnav_bt.seams import Observation
 
 SAME_PLATE_M = 0.4  # two sightings this near are one plate
-PLATE_Z_M = (0.8, 2.8)  # a plate's centre above the floor: door plates to flag signs
+PLATE_Z_M = (1.1, 2.7)  # a plate's centre above the floor: door plates to flag signs
+BORDER_PX = 2  # a candidate this near the frame's border is cut off: not judged
 MAX_PLATE_WIDTH_M = 1.2
 LINE_HEIGHT_M = (0.01, 0.2)  # a text line of a room plate: 20-80 mm capitals, as measured
 MAX_SEEN_M = 8.0  # farther than this, depth places a plate too poorly to drive to
@@ -80,6 +81,9 @@ def unread_plate(
     """The plate in ``box`` (frame pixels; ``line_px`` its text-line height in them) as
     depth places it, in the odometry frame; None without depth or where it cannot be a
     plate (see the module docstring)."""
+    h, w = obs.rgb.shape[:2]
+    if min(box[0], box[1], w - 1 - box[2], h - 1 - box[3]) < BORDER_PX:
+        return None
     plate = plate_pose(obs, box)
     if plate is None:
         return None
