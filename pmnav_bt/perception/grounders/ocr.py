@@ -11,6 +11,8 @@
   Without depth the door cannot be placed: the sign's detection stands in for it.
 - ``detect(landmark)``: the landmark's sign.
 - ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
+- ``unread_plates``: the plates it found but could not read, or read and could not tell
+  apart (``perception/unread_plates.py``), placed by depth, for the tree's active read.
 
 Where the body offers a wider view of the frame for reading (``Observation.reading``),
 plates are looked for in the frame and their crops read in that view (only the crops are
