@@ -198,7 +198,9 @@ class PlateRanges:
 
     def measured_range(self, width: int, row: int, recall: float) -> float:
         """The far end of the last band, counted from the nearest, with at least
-        ``recall`` for ``row`` at a measured ``width``; the nearest band's start if none."""
+        ``recall`` for ``row`` at a measured ``width``; the nearest band's start if none
+        (nearer than that the benchmark did not look: the reading pose's least standoff
+        is nearer still)."""
         far = self.bands[0][0]
         for (_, end), r in zip(self.bands, self.rows[width][row][1], strict=True):
             if r < recall:
@@ -209,9 +211,12 @@ class PlateRanges:
     def at_width(self, width: int, line_height: float, recall: float) -> float:
         """How far a plate with text lines ``line_height`` m high is read at a measured
         ``width``: between rows interpolated; beyond them in proportion to the height
-        (text that many pixels larger or smaller), no farther than the last band."""
+        (text that many pixels larger or smaller), no farther than the last band; never
+        less far for larger text."""
         rows = self.rows[width]
-        ranges = [self.measured_range(width, i, recall) for i in range(len(rows))]
+        # larger text is read at least as far as smaller (a row's few views are noisy)
+        measured = [self.measured_range(width, i, recall) for i in range(len(rows))]
+        ranges = [float(r) for r in np.maximum.accumulate(measured)]
         heights = [h for h, _ in rows]
         if line_height <= heights[0]:
             return ranges[0] * line_height / heights[0]
