@@ -34,6 +34,7 @@ KEYS = (
     "bearing",  # float: refined bearing to the target, relative to the chosen view
     "sighting",  # Sighting: the target's position seen, in the odometry frame
     "recent_sightings",  # list[Sighting]: the last verified sightings (pose re-fits)
+    "reading_pose",  # ReadingPlan: an unread plate and where to read it (active_read.py)
     "last_action",  # Action: the last plan action carried out
     "avoid_landmarks",  # frozenset[str]: landmark IDs that failed and are not used again
     "blocked_segments",  # frozenset[int]: segments found blocked (twice)

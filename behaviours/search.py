@@ -92,7 +92,8 @@ class CoarseDirection(PmNavBehaviour):
 class FaceAndGround(PmNavBehaviour):
     """Face a heading, then ground a target in a fresh frame (in the worker, which skips
     the detection once cancelled). The best detection ``accept`` takes becomes ``choice``
-    with the new frame; if none, the old ``choice`` stands. SUCCESS either way.
+    with the new frame; if none, the old ``choice`` stands. SUCCESS either way, unless
+    ``MUST_SEE``: then FAILURE (TARGET_NOT_FOUND) when the fresh frame shows none.
 
     Subclasses say where to look and for what (``aim``) and which detections count
     (``accept``). Writes ``choice``.
@@ -103,6 +104,7 @@ class FaceAndGround(PmNavBehaviour):
     STOPS_BASE = True
     ACTIVITY = "grounding the target"  # what a failed job was doing
     KEPT = "not in the fresh frame: keeping the earlier detection"
+    MUST_SEE = False
 
     def aim(self) -> tuple[float, Entity | None]:
         """The heading to face (rad, odometry frame) and what to ground there."""
@@ -138,6 +140,8 @@ class FaceAndGround(PmNavBehaviour):
             best = max(accepted, key=lambda d: d.score)
             self.bb.set("choice", CoarseChoice(View(0.0, obs, dets), best))
             self.feedback_message = f"seen in the fresh frame, score {best.score:.2f}"
+        elif self.MUST_SEE:
+            return self.fail(FailureCode.TARGET_NOT_FOUND, f"{self._target} not in the fresh frame")
         else:
             self.feedback_message = self.KEPT
         return Status.SUCCESS

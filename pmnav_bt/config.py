@@ -283,6 +283,13 @@ class TreeConfig(_Section):
         description="move this far towards a target not found before searching again; "
         "unset: half the search range, at most 2 m",
     )
+    active_reads: int = Field(
+        2,
+        ge=0,
+        le=10,
+        description="times a search drives to read a plate it saw but could not read near "
+        "the target, before moving on (behaviours/active_read.py); 0: never",
+    )
     replans: int = Field(2, ge=0, le=100, description="re-localize-and-replan recoveries")
     goal_offset: float = Field(
         STOP_OFFSET_M, ge=0.0, le=10.0, description="stop this far from the goal door"

@@ -133,7 +133,8 @@ def load(target: str) -> Any:
     return getattr(importlib.import_module(module), attr)
 
 
-PP_OCR_READING = "pmnav_bt.perception.read_range:PP_OCR"  # measured by bench_signs.py
+# measured by benchmarks/bench_signs.py and sign_ranges.py
+PP_OCR_READING = "pmnav_bt.perception.read_range:PP_OCR"
 
 GROUNDERS = Registry(
     "grounder",

@@ -116,7 +116,8 @@ def make_rig(request, body, pm, clean_blackboard):
     """``make_rig(pose, **options)`` -> Rig on the ``body`` fixture's body, in the module's
     building; options: ``width``, ``height``, ``seed``, ``budget``, ``overrides`` (config)
     for both bodies; ``grounder``, ``coarse``, ``refiner``, ``planner`` (doubles) on the
-    doubles; ``noise``, ``segmentation`` on pybullet. Everything is torn down afterwards."""
+    doubles; ``noise``, ``segmentation``, ``reading_width`` on pybullet. Everything is torn
+    down afterwards."""
     made: list[Rig] = []
 
     def make(pose: Pose2D, **options) -> Rig:

@@ -168,6 +168,7 @@ def build_rig(
     overrides: tuple[str, ...] = (),
     noise: float | None = None,
     segmentation: bool = True,
+    reading_width: int = 0,
     grounder: ScriptedGrounder | None = None,
     coarse: FakeCoarseDirection | None = None,
     refiner: FakeRefiner | None = None,
@@ -180,7 +181,8 @@ def build_rig(
     is a default one; background jobs start between ticks, as in simulation.
     ``"pybullet"``: a SimBase in ``world`` with the config's back ends; background jobs start
     at once, in the worker's thread. ``noise``: drifting odometry (NoisyOdometry) around the
-    body; ``segmentation``: the camera's labels (the ground-truth grounder needs them).
+    body; ``segmentation``: the camera's labels (the ground-truth grounder needs them);
+    ``reading_width``: a wider view for reading signs (``Observation.reading``; 0: none).
     """
     cfg = load_config(overrides=[ORACLE, *overrides])
     doubles = (grounder, coarse, refiner, planner)
@@ -189,11 +191,18 @@ def build_rig(
         from pmnav_bt.sim.robot import SimBase
 
         assert all(d is None for d in doubles), "test doubles need the doubles body"
-        sim = SimBase(world, pose=pose, width=width, height=height, segmentation=segmentation)
+        sim = SimBase(
+            world,
+            pose=pose,
+            width=width,
+            height=height,
+            segmentation=segmentation,
+            reading_width=reading_width,
+        )
         base = sim if noise is None else NoisyOdometry(sim, noise, seed=seed)
         return Rig(sim, base, make_context(base, pm, cfg, seed, budget), pm, writer(), world)
     assert body == "doubles", f"no body {body!r}; choose from {BODIES}"
-    assert noise is None and segmentation, "drifting odometry and labels need pybullet"
+    assert noise is None and segmentation and not reading_width, "these need pybullet"
     fake = FakeBase(pose, intrinsics=CameraIntrinsics.from_hfov(width, height, DOUBLES_HFOV))
     backends = Backends(
         grounder=grounder or ScriptedGrounder(pm),

@@ -48,6 +48,7 @@ from pmnav_bt.behaviours.search import (
     target_entity,
 )
 from pmnav_bt.perception.read_range import SearchRanges
+from pmnav_bt.trees.active_read import read_closer_subtree
 from pmnav_bt.trees.localize import active_localize_subtree
 from pmnav_bt.trees.mission import monitored_mission, sequence
 from pmnav_bt.trees.recovery import recovery_subtree
@@ -123,13 +124,16 @@ def step_subtree(ctx: Context, refine: bool = True) -> py_trees.behaviour.Behavi
         ),
         AlwaysFail(name="SearchAgain"),
     )
+    # A plate seen near the target but not read is read from nearer (grounding a fresh
+    # frame there: not in the coarse-only ablation, which grounds nothing).
+    read = [read_closer_subtree(ctx)] if refine and cfg.active_reads > 0 else []
     visible = sequence(
         "SeenTarget",
         TargetIs("IsVisible", ctx, visible=True),
         MoveToward("IntoSearchRange", ctx, keep=search_range),
         Retry(
             "Search",
-            Selector("SearchOrMoveOn", memory=True, children=[search_once, research]),
+            Selector("SearchOrMoveOn", memory=True, children=[search_once, *read, research]),
             num_failures=cfg.search_attempts,
         ),
         (PolicyApproach if closed_loop else Approach)("Approach", ctx),

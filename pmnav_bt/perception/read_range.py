@@ -26,10 +26,15 @@ Values set in the config win.
 
 from __future__ import annotations
 
+import functools
+import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from pmnav_bt.errors import ConfigError
 from pmnav_bt.geometry import side_of
@@ -46,6 +51,9 @@ OCR_RECALL: dict[int, tuple[tuple[float, float, float], ...]] = {
     320: ((1.5, 2.5, 0.939), (2.5, 3.5, 0.490), (3.5, 4.5, 0.033), (4.5, 6.0, 0.045)),
     640: ((1.5, 2.5, 0.949), (2.5, 3.5, 0.837), (3.5, 4.5, 0.300), (4.5, 6.0, 0.136)),
 }
+# benchmarks/sign_ranges.py: reads per distance band of plates by capital height, font and
+# camera width (the realistic preset's signage), for ``plate_read_range``.
+SIGN_RANGES_FILE = Path(__file__).parent.parent / "data" / "sign_ranges.json"
 # Plate kinds by the sign text (as the priori-map knows it; sim/textures.py lays plates out
 # so: a leading room number on its own line, the name's words wrapped at LINE_CHARS).
 PLATE_KINDS = ("number", "name", "long name")
@@ -70,6 +78,7 @@ OCR_RECALL_BY_KIND: dict[str, dict[int, tuple[tuple[float, float, float], ...]]]
 # of the 0-70 deg tables' recall kept up to each angle (deg).
 ANGLE_RECALL = ((70.0, 1.0), (75.0, 0.4), (90.0, 0.0))
 RELIABLE_RECALL = 0.75  # the tree searches where signs are read this often
+PLATE_RECALL = 0.8  # an active read goes where a plate of its size is read this often
 POSSIBLE_RECALL = 0.1  # beyond where signs are read this often, a reading is unexpected
 # The oracle's search settings (a sign read to 9 m): the tree's settings before the reader.
 MAX_SEARCH_RANGE_M = 4.5
@@ -160,21 +169,115 @@ def angle_share(angle: float) -> float:
 
 
 @dataclass(frozen=True)
+class PlateRanges:
+    """Recall by distance of plates by text size, from ``benchmarks/sign_ranges.py``
+    (``SIGN_RANGES_FILE``): per camera width, rows of (text-line height the reader
+    measures, m; recall per band of ``bands``), one row per capital height, pooled over
+    the fonts. The row is keyed by the line height the candidate finder measures (the
+    capitals and a pixel or two of edge: about 1.2 times the capitals), since that is
+    what the robot knows of a plate it has not read."""
+
+    bands: tuple[tuple[float, float], ...]
+    rows: dict[int, tuple[tuple[float, tuple[float, ...]], ...]]
+
+    @classmethod
+    def from_counts(cls, table: dict) -> PlateRanges:
+        bands = tuple((float(a), float(b)) for a, b in table["bands_m"])
+        cells: dict[tuple[int, float], list[dict]] = {}
+        for c in table["cells"]:
+            cells.setdefault((int(c["width"]), float(c["cap_height_m"])), []).append(c)
+        rows: dict[int, list] = {}
+        for (width, cap), mine in sorted(cells.items()):
+            views = [sum(c["views"][i] for c in mine) for i in range(len(bands))]
+            reads = [sum(c["reads"][i] for c in mine) for i in range(len(bands))]
+            lines = [c["line_height_m"] for c in mine if c.get("line_height_m")]
+            line = sorted(lines)[len(lines) // 2] if lines else cap
+            recall = tuple(r / v if v else 0.0 for r, v in zip(reads, views, strict=True))
+            rows.setdefault(width, []).append((line, recall))
+        return cls(bands, {w: tuple(sorted(r)) for w, r in rows.items()})
+
+    def measured_range(self, width: int, row: int, recall: float) -> float:
+        """The far end of the last band, counted from the nearest, with at least
+        ``recall`` for ``row`` at a measured ``width``; the nearest band's start if none
+        (nearer than that the benchmark did not look: the reading pose's least standoff
+        is nearer still)."""
+        far = self.bands[0][0]
+        for (_, end), r in zip(self.bands, self.rows[width][row][1], strict=True):
+            if r < recall:
+                break
+            far = end
+        return far
+
+    def at_width(self, width: int, line_height: float, recall: float) -> float:
+        """How far a plate with text lines ``line_height`` m high is read at a measured
+        ``width``: between rows interpolated; beyond them in proportion to the height
+        (text that many pixels larger or smaller), no farther than the last band; never
+        less far for larger text."""
+        rows = self.rows[width]
+        # larger text is read at least as far as smaller (a row's few views are noisy)
+        measured = [self.measured_range(width, i, recall) for i in range(len(rows))]
+        ranges = [float(r) for r in np.maximum.accumulate(measured)]
+        heights = [h for h, _ in rows]
+        if line_height <= heights[0]:
+            return ranges[0] * line_height / heights[0]
+        if line_height >= heights[-1]:
+            return min(self.bands[-1][1], ranges[-1] * line_height / heights[-1])
+        return float(np.interp(line_height, heights, ranges))
+
+    def read_range(self, width: int, line_height: float, recall: float = PLATE_RECALL) -> float:
+        """How far (m) a plate with text lines ``line_height`` m high is read at least
+        ``recall`` of the time with a camera ``width`` pixels wide: other widths as
+        ``ocr_read_range`` treats them."""
+        widths = sorted(self.rows)
+        if width <= widths[0]:
+            return self.at_width(widths[0], line_height * width / widths[0], recall)
+        for lo, hi in zip(widths, widths[1:], strict=False):
+            if width <= hi:
+                a = self.at_width(lo, line_height, recall)
+                b = self.at_width(hi, line_height, recall)
+                return a + (b - a) * (width - lo) / (hi - lo)
+        return self.at_width(widths[-1], line_height, recall)
+
+
+@functools.lru_cache(maxsize=2)
+def shipped_plate_ranges(path: Path = SIGN_RANGES_FILE) -> PlateRanges:
+    """The shipped table (``benchmarks/sign_ranges.py``), read once."""
+    try:
+        return PlateRanges.from_counts(json.loads(path.read_text()))
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise ConfigError(
+            f"{path}: the sign reading ranges table is missing or damaged ({e}); "
+            "regenerate it with python benchmarks/sign_ranges.py"
+        ) from e
+
+
+def ocr_plate_range(width: int, line_height: float, recall: float = PLATE_RECALL) -> float:
+    """How far (m) the OCR reader reads a plate with text lines ``line_height`` m high at
+    least ``recall`` of the time, with a camera ``width`` pixels wide (the shipped table)."""
+    return shipped_plate_ranges().read_range(width, line_height, recall)
+
+
+@dataclass(frozen=True)
 class ReadingModel:
     """How far and how often a reader names signs (its *reading model*), as a grounder
     declares it (``registry.GrounderSpec.reading``): ``read_range(width, recall, kind)``,
     the far end (m) of where it names at least ``recall`` of the plates of ``kind`` (None:
     all) with a camera ``width`` pixels wide; ``recall(width, distance, kind)``, the share
     it names from ``distance`` m; ``angle_share(angle)``, the share of that kept ``angle``
-    rad off the plate's normal. A grounder whose reading model is ``ORACLE_READING`` has
-    none of these: it reads every sign in sight up to ``grounder.max_range``."""
+    rad off the plate's normal; ``plate_range(width, line_height, recall)``, how far a
+    plate of any style whose text lines are ``line_height`` m high is read at least
+    ``recall`` of the time (where an active read goes to read a plate it saw). A grounder
+    whose reading model is ``ORACLE_READING`` has none of these: it reads every sign in
+    sight up to ``grounder.max_range``."""
 
     read_range: Callable[[int, float, str | None], float]
     recall: Callable[[int, float, str | None], float]
     angle_share: Callable[[float], float]
+    plate_range: Callable[[int, float, float], float]
 
 
-PP_OCR = ReadingModel(ocr_read_range, ocr_recall, angle_share)  # bench_signs.py's tables
+# bench_signs.py's tables (the first plates), sign_ranges.py's table (plates by text size)
+PP_OCR = ReadingModel(ocr_read_range, ocr_recall, angle_share, ocr_plate_range)
 
 
 def reading_model(config: Config) -> ReadingModel | None:
@@ -206,6 +309,17 @@ def sign_read_range(config: Config, width: int | None = None, kind: str | None =
     if model is None:
         return config.grounder.max_range
     return model.read_range(width or reading_width(config), RELIABLE_RECALL, kind)
+
+
+def plate_read_range(config: Config, line_height: float, width: int | None = None) -> float | None:
+    """How far (m) the configured grounder reads a plate whose text lines are
+    ``line_height`` m high at least ``PLATE_RECALL`` of the time (the reading camera's
+    ``width``, if not ``reading_width(config)``). None for the oracle: it reads every
+    sign in sight."""
+    model = reading_model(config)
+    if model is None:
+        return None
+    return model.plate_range(width or reading_width(config), line_height, PLATE_RECALL)
 
 
 def sign_visible_range(config: Config, width: int | None = None) -> float | None:

@@ -6,7 +6,8 @@
   and errors.
 - ``ScriptedGrounder``: sees what is in the camera's field of view within range on the
   priori-map (doors and landmarks where the map puts them), with a 3D ``point`` per
-  detection; entities can be hidden, signs made unreadable, errors injected.
+  detection; entities can be hidden, signs made unreadable (or readable only from near:
+  seen farther, an unread plate), errors injected.
 - ``FakeCoarseDirection``: the best detection across the views, recording which thread
   it ran in; ``FakeRefiner``: the pixel bearing and the grounder's range;
   ``FakePlanner``: the real ``GraphPlanner`` with injectable errors.
@@ -26,6 +27,7 @@ import numpy as np
 
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.map.priori_map import PrioriMap
+from pmnav_bt.perception.unread_plates import UnreadPlate, UnreadPlates
 from pmnav_bt.planning.graph_planner import GraphPlanner
 from pmnav_bt.planning.plan import Plan
 from pmnav_bt.planning.resolve import entity_position, sign_text
@@ -236,7 +238,10 @@ class ScriptedGrounder:
     ``hidden``: room/landmark IDs never seen; ``signs_readable``: False makes ``read_signs``
     see nothing (localization fails); ``error``: every call raises it (a buggy back end);
     ``open_ahead``: what ``surfaces`` shows in the lower band (floor, or a wall);
-    ``masks``: each detection carries its box as a mask (as a segmenting grounder's do).
+    ``masks``: each detection carries its box as a mask (as a segmenting grounder's do);
+    ``readable_within``: room/landmark ID -> metres: its sign is read only that near, and
+    seen farther it is an unread plate (``unread_plates``: at the entity's map point,
+    facing its node on the centre line, text lines ``PLATE_LINE_M`` high).
     """
 
     pm: PrioriMap
@@ -247,8 +252,16 @@ class ScriptedGrounder:
     open_ahead: bool = True
     score: float = 0.9
     masks: bool = False
+    readable_within: dict[str, float] = field(default_factory=dict)
     needs_sim_labels = False
     calls: list[str] = field(default_factory=list)
+    unread: UnreadPlates = field(default_factory=UnreadPlates)
+
+    PLATE_LINE_M = 0.05
+    PLATE_Z_M = 1.5
+
+    def unread_plates(self, since: float) -> list[UnreadPlate]:
+        return self.unread.since(since)
 
     def detect(self, obs: Observation, target: Entity) -> list[Detection]:
         self._called("detect")
@@ -291,6 +304,9 @@ class ScriptedGrounder:
         u = k.cx - k.fx * y / x
         if not 12 <= u <= k.width - 13:  # off the image, or cut by its border
             return None
+        if math.hypot(x, y) > self.readable_within.get(entity.id, math.inf):
+            self._unread(obs, entity, (mx, my))
+            return None
         v = k.cy
         box = (u - 10.0, v - 10.0, u + 10.0, v + 10.0)
         text = sign_text(self.pm.building, entity)
@@ -299,6 +315,24 @@ class ScriptedGrounder:
             mask = np.zeros((k.height, k.width), bool)
             mask[int(v) - 10 : int(v) + 10, int(round(u)) - 10 : int(round(u)) + 10] = True
         return Detection(text, box, self.score, mask=mask, entity=entity, point=(x, y, 0.0))
+
+
+    def _unread(self, obs: Observation, entity: Entity, at: tuple[float, float]) -> None:
+        node = self.pm.node_xy(self.pm.places[entity.id].node)
+        out = node - np.asarray(at, float)
+        n = float(np.linalg.norm(out))
+        if n > 1e-6:
+            self.unread.seen(
+                UnreadPlate(
+                    xy=(float(at[0]), float(at[1])),
+                    normal=(float(out[0] / n), float(out[1] / n)),
+                    z=self.PLATE_Z_M,
+                    line_height=self.PLATE_LINE_M,
+                    width=0.3,
+                    stamp=obs.stamp,
+                    seen_from=(obs.pose.x, obs.pose.y),
+                )
+            )
 
 
 @dataclass

@@ -187,6 +187,7 @@ FIVE_METRES = ReadingModel(
     lambda width, recall, kind: 5.0,
     lambda width, distance, kind: float(distance <= 5.0),
     lambda angle: 1.0,
+    lambda width, line_height, recall: 5.0,
 )
 
 

@@ -27,6 +27,7 @@ from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.doors import DoorLayout
 from pmnav_bt.perception.grounders.ocr import OcrGrounder, reader_and_layout
 from pmnav_bt.perception.signs import SignReader
+from pmnav_bt.perception.unread_plates import UnreadPlate
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
 
 # Phrases for landmark kinds GroundingDINO knows by another name.
@@ -112,6 +113,10 @@ class GdinoSamGrounder:
     def watch_reads(self, observer) -> None:
         """The sign reader's frames (``perception.map_check.WatchesReads``)."""
         self.signs.watch_reads(observer)
+
+    def unread_plates(self, since: float) -> list[UnreadPlate]:
+        """The sign reader's (``perception.unread_plates.SeesUnreadPlates``)."""
+        return self.signs.unread_plates(since)
 
     def surfaces(self, obs: Observation) -> SurfaceMasks:
         return depth_geom.surfaces(obs)

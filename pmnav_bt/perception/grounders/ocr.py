@@ -11,6 +11,8 @@
   Without depth the door cannot be placed: the sign's detection stands in for it.
 - ``detect(landmark)``: the landmark's sign.
 - ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
+- ``unread_plates``: the plates it found but could not read, or read and could not tell
+  apart (``perception/unread_plates.py``), placed by depth, for the tree's active read.
 
 Where the body offers a wider view of the frame for reading (``Observation.reading``),
 plates are looked for in the frame and their crops read in that view (only the crops are
@@ -32,8 +34,9 @@ from pmnav_bt.map.building import Building
 from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.doors import DoorLayout, door_from_sign
 from pmnav_bt.perception.grounders.plate_memory import PlateMemory
-from pmnav_bt.perception.sign_match import Match, SignMatcher, decide
-from pmnav_bt.perception.signs import MIN_LINE_PX, SignReader, SignText, scale_sign
+from pmnav_bt.perception.sign_match import Evidence, Match, SignMatcher, decide
+from pmnav_bt.perception.signs import MIN_LINE_PX, Box, SignReader, SignText, scale_sign
+from pmnav_bt.perception.unread_plates import UnreadPlate, UnreadPlates, ambiguous, unread_plate
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
 
 
@@ -60,6 +63,7 @@ class OcrGrounder:
         self.reader = reader if reader is not None else SignReader()
         self.matcher = SignMatcher(building)
         self.memory = PlateMemory(self._door_of)
+        self.unread = UnreadPlates()
         self.layout = layout if layout is not None else DoorLayout()
         self._lock = threading.Lock()
         self._memory_lock = threading.Lock()
@@ -83,6 +87,11 @@ class OcrGrounder:
     def surfaces(self, obs: Observation) -> SurfaceMasks:
         return depth_geom.surfaces(obs)
 
+    # -- plates seen but not read (perception.unread_plates.SeesUnreadPlates) ------------
+
+    def unread_plates(self, since: float) -> list[UnreadPlate]:
+        return self.unread.since(since)
+
     # -- what a map check watches (perception.map_check.WatchesReads) ---------------------
 
     def watch_reads(self, observer) -> None:
@@ -99,14 +108,21 @@ class OcrGrounder:
             if c is not None and c[0] is obs.rgb and c[1] == obs.stamp:
                 return c[2]
         signs, doors, unmatched = [], [], []
-        for sign in self._read_text(obs):
+        for box, line_px, sign in self._read_text(obs):
+            if sign is None:  # a plate seen, its text not read
+                self._unread(obs, box, line_px, "")
+                continue
             lines = [(ln.text, ln.score) for ln in sign.lines]
             plate = depth_geom.plate_pose(obs, sign.box)
-            m = self._match(obs, sign, plate)
+            m, ev = self._match(obs, sign, plate)
             if m is None:
+                if ambiguous(ev):
+                    self._unread(obs, box, line_px, sign.text)
                 if self._observer is not None and self.matcher.trusted(lines):
                     unmatched.append(_unmatched(obs, sign))
                 continue
+            if plate is not None:
+                self.unread.read_at(_odom(obs, plate.centre))
             det = Detection(
                 label=sign.text,
                 box=sign.box,
@@ -129,18 +145,21 @@ class OcrGrounder:
 
     def _match(
         self, obs: Observation, sign: SignText, plate: depth_geom.PlatePose | None
-    ) -> Match | None:
+    ) -> tuple[Match | None, Evidence]:
         """What ``sign`` names: with its plate's place known, all reads of that plate and
-        the plates named around it weighed (``PlateMemory``); else this read alone."""
+        the plates named around it weighed (``PlateMemory``); else this read alone. With
+        the evidence of this read."""
         ev = self.matcher.evidence([(ln.text, ln.score, ln.char_scores) for ln in sign.lines])
         if plate is None:
-            return decide(ev)
+            return decide(ev), ev
         p = obs.pose
-        x, y = float(plate.centre[0]), float(plate.centre[1])
-        c, s = math.cos(p.yaw), math.sin(p.yaw)
-        xy = (p.x + c * x - s * y, p.y + s * x + c * y)
         with self._memory_lock:
-            return self.memory.read(xy, (p.x, p.y, p.yaw), obs.stamp, ev)
+            return self.memory.read(_odom(obs, plate.centre), (p.x, p.y, p.yaw), obs.stamp, ev), ev
+
+    def _unread(self, obs: Observation, box: Box, line_px: float, read: str) -> None:
+        plate = unread_plate(obs, box, line_px, read)
+        if plate is not None:
+            self.unread.seen(plate)
 
     def _door_of(self, e: Entity) -> tuple[float, float] | None:
         """Where the map puts ``e``'s door (a landmark: where it stands); None where the
@@ -149,21 +168,23 @@ class OcrGrounder:
         x, y = b.room(e.id).door if e.kind == EntityKind.ROOM else b.landmark(e.id).pos
         return (float(x), float(y)) if math.isfinite(x) and math.isfinite(y) else None
 
-    def _read_text(self, obs: Observation) -> list[SignText]:
-        """The frame's signs, boxes in the frame's pixels. Where the body offers a wider
-        view (``obs.reading``), plates are looked for in the frame as the reader looks for
-        them in that view (scaled lines as low), and only their crops of the view are made
-        and read."""
+    def _read_text(self, obs: Observation) -> list[tuple[Box, float, SignText | None]]:
+        """The frame's plate candidates (box and text-line height in the frame's pixels),
+        each with its text (None: not read). Where the body offers a wider view
+        (``obs.reading``), plates are looked for in the frame as the reader looks for them
+        in that view (scaled lines as low), and only their crops of the view are made and
+        read."""
         r = obs.reading
         w = obs.rgb.shape[1]
         if r is None or r.width <= w:
-            return self.reader.read(obs.rgb)
+            found = self.reader.candidates(obs.rgb)
+            return _by_candidate(found, self.reader.read(obs.rgb, found))
         s = r.width / w
         found = self.reader.candidates(obs.rgb, min_line_px=MIN_LINE_PX / s)
         if not found:
             return []
         cands = [((b[0] * s, b[1] * s, b[2] * s, b[3] * s), lh * s) for b, lh in found]
-        return [scale_sign(t, 1.0 / s) for t in self.reader.read(r, cands)]
+        return _by_candidate(found, [scale_sign(t, 1.0 / s) for t in self.reader.read(r, cands)])
 
     def _door(self, obs: Observation, sign: Detection, plate: depth_geom.PlatePose) -> Detection:
         door = door_from_sign(obs, plate, self.layout)
@@ -180,6 +201,26 @@ class OcrGrounder:
             entity=sign.entity,
             point=tuple(float(v) for v in door.centre),  # type: ignore[arg-type]
         )
+
+
+def _by_candidate(
+    found: list[tuple[Box, float]], read: list[SignText]
+) -> list[tuple[Box, float, SignText | None]]:
+    """Each candidate (box, line height) with the text read in it (the reader keeps a
+    candidate's box for its text), or None."""
+    out = []
+    for box, line_px in found:
+        same = (t for t in read if max(abs(a - b) for a, b in zip(t.box, box, strict=True)) < 1)
+        out.append((box, line_px, next(same, None)))
+    return out
+
+
+def _odom(obs: Observation, centre: np.ndarray) -> tuple[float, float]:
+    """A point of the camera body frame (x forward, y left) in the odometry frame."""
+    p = obs.pose
+    x, y = float(centre[0]), float(centre[1])
+    c, s = math.cos(p.yaw), math.sin(p.yaw)
+    return (p.x + c * x - s * y, p.y + s * x + c * y)
 
 
 def _unmatched(obs: Observation, sign: SignText) -> Detection:

@@ -1,0 +1,142 @@
+"""Plates seen but not read: where they hang, which way they face, how big their text is.
+
+A reader finds a plate long before it can read it: the candidate finder
+(``signs.SignReader.candidates``) sees a small, dense patch of text from 4-5 m where the
+recogniser needs the capitals a dozen pixels high. Such a plate is not "absent": the
+robot can go where it is read (``behaviours/active_read.py``). A plate is *unread* when
+its text was not read at all, or was read and fits a room of the building as well as
+another or no better than a plate the building does not hold (``ambiguous``: below the
+matcher's confidence). A read that clearly names nothing of the map (a directional sign,
+a notice) is not unread: it was read.
+
+What the tree needs of an unread plate comes from depth (``depth.plate_pose``): its
+centre and the wall's normal in the odometry frame, the height of its centre, and its
+text-line height in metres (the candidate's line height in pixels at the plate's depth),
+by which the reading model says from how far a plate of that size is read
+(``read_range.plate_read_range``). Candidates that cannot be plates (off the wall's
+height, too wide, text too tall) are left out.
+
+A grounder that reads plates remembers the unread ones (``UnreadPlates``, odometry frame,
+one entry per place, the newest sighting kept, dropped once the plate is read) and tells
+the tree through ``SeesUnreadPlates``. The oracle (``sim_gt``) reads every sign it sees:
+it has none.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+from pmnav_bt.perception.depth import plate_pose
+from pmnav_bt.perception.sign_match import Evidence
+from pmnav_bt.seams import Observation
+
+SAME_PLATE_M = 0.4  # two sightings this near are one plate
+PLATE_Z_M = (1.1, 2.7)  # a plate's centre above the floor: door plates to flag signs
+BORDER_PX = 2  # a candidate this near the frame's border is cut off: not judged
+MAX_PLATE_WIDTH_M = 1.2
+LINE_HEIGHT_M = (0.01, 0.2)  # a text line of a room plate: 20-80 mm capitals, as measured
+MAX_SEEN_M = 8.0  # farther than this, depth places a plate too poorly to drive to
+KEEP_S = 120.0  # an unread plate is remembered this long (clock s)
+
+
+@dataclass(frozen=True)
+class UnreadPlate:
+    """A plate seen but not read, in the odometry frame: ``xy`` its centre on the wall,
+    ``normal`` the wall's unit normal out towards where it was seen from, ``z`` its
+    centre's height above the floor, ``line_height`` its text-line height (m), ``width``
+    along the wall (m); ``stamp`` when and ``seen_from`` where it was seen; ``read``
+    what was read of it ("" nothing)."""
+
+    xy: tuple[float, float]
+    normal: tuple[float, float]
+    z: float
+    line_height: float
+    width: float
+    stamp: float
+    seen_from: tuple[float, float]
+    read: str = ""
+
+
+@runtime_checkable
+class SeesUnreadPlates(Protocol):
+    """A grounder that remembers the plates it saw but could not read (``UnreadPlate``,
+    odometry frame), seen at or after clock time ``since``."""
+
+    def unread_plates(self, since: float) -> list[UnreadPlate]: ...
+
+
+def ambiguous(ev: Evidence) -> bool:
+    """Whether a read that named nothing still fits a room or landmark as well as the
+    plate the building does not hold: a read below the matcher's confidence (look
+    nearer), not a plate that names nothing of the map."""
+    return bool(ev.entities) and max(ev.entities.values()) >= ev.unknown
+
+
+def unread_plate(
+    obs: Observation, box: tuple[float, float, float, float], line_px: float, read: str = ""
+) -> UnreadPlate | None:
+    """The plate in ``box`` (frame pixels; ``line_px`` its text-line height in them) as
+    depth places it, in the odometry frame; None without depth or where it cannot be a
+    plate (see the module docstring)."""
+    h, w = obs.rgb.shape[:2]
+    if min(box[0], box[1], w - 1 - box[2], h - 1 - box[3]) < BORDER_PX:
+        return None
+    plate = plate_pose(obs, box)
+    if plate is None:
+        return None
+    x, y, z = (float(v) for v in plate.centre)
+    line = line_px * x / obs.intrinsics.fy
+    height = z + obs.camera_height
+    if not (
+        PLATE_Z_M[0] <= height <= PLATE_Z_M[1]
+        and plate.width <= MAX_PLATE_WIDTH_M
+        and LINE_HEIGHT_M[0] <= line <= LINE_HEIGHT_M[1]
+        and math.hypot(x, y) <= MAX_SEEN_M
+    ):
+        return None
+    p = obs.pose
+    c, s = math.cos(p.yaw), math.sin(p.yaw)
+    nx, ny = float(plate.normal[0]), float(plate.normal[1])
+    return UnreadPlate(
+        xy=(p.x + c * x - s * y, p.y + s * x + c * y),
+        normal=(c * nx - s * ny, s * nx + c * ny),
+        z=height,
+        line_height=line,
+        width=plate.width,
+        stamp=obs.stamp,
+        seen_from=(p.x, p.y),
+        read=read,
+    )
+
+
+class UnreadPlates:
+    """The unread plates a grounder saw (thread-safe: frames are read in the worker)."""
+
+    def __init__(self) -> None:
+        self._plates: list[UnreadPlate] = []
+        self._lock = threading.Lock()
+
+    def seen(self, plate: UnreadPlate) -> None:
+        """Remember ``plate``, in place of an earlier sighting of it."""
+        with self._lock:
+            self._plates = [p for p in self._forget(plate.stamp) if not _same(p, plate.xy)]
+            self._plates.append(plate)
+
+    def read_at(self, xy: tuple[float, float]) -> None:
+        """The plate at ``xy`` (odometry frame) was read: it is unread no more."""
+        with self._lock:
+            self._plates = [p for p in self._plates if not _same(p, xy)]
+
+    def since(self, t: float) -> list[UnreadPlate]:
+        with self._lock:
+            return [p for p in self._plates if p.stamp >= t]
+
+    def _forget(self, now: float) -> list[UnreadPlate]:
+        return [p for p in self._plates if now - p.stamp <= KEEP_S]
+
+
+def _same(p: UnreadPlate, xy: tuple[float, float]) -> bool:
+    return math.dist(p.xy, xy) <= SAME_PLATE_M
