@@ -193,7 +193,7 @@ def _target_of(
 
 def _places(
     pm: PrioriMap, sp: StartPoint, start_xy: np.ndarray, nodes: list[str]
-) -> tuple[list[np.ndarray], list[str | None], list[str]]:
+) -> tuple[list[tuple[float, float]], list[str | None], list[str]]:
     """The route as the places the robot passes: their points, the node at each (None for a
     start point off every node) and the name of the segment that leads there.
 
@@ -203,18 +203,20 @@ def _places(
     to drive and no heading (it would read as a turn around and back). The later node is
     kept, so the goal stays the last place, with the segment that led to the place.
     """
-    pts, route, via = [np.asarray(start_xy, float)], [None], [sp.segment.name]
+    adj, map_nodes, segments = pm.adjacency, pm.nodes, pm.segments
+    pts = [(float(start_xy[0]), float(start_xy[1]))]
+    route: list[str | None] = [None]
+    via = [sp.segment.name]
     for n in nodes:
-        xy = pm.node_xy(n)
-        seg = sp.segment.name
-        if route[-1] is not None and pm.graph.has_edge(route[-1], n):
-            seg = pm.segments[graph_segment(pm, route[-1], n) - 1].name
-        if np.linalg.norm(xy - pts[-1]) < SAME_PLACE_M:
-            pts[-1], route[-1] = xy, n
-        else:
-            pts.append(xy)
-            route.append(n)
-            via.append(seg)
+        x, y = map_nodes[n].pos
+        px, py = pts[-1]
+        if math.sqrt((x - px) ** 2 + (y - py) ** 2) < SAME_PLACE_M:
+            pts[-1], route[-1] = (x, y), n
+            continue
+        edge = adj[route[-1]].get(n) if route[-1] is not None else None
+        via.append(segments[edge[1] - 1].name if edge is not None else sp.segment.name)
+        pts.append((x, y))
+        route.append(n)
     return pts, route, via
 
 
@@ -232,11 +234,13 @@ def build_plan(
     """Turn a node route into plan steps (actions, predictions, forks, sides)."""
     pts, route, via = _places(pm, sp, start_xy, nodes)  # index i of route matches pts[i]
     cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    cum = cum.tolist()
+    headings = [heading(p, q) for p, q in pairwise(pts)]  # headings[i - 1]: into place i
     notes: list[str] = []
     if len(pts) == 1:
         first_heading = sp.heading if sp.heading is not None else sp.segment.heading
     else:
-        first_heading = heading(pts[0], pts[1])
+        first_heading = headings[0]
     if sp.heading is None:
         initial = Action.GO_STRAIGHT
         notes.append("start heading unknown: the plan assumes the robot faces its first segment")
@@ -261,20 +265,22 @@ def build_plan(
                 segment=sp.segment.name,
             )
         )
+    first_at: dict[str, int] = {}  # each node's first index on the route, before merging
+    for k, n in enumerate(nodes):
+        first_at.setdefault(n, k)
     for i in range(1, len(pts)):
         node_id = route[i]
-        h_in = heading(pts[i - 1], pts[i])
+        h_in = headings[i - 1]
         is_goal = i == len(pts) - 1
-        h_out = h_in if is_goal else heading(pts[i], pts[i + 1])
-        action = Action.ARRIVE if is_goal else relative_action(h_in, h_out)
+        action = Action.ARRIVE if is_goal else relative_action(h_in, headings[i])
         node = pm.nodes[node_id]
         fork = None
         if node.kind == "branch" and not is_goal:
-            k = nodes.index(node_id)  # its neighbours on the route, before places merged
+            k = first_at[node_id]  # its neighbours on the route, before places merged
             came, goes = nodes[k - 1] if k > 0 else route[i - 1], nodes[k + 1]
             others = [
-                relative_action(h_in, heading(pts[i], pm.node_xy(nb)))
-                for nb in pm.graph.neighbors(node_id)
+                relative_action(h_in, heading(pts[i], pm.nodes[nb].pos))
+                for nb in pm.adjacency[node_id]
                 if nb not in (came, goes)
             ]
             fork = ForkChoice(action, tuple(others))
@@ -355,7 +361,8 @@ def build_plan(
         goal_name=goal.display_name,
         steps=tuple(steps),
         nodes=tuple(nodes),
-        path=tuple((float(p[0]), float(p[1])) for p in [start_xy] + [pm.node_xy(n) for n in nodes]),
+        path=((float(start_xy[0]), float(start_xy[1])),)
+        + tuple((float(x), float(y)) for x, y in (pm.nodes[n].pos for n in nodes)),
         length=float(length),
         initial_action=initial,
         planner=planner,
