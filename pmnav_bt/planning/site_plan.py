@@ -265,14 +265,17 @@ class _LobbySearch:
                     yield (lv, other.id), d
 
     def route(self) -> tuple[list[tuple[str, str]], float]:
-        """The (level, lift) lobbies passed, in order, and the total cost."""
+        """The (level, lift) lobbies passed, in order, and the total cost: A* over the
+        lobby graph, each lobby ranked by its cost so far and the least it can still cost
+        (``_still``), so lobbies that cannot beat the way found are never expanded."""
         best = {_START: 0.0}
         came: dict[tuple[str, str], tuple[str, str]] = {}
         tie = count()
-        heap = [(0.0, next(tie), _START)]
+        heap = [(0.0, next(tie), 0.0, _START)]
         done = set()
+        still = self._still()
         while heap:
-            cost, _, node = heapq.heappop(heap)
+            _, _, cost, node = heapq.heappop(heap)
             if node in done:
                 continue
             done.add(node)
@@ -286,7 +289,7 @@ class _LobbySearch:
                 if c < best.get(nxt, INF):
                     best[nxt] = c
                     came[nxt] = node
-                    heapq.heappush(heap, (c, next(tie), nxt))
+                    heapq.heappush(heap, (c + still(nxt), next(tie), c, nxt))
         site, level = self.sm.site, self.level
         served = ", ".join(lift.id for lift in site.lifts_at(level))
         why = (
@@ -298,6 +301,27 @@ class _LobbySearch:
             f"{self.goal_id} on {self.goal_level} cannot be reached from "
             f"{self.sp.description} on {level}: {why}"
         )
+
+    def _still(self):
+        """The least a lobby can still cost to the goal: on a level other than the goal's,
+        a ride there; and from a lobby of the goal's level, the walk from the nearest one
+        to the goal. It never overstates, and falls by no more than an edge's cost along
+        one, so A* expands each lobby once and finds the cheapest way."""
+        sm, goal_level = self.sm, self.goal_level
+        walks = [
+            sm.lobby_tree(lift.id, goal_level).dist.get(self.goal_node, INF)
+            for lift in sm.site.lifts_at(goal_level)
+        ]
+        last = min(walks, default=INF)
+        ride = self.planner.ride_cost
+
+        def still(node: tuple[str, str]) -> float:
+            if node == _GOAL:
+                return 0.0
+            lv = node[0]
+            return last if lv == goal_level else ride(sm.site, lv, goal_level) + last
+
+        return still
 
     def first_leg(self, lift: str, max_gap: float) -> Plan:
         """The walk from the start to ``lift``'s lobby on the start level."""
