@@ -5,9 +5,12 @@ to the goal's level, walk from that lift's lobby to the room. The planner choose
 lifts by total cost, in metres of corridor: the metres to the lobby on the start level,
 a ride's cost (a call, once per ride, and a cost per level travelled), and the metres
 from the lobby on the goal level (with, where no lift serves both levels, the metres
-between two lifts' lobbies on a level in between). It searches over the lobbies
-(Dijkstra on a small graph: the start, each lift's lobby on each level, the goal), so
-it costs two corridor searches per candidate lobby, not one per level.
+between two lifts' lobbies on a level in between). It searches over the lobbies (A* on
+a small graph: the start, each lift's lobby on each level, the goal), whose edges are
+read off the shortest-way trees the site map keeps for each lobby (``SiteMap.lobby_tree``,
+one corridor search per lobby, once per site map): a plan makes no corridor search of its
+own, unless blocked corridors on the start level call for one there. What a plan costs
+is mostly turning its legs' routes into steps (``build_plan``), one leg per level walked.
 
 Each leg is a ``Plan`` of the ordinary planner (``GraphPlanner``), to a landmark goal
 (the lift's lobby) or to the goal room; each ride is a ``LiftRide`` between them, whose
