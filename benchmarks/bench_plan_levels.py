@@ -7,8 +7,10 @@ serves the lower half only. A plan starts on a random segment of a random level 
 goes to a random room of another level, named as a person qualifies it ("L7/room123");
 the time covers resolving the goal, choosing the lifts and planning every leg, after one
 plan per level has built the caches a long-lived planner keeps (each level's name index
-and corridor lists). "site s" is validating the site (every level's building) and
-parsing every level's priori-map.
+and corridor lists, and the site map's lobby trees: one corridor search per lift's lobby,
+``SiteMap.lobby_tree``). "site s" is validating the site (every level's building) and
+parsing every level's priori-map; "warm s" is those first plans, one per level, the
+lobby trees' cost included.
 
     python benchmarks/bench_plan_levels.py [--levels 10] [--rooms 1000] [--plans 200]
 """
@@ -61,8 +63,10 @@ def main() -> None:
     rng = random.Random(args.seed)
     planner = SitePlanner()
     names = sm.site.level_names
+    t = time.perf_counter()
     for here, there in zip(names, names[1:] + names[:1], strict=True):  # warm each level's
         planner.plan(sm, here, "seg1", f"{there}/{sm.maps[there].building.rooms[0].id}")
+    t_warm = time.perf_counter() - t
     times, cpu, rides, legs = [], [], [], []
     for _ in range(args.plans):
         here, there = rng.sample(names, 2)
@@ -79,13 +83,13 @@ def main() -> None:
     p95 = times[int(0.95 * (len(times) - 1))]
     segments = sum(len(pm.segments) for pm in sm.maps.values())
     print(
-        f"{'levels':>6} {'rooms':>6} {'lifts':>5} {'segments':>8} {'site s':>7} "
+        f"{'levels':>6} {'rooms':>6} {'lifts':>5} {'segments':>8} {'site s':>7} {'warm s':>6} "
         f"{'plan med ms':>11} {'plan p95 ms':>11} {'cpu med ms':>10} {'rides med':>9} "
         f"{'steps med':>9}"
     )
     print(
         f"{args.levels:>6} {args.levels * args.rooms:>6} {len(sm.site.lifts):>5} {segments:>8} "
-        f"{t_site:>7.2f} {1e3 * statistics.median(times):>11.2f} {1e3 * p95:>11.2f} "
+        f"{t_site:>7.2f} {t_warm:>6.2f} {1e3 * statistics.median(times):>11.2f} {1e3 * p95:>11.2f} "
         f"{1e3 * statistics.median(cpu):>10.2f} {statistics.median(rides):>9.0f} "
         f"{statistics.median(legs):>9.0f}"
     )

@@ -10,9 +10,10 @@ priori-map under its name. A one-level site's text is its building's, unchanged.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
+from pmnav_bt.map.corridor_search import LobbyTree
 from pmnav_bt.map.priori_map import PrioriMap, parse_building
 from pmnav_bt.map.site import LiftLink, Site
 
@@ -23,6 +24,9 @@ class SiteMap:
 
     site: Site
     maps: dict[str, PrioriMap]
+    _lobby_trees: dict[tuple[str, str], LobbyTree] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     def level_map(self, level: str) -> PrioriMap:
         """The priori-map of ``level`` (a name as typed: case is ignored)."""
@@ -41,6 +45,16 @@ class SiteMap:
             for lift in self.site.lifts
             for level, lobby in lift.lobbies.items()
         }
+
+    def lobby_tree(self, lift: str, level: str) -> LobbyTree:
+        """The shortest ways from every node of ``level`` to ``lift``'s lobby there: one
+        search of the level, the first time it is asked for, kept for every later plan
+        (``corridor_search``)."""
+        key = (lift, level)
+        tree = self._lobby_trees.get(key)
+        if tree is None:
+            tree = self._lobby_trees[key] = LobbyTree.grow(self.maps[level], self.lobby_nodes[key])
+        return tree
 
     def link_line(self, link: LiftLink) -> str:
         """One lift (or stairs) for the text: its lobby on each level, where it is seen."""

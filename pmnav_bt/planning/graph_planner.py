@@ -193,7 +193,7 @@ def _target_of(
 
 def _places(
     pm: PrioriMap, sp: StartPoint, start_xy: np.ndarray, nodes: list[str]
-) -> tuple[list[np.ndarray], list[str | None], list[str]]:
+) -> tuple[list[tuple[float, float]], list[str | None], list[str]]:
     """The route as the places the robot passes: their points, the node at each (None for a
     start point off every node) and the name of the segment that leads there.
 
@@ -203,18 +203,20 @@ def _places(
     to drive and no heading (it would read as a turn around and back). The later node is
     kept, so the goal stays the last place, with the segment that led to the place.
     """
-    pts, route, via = [np.asarray(start_xy, float)], [None], [sp.segment.name]
+    adj, map_nodes, segments = pm.adjacency, pm.nodes, pm.segments
+    pts = [(float(start_xy[0]), float(start_xy[1]))]
+    route: list[str | None] = [None]
+    via = [sp.segment.name]
     for n in nodes:
-        xy = pm.node_xy(n)
-        seg = sp.segment.name
-        if route[-1] is not None and pm.graph.has_edge(route[-1], n):
-            seg = pm.segments[graph_segment(pm, route[-1], n) - 1].name
-        if np.linalg.norm(xy - pts[-1]) < SAME_PLACE_M:
-            pts[-1], route[-1] = xy, n
-        else:
-            pts.append(xy)
-            route.append(n)
-            via.append(seg)
+        x, y = map_nodes[n].pos
+        px, py = pts[-1]
+        if math.sqrt((x - px) ** 2 + (y - py) ** 2) < SAME_PLACE_M:
+            pts[-1], route[-1] = (x, y), n
+            continue
+        edge = adj[route[-1]].get(n) if route[-1] is not None else None
+        via.append(segments[edge[1] - 1].name if edge is not None else sp.segment.name)
+        pts.append((x, y))
+        route.append(n)
     return pts, route, via
 
 
@@ -232,115 +234,97 @@ def build_plan(
     """Turn a node route into plan steps (actions, predictions, forks, sides)."""
     pts, route, via = _places(pm, sp, start_xy, nodes)  # index i of route matches pts[i]
     cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    cum = cum.tolist()
+    headings = [heading(p, q) for p, q in pairwise(pts)]  # headings[i - 1]: into place i
     notes: list[str] = []
     if len(pts) == 1:
         first_heading = sp.heading if sp.heading is not None else sp.segment.heading
     else:
-        first_heading = heading(pts[0], pts[1])
+        first_heading = headings[0]
     if sp.heading is None:
         initial = Action.GO_STRAIGHT
         notes.append("start heading unknown: the plan assumes the robot faces its first segment")
     else:
         initial = relative_action(sp.heading, first_heading)
 
-    candidates: list[dict] = []
-    if len(pts) == 1:  # already at the goal's room waypoint
-        look_for, target = _target_of(pm, route[0], goal_id)
-        candidates.append(
-            dict(
-                i=0,
-                node=pm.nodes[route[0]],
-                action=Action.ARRIVE,
-                h_in=first_heading,
-                fork=None,
-                is_goal=True,
-                landmark=goal_id,
-                visible=True,
-                look_for=goal_id,
-                target=target,
-                segment=sp.segment.name,
-            )
-        )
+    # Each place a candidate step (the start only where it is the goal's place already):
+    # its action on arrival, the fork there, what to look for there and where that is.
+    last = len(pts) - 1
+    order = range(1, len(pts)) if last else range(1)
+    h_ins = [first_heading, *headings]  # h_ins[i]: the heading on arriving at place i
+    actions: list[Action] = [Action.ARRIVE] * len(pts)
+    forks: list[ForkChoice | None] = [None] * len(pts)
+    looks: list[str | None] = [goal_id] * len(pts)
+    targets: list = [None] * len(pts)
+    if not last:  # already at the goal's room waypoint
+        targets[0] = _target_of(pm, route[0], goal_id)[1]
+    first_at: dict[str, int] = {}  # each node's first index on the route, before merging
+    for k, n in enumerate(nodes):
+        first_at.setdefault(n, k)
     for i in range(1, len(pts)):
         node_id = route[i]
-        h_in = heading(pts[i - 1], pts[i])
-        is_goal = i == len(pts) - 1
-        h_out = h_in if is_goal else heading(pts[i], pts[i + 1])
-        action = Action.ARRIVE if is_goal else relative_action(h_in, h_out)
-        node = pm.nodes[node_id]
-        fork = None
-        if node.kind == "branch" and not is_goal:
-            k = nodes.index(node_id)  # its neighbours on the route, before places merged
-            came, goes = nodes[k - 1] if k > 0 else route[i - 1], nodes[k + 1]
-            others = [
-                relative_action(h_in, heading(pts[i], pm.node_xy(nb)))
-                for nb in pm.graph.neighbors(node_id)
-                if nb not in (came, goes)
-            ]
-            fork = ForkChoice(action, tuple(others))
-        look_for, target = _target_of(pm, node_id, goal_id, avoid_landmarks)
-        candidates.append(
-            dict(
-                i=i,
-                node=node,
-                action=action,
-                h_in=h_in,
-                fork=fork,
-                is_goal=is_goal,
-                landmark=goal_id if is_goal else node_id,
-                visible=look_for is not None,
-                look_for=look_for,
-                target=target,
-                segment=via[i],
-            )
-        )
+        h_in = h_ins[i]
+        if i < last:
+            actions[i] = relative_action(h_in, h_ins[i + 1])
+            if pm.nodes[node_id].kind == "branch":
+                k = first_at[node_id]  # its neighbours on the route, before places merged
+                came, goes = nodes[k - 1] if k > 0 else route[i - 1], nodes[k + 1]
+                others = [
+                    relative_action(h_in, heading(pts[i], pm.nodes[nb].pos))
+                    for nb in pm.adjacency[node_id]
+                    if nb not in (came, goes)
+                ]
+                forks[i] = ForkChoice(actions[i], tuple(others))
+        looks[i], targets[i] = _target_of(pm, node_id, goal_id, avoid_landmarks)
 
     required = {
-        c["i"]
-        for c in candidates
-        if c["is_goal"] or c["fork"] is not None or c["action"] is not Action.GO_STRAIGHT
+        i
+        for i in order
+        if i == last or forks[i] is not None or actions[i] is not Action.GO_STRAIGHT
     }
     # The last visible node before each unseen required step predicts it.
     predictor: dict[int, int] = {}
     last_visible = None
-    for c in candidates:
-        if c["i"] in required and not c["visible"] and last_visible is not None:
-            predictor[last_visible] = c["i"]
+    for i in order:
+        visible = looks[i] is not None
+        if i in required and not visible and last_visible is not None:
+            predictor[last_visible] = i
             required.add(last_visible)
-        if c["visible"]:
-            last_visible = c["i"]
-        if c["i"] in required:
-            last_visible = None if not c["visible"] else c["i"]
+        if visible:
+            last_visible = i
+        if i in required:
+            last_visible = None if not visible else i
     # Fill long gaps with visible landmarks (greedy: keep one before the gap gets too long).
     kept: list[int] = []
     last_cum = 0.0
-    anchors = [c for c in candidates if c["visible"] or c["i"] in required]
-    for k, c in enumerate(anchors):
-        nxt = anchors[k + 1]["i"] if k + 1 < len(anchors) else None
-        if c["i"] in required or (nxt is not None and cum[nxt] - last_cum > max_gap):
-            kept.append(c["i"])
-            last_cum = cum[c["i"]]
-    by_i = {c["i"]: c for c in candidates}
+    anchors = [i for i in order if looks[i] is not None or i in required]
+    for k, i in enumerate(anchors):
+        nxt = anchors[k + 1] if k + 1 < len(anchors) else None
+        if i in required or (nxt is not None and cum[nxt] - last_cum > max_gap):
+            kept.append(i)
+            last_cum = cum[i]
     steps: list[PlanStep] = []
     prev_cum = 0.0
     for i in kept:
-        c = by_i[i]
-        pred = by_i[predictor[i]] if i in predictor else None
+        visible = looks[i] is not None
+        pred = predictor.get(i)
         steps.append(
             PlanStep(
-                landmark=c["landmark"],
-                action=c["action"],
-                kind=c["node"].kind,
-                visible=c["visible"],
-                position=tuple(float(v) for v in pts[i]),
-                heading=c["h_in"],
+                landmark=goal_id if i == last else route[i],
+                action=actions[i],
+                kind=pm.nodes[route[i]].kind,
+                visible=visible,
+                position=(float(pts[i][0]), float(pts[i][1])),
+                heading=h_ins[i],
                 distance=float(cum[i] - prev_cum),
-                segment=c["segment"],
-                side=_side(c["h_in"], pts[i], c["target"]) if c["visible"] else None,
-                target=tuple(float(v) for v in c["target"]) if c["visible"] else None,
-                look_for=c["look_for"],
-                predicts=(pred["landmark"], pred["action"]) if pred else None,
-                fork=c["fork"],
+                segment=via[i],
+                side=_side(h_ins[i], pts[i], targets[i]) if visible else None,
+                target=tuple(float(v) for v in targets[i]) if visible else None,
+                look_for=looks[i],
+                predicts=(route[pred] if pred != last else goal_id, actions[pred])
+                if pred is not None
+                else None,
+                fork=forks[i],
             )
         )
         prev_cum = cum[i]
@@ -355,7 +339,8 @@ def build_plan(
         goal_name=goal.display_name,
         steps=tuple(steps),
         nodes=tuple(nodes),
-        path=tuple((float(p[0]), float(p[1])) for p in [start_xy] + [pm.node_xy(n) for n in nodes]),
+        path=((float(start_xy[0]), float(start_xy[1])),)
+        + tuple((float(x), float(y)) for x, y in (pm.nodes[n].pos for n in nodes)),
         length=float(length),
         initial_action=initial,
         planner=planner,

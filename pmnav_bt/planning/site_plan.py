@@ -5,9 +5,12 @@ to the goal's level, walk from that lift's lobby to the room. The planner choose
 lifts by total cost, in metres of corridor: the metres to the lobby on the start level,
 a ride's cost (a call, once per ride, and a cost per level travelled), and the metres
 from the lobby on the goal level (with, where no lift serves both levels, the metres
-between two lifts' lobbies on a level in between). It searches over the lobbies
-(Dijkstra on a small graph: the start, each lift's lobby on each level, the goal), so
-it costs two corridor searches per candidate lobby, not one per level.
+between two lifts' lobbies on a level in between). It searches over the lobbies (A* on
+a small graph: the start, each lift's lobby on each level, the goal), whose edges are
+read off the shortest-way trees the site map keeps for each lobby (``SiteMap.lobby_tree``,
+one corridor search per lobby, once per site map): a plan makes no corridor search of its
+own, unless blocked corridors on the start level call for one there. What a plan costs
+is mostly turning its legs' routes into steps (``build_plan``), one leg per level walked.
 
 Each leg is a ``Plan`` of the ordinary planner (``GraphPlanner``), to a landmark goal
 (the lift's lobby) or to the goal room; each ride is a ``LiftRide`` between them, whose
@@ -22,11 +25,13 @@ import heapq
 import json
 from dataclasses import dataclass, replace
 from itertools import count
+from typing import NamedTuple
 
-import networkx as nx
+import numpy as np
 
 from pmnav_bt.errors import PlanningError
 from pmnav_bt.geometry import heading, wrap_angle
+from pmnav_bt.map.corridor_search import INF, CorridorSearch, LobbyTree
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.map.site import Site
 from pmnav_bt.map.site_map import SiteMap
@@ -190,115 +195,90 @@ class SitePlanner:
             elif prev is None:  # the first walk: its route is the search's
                 legs.append(Leg(lv, search.first_leg(lift, self.max_gap)))
             else:  # a change of lifts on a level between
-                lobby = site.lift(lift).lobbies[lv]
-                legs.append(Leg(lv, legs_planner.plan_to_landmark(sm.maps[lv], at, lobby)))
+                legs.append(Leg(lv, search.between_leg(lv, at, lift, self.max_gap)))
             prev = (lv, lift)
         legs.append(Leg(here, search.last_leg(prev[1], at, self.max_gap)))
         return SitePlan(site.name, tuple(legs), tuple(rides), goal_level, goal_id, goal_name, cost)
 
 
+class _Walk(NamedTuple):
+    """A walk along one level's corridors: its cost (metres with a hair of tie-break),
+    its metres and its nodes, from the first to the last."""
+
+    cost: float
+    metres: float
+    nodes: list[str]
+
+
 class _LobbySearch:
     """The cheapest way from a start to a goal room on another level, over the lifts'
     lobbies: a small graph whose nodes are the start, each (level, lift) lobby and the
-    goal. Its edges: the corridor metres from the start to each lobby of its level (one
-    search from the start), a ride's cost between two lobbies of one lift, the metres
-    between two lifts' lobbies on a level (cached on the site map), and the metres from
-    each lobby of the goal's level to the goal (one search from the goal). The two
-    searches grow together and stop once no lobby left can do better (``_search_both``);
-    the first and last legs' routes are theirs, so each leg costs no search of its own."""
+    goal. Its edges are read off the site map's lobby trees (``SiteMap.lobby_tree``: one
+    search of a level from each lobby, kept for every plan): the corridor metres from the
+    start to each lobby of its level, a ride's cost between two lobbies of one lift, the
+    metres between two lifts' lobbies on a level, and the metres from each lobby of the
+    goal's level to the goal. So a plan searches no corridor, except where ``constraints``
+    block segments of the start level, which the trees do not know of: then one search
+    from the start to that level's lobbies. The legs' routes are read off the same trees
+    (or that search), so no leg costs a search of its own either."""
 
     def __init__(self, planner, sm, level, sp, goal_level, goal_id, constraints):
         self.planner, self.sm, self.level, self.sp = planner, sm, level, sp
         self.goal_level, self.goal_id, self.constraints = goal_level, goal_id, constraints
         pm = sm.maps[level]
-        seg = sp.segment
-        a_xy, b_xy = pm.node_xy(seg.a), pm.node_xy(seg.b)
-        self.start_xy = a_xy + sp.t * (b_xy - a_xy)
-        shut = shut_ends(pm, sp, constraints.blocked_at)
-        sources = {}
-        for end, lead in ((seg.a, sp.t * seg.length), (seg.b, (1.0 - sp.t) * seg.length)):
-            if end in shut:
-                continue
-            # On a tie, the way the robot already faces, else the segment's first end (as
-            # shortest_route): the legs' routes are the graph planner's.
-            tie = 0.0 if end == seg.a else 1e-12
-            if sp.heading is not None:
-                toward = heading(self.start_xy, pm.node_xy(end)) if lead > 1e-9 else sp.heading
-                tie += abs(wrap_angle(toward - sp.heading)) * 1e-9
-            sources[end] = (lead + tie, lead)
-        site = sm.site
-        goal_pm = sm.maps[goal_level]
-        self.goal_node = goal_pm.places[goal_id].node
-        at_start = {lift.id: sm.lobby_nodes[(lift.id, level)] for lift in site.lifts_at(level)}
-        at_goal = {
-            lift.id: sm.lobby_nodes[(lift.id, goal_level)] for lift in site.lifts_at(goal_level)
-        }
-        self.from_start = _Search(pm, sources, set(at_start.values()), constraints.blocked_segments)
-        self.to_goal = _Search(goal_pm, {self.goal_node: (0.0, 0.0)}, set(at_goal.values()))
-        self._search_both(at_start, at_goal)
-
-    def _search_both(self, at_start: dict[str, str], at_goal: dict[str, str]) -> None:
-        """Grow the start's and the goal's searches together, the nearer frontier first,
-        until no lobby either has not reached can lead to a cheaper way than one known.
-        A way by a lift serving both levels costs its two walks and its ride; any other
-        changes lifts, so rides twice at least. A lobby not reached is at least as far
-        as its search's frontier."""
-        s, g = self.from_start, self.to_goal
-        direct = [k for k in at_start if k in at_goal]
-        ride = self.planner.ride_cost(self.sm.site, self.level, self.goal_level)
-        two_calls = 2.0 * self.planner.ride_call_m
-        known, pops = INF, 0
-        while s.frontier < INF or g.frontier < INF:
-            search = s if s.frontier <= g.frontier else g
-            if search.step() is not None:
-                for k in direct:
-                    a, b = s.dist.get(at_start[k]), g.dist.get(at_goal[k])
-                    if a is not None and b is not None:
-                        known = min(known, a + ride + b)
-            pops += 1
-            if known == INF or pops % 8:
-                continue
-            bound = two_calls + min(map(s.value, at_start.values())) + min(
-                map(g.value, at_goal.values())
-            )
-            for k in direct:
-                a, b = at_start[k], at_goal[k]
-                if a not in s.dist or b not in g.dist:
-                    bound = min(bound, s.value(a) + ride + g.value(b))
-            if bound >= known:
-                return
+        self.start_xy = _point(pm, sp)
+        sources = _sources(pm, sp, self.start_xy, shut_ends(pm, sp, constraints.blocked_at))
+        self.goal_node = sm.maps[goal_level].places[goal_id].node
+        lobbies = {lift.id: sm.lobby_nodes[(lift.id, level)] for lift in sm.site.lifts_at(level)}
+        self.walks: dict[str, _Walk] = {}  # lift id -> the walk to its lobby on the start level
+        if constraints.blocked_segments:
+            search = CorridorSearch(pm, sources, constraints.blocked_segments)
+            search.run(set(lobbies.values()))
+            for lift, node in lobbies.items():
+                if node in search.dist:
+                    way = search.path(node)[::-1]
+                    self.walks[lift] = _Walk(search.dist[node], search.length[node], way)
+        else:
+            for lift in lobbies:
+                walk = _walk_to_lobby(sm.lobby_tree(lift, level), sources)
+                if walk is not None:
+                    self.walks[lift] = walk
 
     def _neighbours(self, node: tuple[str, str]):
         sm, site, level = self.sm, self.sm.site, self.level
         if node == _START:
-            for lift in site.lifts_at(level):
-                d = self.from_start.dist.get(sm.lobby_nodes[(lift.id, level)])
-                if d is not None:
-                    yield (level, lift.id), d
+            for lift, walk in self.walks.items():
+                yield (level, lift), walk.cost
             return
         lv, lift_id = node
         for other in site.lift(lift_id).lobbies:
             if other != lv:
                 yield (other, lift_id), self.planner.ride_cost(site, lv, other)
         if lv == self.goal_level:
-            d = self.to_goal.dist.get(sm.lobby_nodes[(lift_id, lv)])
+            d = sm.lobby_tree(lift_id, lv).dist.get(self.goal_node)
             if d is not None:
                 yield _GOAL, d
+        if lv in (level, self.goal_level):
+            return  # a change of lifts here never beats walking to the other lobby at once
+        here = sm.lobby_nodes[(lift_id, lv)]
         for other in site.lifts_at(lv):
             if other.id != lift_id:
-                d = _lobby_distance(sm, lv, lift_id, other.id)
+                d = sm.lobby_tree(other.id, lv).dist.get(here)
                 if d is not None:
                     yield (lv, other.id), d
 
     def route(self) -> tuple[list[tuple[str, str]], float]:
-        """The (level, lift) lobbies passed, in order, and the total cost."""
+        """The (level, lift) lobbies passed, in order, and the total cost: A* over the
+        lobby graph, each lobby ranked by its cost so far and the least it can still cost
+        (``_still``), so lobbies that cannot beat the way found are never expanded."""
         best = {_START: 0.0}
         came: dict[tuple[str, str], tuple[str, str]] = {}
         tie = count()
-        heap = [(0.0, next(tie), _START)]
+        heap = [(0.0, next(tie), 0.0, _START)]
         done = set()
+        still = self._still()
         while heap:
-            cost, _, node = heapq.heappop(heap)
+            _, _, cost, node = heapq.heappop(heap)
             if node in done:
                 continue
             done.add(node)
@@ -309,10 +289,10 @@ class _LobbySearch:
                 return route[-2:0:-1], cost
             for nxt, step in self._neighbours(node):
                 c = cost + step
-                if c < best.get(nxt, float("inf")):
+                if c < best.get(nxt, INF):
                     best[nxt] = c
                     came[nxt] = node
-                    heapq.heappush(heap, (c, next(tie), nxt))
+                    heapq.heappush(heap, (c + still(nxt), next(tie), c, nxt))
         site, level = self.sm.site, self.level
         served = ", ".join(lift.id for lift in site.lifts_at(level))
         why = (
@@ -325,125 +305,88 @@ class _LobbySearch:
             f"{self.sp.description} on {level}: {why}"
         )
 
+    def _still(self):
+        """The least a lobby can still cost to the goal: on a level other than the goal's,
+        a ride there; and from a lobby of the goal's level, the walk from the nearest one
+        to the goal. It never overstates, and falls by no more than an edge's cost along
+        one, so A* expands each lobby once and finds the cheapest way."""
+        sm, goal_level = self.sm, self.goal_level
+        walks = [
+            sm.lobby_tree(lift.id, goal_level).dist.get(self.goal_node, INF)
+            for lift in sm.site.lifts_at(goal_level)
+        ]
+        last = min(walks, default=INF)
+        ride = self.planner.ride_cost
+
+        def still(node: tuple[str, str]) -> float:
+            if node == _GOAL:
+                return 0.0
+            lv = node[0]
+            return last if lv == goal_level else ride(sm.site, lv, goal_level) + last
+
+        return still
+
     def first_leg(self, lift: str, max_gap: float) -> Plan:
         """The walk from the start to ``lift``'s lobby on the start level."""
-        sm, level = self.sm, self.level
-        node = sm.lobby_nodes[(lift, level)]
-        nodes = self.from_start.path(node)[::-1]
-        length = self.from_start.length[node]
+        sm, level, walk = self.sm, self.level, self.walks[lift]
         lobby = sm.site.lift(lift).lobbies[level]
         return build_plan(
-            sm.maps[level], self.sp, lobby, nodes, length, self.start_xy, max_gap, "graph",
-            self.constraints.avoid_landmarks,
+            sm.maps[level], self.sp, lobby, walk.nodes, walk.metres, self.start_xy, max_gap,
+            "graph", self.constraints.avoid_landmarks,
         )
+
+    def between_leg(self, level: str, at: StartPoint, lift: str, max_gap: float) -> Plan:
+        """The walk on a level between two rides: from ``at`` (out of one lift) to
+        ``lift``'s lobby, the change of lifts."""
+        sm, pm = self.sm, self.sm.maps[level]
+        xy = _point(pm, at)
+        walk = _walk_to_lobby(sm.lobby_tree(lift, level), _sources(pm, at, xy, set()))
+        lobby = sm.site.lift(lift).lobbies[level]
+        return build_plan(pm, at, lobby, walk.nodes, walk.metres, xy, max_gap, "graph")
 
     def last_leg(self, lift: str, at: StartPoint, max_gap: float) -> Plan:
         """The walk out of ``lift`` on the goal level to the goal room."""
-        sm, level = self.sm, self.goal_level
-        pm = sm.maps[level]
-        node = sm.lobby_nodes[(lift, level)]
-        nodes = self.to_goal.path(node)
-        seg = at.segment
-        a_xy, b_xy = pm.node_xy(seg.a), pm.node_xy(seg.b)
-        start_xy = a_xy + at.t * (b_xy - a_xy)
-        length = self.to_goal.length[node]
-        return build_plan(pm, at, self.goal_id, nodes, length, start_xy, max_gap, "graph")
+        level = self.goal_level
+        pm, tree = self.sm.maps[level], self.sm.lobby_tree(lift, level)
+        nodes = tree.way(self.goal_node)[::-1]
+        metres = tree.dist[self.goal_node]
+        return build_plan(pm, at, self.goal_id, nodes, metres, _point(pm, at), max_gap, "graph")
 
 
-class _Search:
-    """Dijkstra on a level's map from several sources, each with a starting (cost, metres),
-    over corridor lengths, never over a segment of ``blocked``, one node at a time
-    (``step``), towards ``targets``. ``dist``: the cost of each node settled; ``length``:
-    its metres; ``pred``: the node it was reached from (None at a source)."""
+def _point(pm: PrioriMap, sp: StartPoint) -> np.ndarray:
+    """Where a start point is on the map."""
+    a_xy, b_xy = pm.node_xy(sp.segment.a), pm.node_xy(sp.segment.b)
+    return a_xy + sp.t * (b_xy - a_xy)
 
-    def __init__(
-        self,
-        pm: PrioriMap,
-        sources: dict[str, tuple[float, float]],
-        targets: set[str],
-        blocked: frozenset[int] = frozenset(),
-    ):
-        self.heap = [(c, n) for n, (c, _) in sources.items()]
-        heapq.heapify(self.heap)
-        self.best = {n: c for n, (c, _) in sources.items()}
-        self.length = {n: m for n, (_, m) in sources.items()}
-        self.pred: dict[str, str | None] = dict.fromkeys(sources)
-        self.dist: dict[str, float] = {}
-        self.left = set(targets)
-        self.adj = _adjacency(pm)
-        self.blocked = blocked
 
-    @property
-    def frontier(self) -> float:
-        """The least cost not yet settled (infinite once every target is settled)."""
-        return self.heap[0][0] if self.heap and self.left else INF
+def _sources(
+    pm: PrioriMap, sp: StartPoint, start_xy: np.ndarray, shut: set[str]
+) -> dict[str, tuple[float, float]]:
+    """The ends of the start's segment a walk can leave by (not those ``shut``), each with
+    its (cost, metres) from the start. On a tie, the way the robot already faces, else the
+    segment's first end (as ``shortest_route``): the legs' routes are the graph planner's."""
+    seg, sources = sp.segment, {}
+    for end, lead in ((seg.a, sp.t * seg.length), (seg.b, (1.0 - sp.t) * seg.length)):
+        if end in shut:
+            continue
+        tie = 0.0 if end == seg.a else 1e-12
+        if sp.heading is not None:
+            toward = heading(start_xy, pm.node_xy(end)) if lead > 1e-9 else sp.heading
+            tie += abs(wrap_angle(toward - sp.heading)) * 1e-9
+        sources[end] = (lead + tie, lead)
+    return sources
 
-    def value(self, node: str) -> float:
-        """A settled node's cost, else the frontier: as little as it can cost."""
-        return self.dist.get(node, self.frontier)
 
-    def step(self) -> str | None:
-        """Settle the nearest node not settled; return it when it is a target."""
-        heap, dist, best = self.heap, self.dist, self.best
-        while heap:
-            c, n = heapq.heappop(heap)
-            if n in dist:
-                continue
-            dist[n] = c
-            for m, length, segment in self.adj[n]:
-                nc = c + length
-                if nc < best.get(m, INF) and m not in dist and segment not in self.blocked:
-                    best[m] = nc
-                    self.length[m] = self.length[n] + length
-                    self.pred[m] = n
-                    heapq.heappush(heap, (nc, m))
-            if n in self.left:
-                self.left.discard(n)
-                return n
-            return None
+def _walk_to_lobby(tree: LobbyTree, sources: dict[str, tuple[float, float]]) -> _Walk | None:
+    """The cheapest walk from one of ``sources`` to the tree's lobby (None: none reaches it)."""
+    best = None
+    for end, (cost, metres) in sources.items():
+        d = tree.dist.get(end)
+        if d is not None and (best is None or cost + d < best[0]):
+            best = (cost + d, metres + d, end)
+    if best is None:
         return None
-
-    def path(self, node: str) -> list[str]:
-        """The nodes from ``node`` back to the source it was reached from."""
-        out = [node]
-        while self.pred[out[-1]] is not None:
-            out.append(self.pred[out[-1]])
-        return out
-
-
-INF = float("inf")
-
-
-def _adjacency(pm: PrioriMap) -> dict[str, list[tuple[str, float, int]]]:
-    """Each node's (neighbour, metres, segment index), as plain lists (cached on the map):
-    a search over these is several times quicker than over the graph's views."""
-    cached = pm.__dict__.get("_site_adjacency")
-    if cached is None:
-        cached = {
-            n: [(m, e["length"], e["segment"]) for m, e in nbrs.items()]
-            for n, nbrs in pm.graph.adj.items()
-        }
-        pm.__dict__["_site_adjacency"] = cached
-    return cached
-
-
-def _node_distance(sm: SiteMap, level: str, a: str, b: str) -> float | None:
-    """Corridor metres between two nodes of a level (None: not joined)."""
-    try:
-        return float(nx.shortest_path_length(sm.maps[level].graph, a, b, weight="length"))
-    except nx.NetworkXNoPath:
-        return None
-
-
-def _lobby_distance(sm: SiteMap, level: str, lift_a: str, lift_b: str) -> float | None:
-    """Corridor metres between two lifts' lobbies on a level (cached on the site map: the
-    change of lifts on a level between the start's and the goal's)."""
-    cache = sm.__dict__.setdefault("_lobby_distances", {})
-    key = (level, *sorted((lift_a, lift_b)))
-    if key not in cache:
-        a, b = sm.lobby_nodes[(lift_a, level)], sm.lobby_nodes[(lift_b, level)]
-        cache[key] = _node_distance(sm, level, a, b)
-    return cache[key]
+    return _Walk(best[0], best[1], tree.way(best[2]))
 
 
 def out_of_lift(sm: SiteMap, lift: str, level: str) -> StartPoint:
