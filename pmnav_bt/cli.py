@@ -178,6 +178,9 @@ def map_draft(
     corridor_min: float | None = typer.Option(None, help="Narrowest corridor (m)."),
     open_width: float | None = typer.Option(None, help="Wider (m) is an open area, a hall."),
     part_min: float | None = typer.Option(None, help="Shortest part apart kept (m)."),
+    corridor_ratio: float | None = typer.Option(
+        None, help="A corridor is this many times longer than wide (else a room)."
+    ),
     link_max: float | None = typer.Option(None, help="Longest link joining a part (m)."),
     clutter: float | None = typer.Option(None, help="Obstacles this small (m) are filled."),
 ) -> None:
@@ -193,6 +196,7 @@ def map_draft(
             ("corridor_min_m", corridor_min),
             ("open_width_m", open_width),
             ("part_min_m", part_min),
+            ("corridor_ratio", corridor_ratio),
             ("link_max_m", link_max),
             ("clutter_m", clutter),
         )

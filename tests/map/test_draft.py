@@ -185,3 +185,20 @@ def test_map_draft_options_set_the_thresholds(tmp_path, capsys):
     assert code == 0 and "warning" not in out.err
     code, out = run("--link-max", "0")
     assert code == 2 and "--link-max must be a positive number of metres" in out.err
+
+
+def test_a_short_wide_dead_end_off_a_corridor_is_a_room_not_a_corridor(tmp_path):
+    from pmnav_bt.map.draft import DraftParams
+
+    # A 28 m corridor with, on its north side, a room 4 m wide and 6 m deep open across
+    # its whole front (a glass front the scan did not see) and a stub corridor 1.4 m wide
+    # and 7 m long (five times longer than wide).
+    rects = [(2, 2, 30, 4.4), (8, 4.4, 12, 10.4), (22, 4.4, 23.4, 11.4)]
+    grid = _grid(tmp_path, rects)
+    b, _, _ = draft_building(grid, tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert not any(w.pos[1] > 6.0 and 7.5 < w.pos[0] < 12.5 for w in b.waypoints)
+    assert _near(b, (22.7, 10.8), 1.2)
+    # With a corridor only as long as it is wide, the room is drafted as a corridor.
+    loose, _, _ = draft_building(grid, tmp_path / "c.yaml", params=DraftParams(corridor_ratio=1.0))
+    assert any(w.pos[1] > 6.0 and 7.5 < w.pos[0] < 12.5 for w in loose.waypoints)
