@@ -182,6 +182,9 @@ def map_draft(
         None, help="A corridor is this many times longer than wide (else a room)."
     ),
     link_max: float | None = typer.Option(None, help="Longest link joining a part (m)."),
+    wall_min: float | None = typer.Option(
+        None, help="A dead end with less of its border wall (not unknown) is a laser fan (0-1)."
+    ),
     clutter: float | None = typer.Option(None, help="Obstacles this small (m) are filled."),
 ) -> None:
     """Draft a building file from an occupancy grid or a drawing ('pmnav map draft SRC -o FILE')."""
@@ -198,6 +201,7 @@ def map_draft(
             ("part_min_m", part_min),
             ("corridor_ratio", corridor_ratio),
             ("link_max_m", link_max),
+            ("wall_min", wall_min),
             ("clutter_m", clutter),
         )
         if v is not None

@@ -202,3 +202,62 @@ def test_a_short_wide_dead_end_off_a_corridor_is_a_room_not_a_corridor(tmp_path)
     # With a corridor only as long as it is wide, the room is drafted as a corridor.
     loose, _, _ = draft_building(grid, tmp_path / "c.yaml", params=DraftParams(corridor_ratio=1.0))
     assert any(w.pos[1] > 6.0 and 7.5 < w.pos[0] < 12.5 for w in loose.waypoints)
+
+
+def _walled_grid(tmp_path, rects, unseen, size=(34.0, 16.0), res=0.05):
+    """A grid of free rectangles, walled (black) but along the ``unseen`` rectangles'
+    borders, which stay the never-seen grey: rays through a door into space not mapped."""
+    import cv2
+
+    w, h = round(size[0] / res), round(size[1] / res)
+    free = np.zeros((h, w), np.uint8)
+    for x0, y0, x1, y1 in [*rects, *unseen]:
+        free[h - round(y1 / res) : h - round(y0 / res), round(x0 / res) : round(x1 / res)] = 1
+    img = np.full((h, w), 205, np.uint8)
+    img[cv2.dilate(free, np.ones((5, 5), np.uint8)) > 0] = 0
+    for x0, y0, x1, y1 in unseen:  # no wall seen round the fan, only its rays
+        r0, r1 = h - round(y1 / res) - 3, h - round(y0 / res) + 3
+        img[r0:r1, round(x0 / res) - 3 : round(x1 / res) + 3] = 205
+    img[free > 0] = 254
+    return save_ros_map(FloorPlanImage(img, res, (0.0, 0.0, 0.0)), tmp_path / "w.yaml")
+
+
+def test_a_dead_end_bordered_by_unseen_space_is_a_laser_fan(tmp_path):
+    # A walled 28 m corridor with two dead ends north, 1.4 m wide and 7 m long: one
+    # walled (a corridor), one with no wall seen round it (rays through a door).
+    corridor, stub = (2, 2, 30, 4.4), (8, 4.4, 9.4, 11.4)
+    fan = (22, 4.4, 23.4, 11.4)
+    grid = _walled_grid(tmp_path, [corridor, stub], [fan])
+    b, d, _ = draft_building(grid, tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert _near(b, (8.7, 10.8), 1.2)
+    # The fan is corridor-shaped (its skeleton is drafted) but no corridor goes up it.
+    plan = load_ros_map(grid)
+    col = plan.world_to_pixel([[22.7, 8.0]]).round().astype(int)[0][0]
+    assert d.skeleton[:, col - 3 : col + 4].any()
+    assert not any(w.pos[1] > 6.0 and w.pos[0] > 20 for w in b.waypoints)
+
+
+def test_walls_saved_as_grey_likelihoods_are_seen_and_unknown_is_not():
+    from pmnav_bt.map.grid import seen_mask
+
+    # map_saver's never-seen grey (205) everywhere, free cells, and walls in a grey the
+    # trinary thresholds read as unknown too (the Willow Garage map's walls).
+    img = np.full((40, 60), 205, np.uint8)
+    img[10:30, 10:50] = 254
+    img[9, 10:50] = 150
+    seen = seen_mask(FloorPlanImage(img, 0.1, (0.0, 0.0, 0.0)))
+    assert seen[9, 10:50].all() and seen.sum() == 40
+    img[img == 205] = 0  # no unknown at all: every non-free cell is a wall
+    assert seen_mask(FloorPlanImage(img, 0.1, (0.0, 0.0, 0.0))).sum() == 60 * 40 - 20 * 40
+
+
+def test_map_draft_wall_min_is_a_share(tmp_path, capsys):
+    from pmnav_bt.cli import main
+
+    grid = _grid(tmp_path, [(2, 2, 30, 4.4)])
+    with pytest.raises(SystemExit) as ex:
+        main(["map", "draft", str(grid), "-o", str(tmp_path / "b.yaml"), "--wall-min", "2"])
+    assert ex.value.code == 2 and "--wall-min is a share of a border, 0 to 1" in (
+        capsys.readouterr().err
+    )
