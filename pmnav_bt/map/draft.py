@@ -411,8 +411,9 @@ def prune_alcoves(h: nx.Graph, dist: np.ndarray, ratio: float) -> int:
     the junction's corridors straight on), is a room or an alcove seen through a wide
     opening or a glass front (the hospital's middle blocks), or a bay between shelves.
     A dead end that carries a corridor straight on through its junction is that
-    corridor's last stretch and stays, however short. Repeated until none goes; returns
-    how many went.
+    corridor's last stretch and stays, however short; so does one that points at
+    another dead end within twice its width (one corridor the graph broke in two).
+    Repeated until none goes; returns how many went.
     """
     gone = 0
     changed = True
@@ -429,7 +430,7 @@ def prune_alcoves(h: nx.Graph, dist: np.ndarray, ratio: float) -> int:
             width = 2.0 * float(np.median(dist[rc[:, 0], rc[:, 1]]))
             if _path_len(path) >= ratio * width:
                 continue
-            if _carries_on(h, nodes[-1], path):
+            if _carries_on(h, nodes[-1], path) or _faces_an_end(h, nodes, path, 2.0 * width):
                 continue
             h.remove_nodes_from(nodes)
             gone += 1
@@ -482,6 +483,22 @@ def _wall_share(path: np.ndarray, dist: np.ndarray, seen: np.ndarray, free: np.n
     border = near & ~free[box]
     n = int(border.sum())
     return float((border & seen[box]).sum()) / n if n else 1.0
+
+
+def _faces_an_end(h: nx.Graph, nodes: list, path: np.ndarray, reach_px: float) -> bool:
+    """Whether the dead end running along ``path`` (junction to end) points at another
+    dead end's end within ``reach_px`` of its own (within 30 degrees of straight on)."""
+    p = path[-1]
+    ahead = path[-1] - path[max(0, len(path) - 1 - int(reach_px))]
+    ahead = ahead / max(float(np.linalg.norm(ahead)), 1e-9)
+    for m in h.nodes:
+        if m in nodes or h.degree(m) != 1:
+            continue
+        gap = h.nodes[m]["rc"] - p
+        d = float(np.linalg.norm(gap))
+        if d <= reach_px and float(np.dot(gap, ahead)) >= math.cos(math.radians(30)) * d:
+            return True
+    return False
 
 
 def _carries_on(h: nx.Graph, last, path: np.ndarray) -> bool:

@@ -261,3 +261,31 @@ def test_map_draft_wall_min_is_a_share(tmp_path, capsys):
     assert ex.value.code == 2 and "--wall-min is a share of a border, 0 to 1" in (
         capsys.readouterr().err
     )
+
+
+def test_an_alcove_goes_unless_it_points_at_another_dead_end():
+    import networkx as nx
+
+    from pmnav_bt.map.draft import prune_alcoves
+    from pmnav_bt.map.draft_links import straight_path
+
+    def graph(with_facing_end: bool) -> nx.Graph:
+        # A corridor L-J-R 20 px wide, and a dead end J-A 30 px long off it (short for
+        # its width); with B-C, another dead end points back at A across an 18 px gap.
+        pts = {"J": (50, 50), "L": (50, 0), "R": (50, 110), "A": (20, 50)}
+        edges = [("J", "L"), ("J", "R"), ("J", "A")]
+        if with_facing_end:
+            pts |= {"B": (2, 50), "C": (2, 110)}
+            edges.append(("B", "C"))
+        h = nx.Graph()
+        for n, rc in pts.items():
+            h.add_node(n, rc=np.array(rc, float))
+        for a, b in edges:
+            h.add_edge(a, b, path=straight_path(h.nodes[a]["rc"], h.nodes[b]["rc"]))
+        return h
+
+    dist = np.full((60, 120), 10.0)
+    alone = graph(False)
+    assert prune_alcoves(alone, dist, 3.0) == 1 and "A" not in alone
+    broken = graph(True)
+    assert prune_alcoves(broken, dist, 3.0) == 0 and "A" in broken
