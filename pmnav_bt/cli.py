@@ -178,7 +178,13 @@ def map_draft(
     corridor_min: float | None = typer.Option(None, help="Narrowest corridor (m)."),
     open_width: float | None = typer.Option(None, help="Wider (m) is an open area, a hall."),
     part_min: float | None = typer.Option(None, help="Shortest part apart kept (m)."),
+    corridor_ratio: float | None = typer.Option(
+        None, help="A corridor is this many times longer than wide (else a room)."
+    ),
     link_max: float | None = typer.Option(None, help="Longest link joining a part (m)."),
+    wall_min: float | None = typer.Option(
+        None, help="A dead end with less of its border wall (not unknown) is a laser fan (0-1)."
+    ),
     clutter: float | None = typer.Option(None, help="Obstacles this small (m) are filled."),
 ) -> None:
     """Draft a building file from an occupancy grid or a drawing ('pmnav map draft SRC -o FILE')."""
@@ -193,7 +199,9 @@ def map_draft(
             ("corridor_min_m", corridor_min),
             ("open_width_m", open_width),
             ("part_min_m", part_min),
+            ("corridor_ratio", corridor_ratio),
             ("link_max_m", link_max),
+            ("wall_min", wall_min),
             ("clutter_m", clutter),
         )
         if v is not None

@@ -11,7 +11,11 @@ The steps (each a function, so a person can look at every stage; run
    and the parts apart from it. Holes up to ``pillar_m`` (pillars) are filled.
 3. **Skeleton** of the corridor space (scikit-image), traced into a graph of pixel
    paths between junctions and ends; spurs shorter than the local half width plus
-   ``spur_m`` are pruned and straight-through nodes merged.
+   ``spur_m`` are pruned and straight-through nodes merged. Dead ends that widen
+   behind their mouth, or that branch off a corridor and are less than
+   ``corridor_ratio`` times longer than wide (a room seen through a wide opening), go;
+   so do dead ends whose border is less than ``wall_min`` wall, the rest never seen
+   (laser fans through open doors).
 4. **Open areas**: skeleton stretches wider than ``open_width_m`` (a lobby, a hall)
    are cut out; each area becomes one waypoint at its most open point with a
    straight corridor to each of its exits, not a lattice round its pillars.
@@ -53,7 +57,7 @@ from pmnav_bt.map.building import (
 from pmnav_bt.map.corridor_space import SpaceParams, corridor_space
 from pmnav_bt.map.draft_links import hall_hubs, link_parts
 from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map, save_ros_map
-from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask
+from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask, seen_mask
 
 ROOM_SPUR_M = 8.0  # a dead end longer than this is a corridor, whatever lies at its end
 
@@ -83,11 +87,16 @@ class DraftParams:
     corridor_min_m: float = 1.0  # free space narrower than this is no corridor (laser fans)
     doorway_max_m: float = 1.6  # a short place this narrow is a doorway: the space is cut
     doorway_m: float = 1.2  # ... if it is no longer than this (longer: a narrow corridor)
-    corridor_ratio: float = 3.0  # a piece is corridor-shaped when this many times longer than wide
+    # A piece, or a dead end branching off a corridor, is a corridor when this many times
+    # longer than wide (else a room); 3.0 is the best on both annotated maps (2.5 and 3.5
+    # drafted more spurious corridors, or lost coverage: docs/real-maps.md).
+    corridor_ratio: float = 3.0
     part_min_m: float = 4.0  # a corridor-shaped piece shorter than this is left out
     link_max_m: float = 6.0  # join a part apart by a straight corridor up to this long
     pillar_m: float = 2.0  # a hole in the corridor space this small is run past, not round
     room_widening: float = 1.5  # a dead end this many times wider behind its mouth is a room
+    # A dead end with less of its border wall (the rest never seen) is a laser fan.
+    wall_min: float = 0.3
 
     def space(self) -> SpaceParams:
         return SpaceParams(
@@ -394,6 +403,121 @@ def prune_room_spurs(h: nx.Graph, dist: np.ndarray, res: float, widening: float)
     return gone
 
 
+def prune_alcoves(h: nx.Graph, dist: np.ndarray, ratio: float) -> int:
+    """Remove dead ends short for their width that branch off a corridor: rooms, not corridors.
+
+    A corridor is long for its width; a dead end no longer than ``ratio`` times its
+    median width, meeting its junction across the corridor there (not carrying one of
+    the junction's corridors straight on), is a room or an alcove seen through a wide
+    opening or a glass front (the hospital's middle blocks), or a bay between shelves.
+    A dead end that carries a corridor straight on through its junction is that
+    corridor's last stretch and stays, however short; so does one that points at
+    another dead end within twice its width (one corridor the graph broke in two).
+    Repeated until none goes; returns how many went.
+    """
+    gone = 0
+    changed = True
+    while changed:
+        changed = False
+        for end in [n for n in h.nodes if h.degree(n) == 1]:
+            if end not in h or h.degree(end) != 1:
+                continue
+            chain = _dead_end_chain(h, end)
+            if chain is None:
+                continue
+            nodes, path = chain
+            rc = np.clip(path.round().astype(int), 0, np.array(dist.shape) - 1)
+            width = 2.0 * float(np.median(dist[rc[:, 0], rc[:, 1]]))
+            if _path_len(path) >= ratio * width:
+                continue
+            if _carries_on(h, nodes[-1], path) or _faces_an_end(h, nodes, path, 2.0 * width):
+                continue
+            h.remove_nodes_from(nodes)
+            gone += 1
+            changed = True
+    return gone
+
+
+def prune_fans(
+    h: nx.Graph, dist: np.ndarray, seen: np.ndarray, free: np.ndarray, wall_min: float
+) -> int:
+    """Remove dead ends whose border is mostly space never seen: laser fans, not corridors.
+
+    A corridor is lined with walls the laser saw; the rays a scanner threw through an
+    open door fan out into space it never mapped, so most of a fan's border is unknown,
+    not wall. Around each dead end's centre line (its median half width and two pixels
+    more) the non-free pixels are counted; the dead end goes when less than
+    ``wall_min`` of them are seen (``grid.seen_mask``). Repeated until none goes (the
+    stem of a fan is a dead end once its arms went); returns how many went. A map with
+    no wall at all (free space drawn on unknown) cannot tell a fan from a corridor:
+    nothing goes.
+    """
+    gone = 0
+    if not seen.any():
+        return gone
+    changed = True
+    while changed:
+        changed = False
+        for end in [n for n in h.nodes if h.degree(n) == 1]:
+            if end not in h or h.degree(end) != 1:
+                continue
+            chain = _dead_end_chain(h, end)
+            if chain is not None and _wall_share(chain[1], dist, seen, free) < wall_min:
+                h.remove_nodes_from(chain[0])
+                gone += 1
+                changed = True
+    return gone
+
+
+def _wall_share(path: np.ndarray, dist: np.ndarray, seen: np.ndarray, free: np.ndarray) -> float:
+    """The share of seen cells among the non-free cells bordering a centre line's space."""
+    rc = np.clip(path.round().astype(int), 0, np.array(dist.shape) - 1)
+    reach = float(np.median(dist[rc[:, 0], rc[:, 1]])) + 2.0
+    pad = int(np.ceil(reach)) + 1
+    lo = np.maximum(rc.min(axis=0) - pad, 0)
+    hi = np.minimum(rc.max(axis=0) + pad + 1, np.array(dist.shape))
+    line = np.ones((hi - lo).tolist(), np.uint8)
+    line[rc[:, 0] - lo[0], rc[:, 1] - lo[1]] = 0
+    near = cv2.distanceTransform(line, cv2.DIST_L2, 5) <= reach
+    box = np.s_[lo[0] : hi[0], lo[1] : hi[1]]
+    border = near & ~free[box]
+    n = int(border.sum())
+    return float((border & seen[box]).sum()) / n if n else 1.0
+
+
+def _faces_an_end(h: nx.Graph, nodes: list, path: np.ndarray, reach_px: float) -> bool:
+    """Whether the dead end running along ``path`` (junction to end) points at another
+    dead end's end within ``reach_px`` of its own (within 30 degrees of straight on)."""
+    p = path[-1]
+    ahead = path[-1] - path[max(0, len(path) - 1 - int(reach_px))]
+    ahead = ahead / max(float(np.linalg.norm(ahead)), 1e-9)
+    for m in h.nodes:
+        if m in nodes or h.degree(m) != 1:
+            continue
+        gap = h.nodes[m]["rc"] - p
+        d = float(np.linalg.norm(gap))
+        if d <= reach_px and float(np.dot(gap, ahead)) >= math.cos(math.radians(30)) * d:
+            return True
+    return False
+
+
+def _carries_on(h: nx.Graph, last, path: np.ndarray) -> bool:
+    """Whether the dead end leaving its junction along ``path`` runs straight on from one of
+    the junction's other corridors (within 30 degrees)."""
+    junction = next(m for m in h.neighbors(last) if h.degree(m) >= 3)
+    j = h.nodes[junction]["rc"]
+    out = h.nodes[last]["rc"] - j
+    out = out / max(float(np.linalg.norm(out)), 1e-9)
+    for m in h.neighbors(junction):
+        if m == last:
+            continue
+        back = j - h.nodes[m]["rc"]
+        back = back / max(float(np.linalg.norm(back)), 1e-9)
+        if float(np.dot(out, back)) >= math.cos(math.radians(30)):
+            return True
+    return False
+
+
 def _dead_end_chain(h: nx.Graph, end) -> tuple[list, np.ndarray] | None:
     """The waypoints from a dead end back to its junction (not included), and the pixel
     path from the junction out to the end; None for a corridor on its own."""
@@ -538,6 +662,8 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
     h = _merge_close(h, dist, params.min_edge_m / res)
     h.remove_edges_from(nx.selfloop_edges(h))
     prune_room_spurs(h, dist, res, params.room_widening)
+    prune_alcoves(h, dist, params.corridor_ratio)
+    prune_fans(h, dist, seen_mask(plan), free, params.wall_min)
     hall_hubs(h, open_mask, free, dist)
     warnings = []
     for rc, n_px in link_parts(h, free, params.link_max_m / res):
@@ -727,7 +853,10 @@ def draft_source(
     for k, v in (knobs or {}).items():
         if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
             option = "--" + k.removesuffix("_m").replace("_", "-")
-            raise DraftError(f"{option} must be a positive number of metres, not {v!r}")
+            unit = " of metres" if k.endswith("_m") else ""
+            raise DraftError(f"{option} must be a positive number{unit}, not {v!r}")
+    if (knobs or {}).get("wall_min", 0.0) > 1.0:
+        raise DraftError(f"--wall-min is a share of a border, 0 to 1, not {knobs['wall_min']!r}")
     params = DraftParams(**(knobs or {}))
     if source.suffix.lower() in (".yaml", ".yml"):
         if scale is not None or scale_from is not None:

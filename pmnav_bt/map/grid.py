@@ -32,6 +32,27 @@ def free_mask(
     return free
 
 
+def seen_mask(plan: FloorPlanImage) -> np.ndarray:
+    """The non-free cells a sensor saw (walls, furniture), not those it never saw.
+
+    A map saver writes every never-seen cell in one grey (map_saver: 205), the commonest
+    shade of the non-free cells; a wall is any other non-free shade. A trinary reading
+    cannot tell them apart where walls are saved as grey likelihoods (the Willow Garage
+    map: only 544 cells are over its occupied threshold). A map whose commonest non-free
+    shade is itself occupied (all walls, nothing unknown) has every non-free cell seen.
+    """
+    grey = plan.grey().round()
+    other = plan.occupancy() != 0
+    shades, counts = np.unique(grey[other], return_counts=True)
+    if not len(shades):
+        return other
+    never = shades[np.argmax(counts)]
+    occupancy = never / 255.0 if plan.negate else 1.0 - never / 255.0
+    if occupancy > plan.occupied_thresh:
+        return other
+    return other & (grey != never)
+
+
 def largest_component(mask: np.ndarray) -> np.ndarray:
     n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=4)
     if n <= 1:

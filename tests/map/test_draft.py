@@ -185,3 +185,107 @@ def test_map_draft_options_set_the_thresholds(tmp_path, capsys):
     assert code == 0 and "warning" not in out.err
     code, out = run("--link-max", "0")
     assert code == 2 and "--link-max must be a positive number of metres" in out.err
+
+
+def test_a_short_wide_dead_end_off_a_corridor_is_a_room_not_a_corridor(tmp_path):
+    from pmnav_bt.map.draft import DraftParams
+
+    # A 28 m corridor with, on its north side, a room 4 m wide and 6 m deep open across
+    # its whole front (a glass front the scan did not see) and a stub corridor 1.4 m wide
+    # and 7 m long (five times longer than wide).
+    rects = [(2, 2, 30, 4.4), (8, 4.4, 12, 10.4), (22, 4.4, 23.4, 11.4)]
+    grid = _grid(tmp_path, rects)
+    b, _, _ = draft_building(grid, tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert not any(w.pos[1] > 6.0 and 7.5 < w.pos[0] < 12.5 for w in b.waypoints)
+    assert _near(b, (22.7, 10.8), 1.2)
+    # With a corridor only as long as it is wide, the room is drafted as a corridor.
+    loose, _, _ = draft_building(grid, tmp_path / "c.yaml", params=DraftParams(corridor_ratio=1.0))
+    assert any(w.pos[1] > 6.0 and 7.5 < w.pos[0] < 12.5 for w in loose.waypoints)
+
+
+def _walled_grid(tmp_path, rects, unseen, size=(34.0, 16.0), res=0.05):
+    """A grid of free rectangles, walled (black) but along the ``unseen`` rectangles'
+    borders, which stay the never-seen grey: rays through a door into space not mapped."""
+    import cv2
+
+    w, h = round(size[0] / res), round(size[1] / res)
+    free = np.zeros((h, w), np.uint8)
+    for x0, y0, x1, y1 in [*rects, *unseen]:
+        free[h - round(y1 / res) : h - round(y0 / res), round(x0 / res) : round(x1 / res)] = 1
+    img = np.full((h, w), 205, np.uint8)
+    img[cv2.dilate(free, np.ones((5, 5), np.uint8)) > 0] = 0
+    for x0, y0, x1, y1 in unseen:  # no wall seen round the fan, only its rays
+        r0, r1 = h - round(y1 / res) - 3, h - round(y0 / res) + 3
+        img[r0:r1, round(x0 / res) - 3 : round(x1 / res) + 3] = 205
+    img[free > 0] = 254
+    return save_ros_map(FloorPlanImage(img, res, (0.0, 0.0, 0.0)), tmp_path / "w.yaml")
+
+
+def test_a_dead_end_bordered_by_unseen_space_is_a_laser_fan(tmp_path):
+    # A walled 28 m corridor with two dead ends north, 1.4 m wide and 7 m long: one
+    # walled (a corridor), one with no wall seen round it (rays through a door).
+    corridor, stub = (2, 2, 30, 4.4), (8, 4.4, 9.4, 11.4)
+    fan = (22, 4.4, 23.4, 11.4)
+    grid = _walled_grid(tmp_path, [corridor, stub], [fan])
+    b, d, _ = draft_building(grid, tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert _near(b, (8.7, 10.8), 1.2)
+    # The fan is corridor-shaped (its skeleton is drafted) but no corridor goes up it.
+    plan = load_ros_map(grid)
+    col = plan.world_to_pixel([[22.7, 8.0]]).round().astype(int)[0][0]
+    assert d.skeleton[:, col - 3 : col + 4].any()
+    assert not any(w.pos[1] > 6.0 and w.pos[0] > 20 for w in b.waypoints)
+
+
+def test_walls_saved_as_grey_likelihoods_are_seen_and_unknown_is_not():
+    from pmnav_bt.map.grid import seen_mask
+
+    # map_saver's never-seen grey (205) everywhere, free cells, and walls in a grey the
+    # trinary thresholds read as unknown too (the Willow Garage map's walls).
+    img = np.full((40, 60), 205, np.uint8)
+    img[10:30, 10:50] = 254
+    img[9, 10:50] = 150
+    seen = seen_mask(FloorPlanImage(img, 0.1, (0.0, 0.0, 0.0)))
+    assert seen[9, 10:50].all() and seen.sum() == 40
+    img[img == 205] = 0  # no unknown at all: every non-free cell is a wall
+    assert seen_mask(FloorPlanImage(img, 0.1, (0.0, 0.0, 0.0))).sum() == 60 * 40 - 20 * 40
+
+
+def test_map_draft_wall_min_is_a_share(tmp_path, capsys):
+    from pmnav_bt.cli import main
+
+    grid = _grid(tmp_path, [(2, 2, 30, 4.4)])
+    with pytest.raises(SystemExit) as ex:
+        main(["map", "draft", str(grid), "-o", str(tmp_path / "b.yaml"), "--wall-min", "2"])
+    assert ex.value.code == 2 and "--wall-min is a share of a border, 0 to 1" in (
+        capsys.readouterr().err
+    )
+
+
+def test_an_alcove_goes_unless_it_points_at_another_dead_end():
+    import networkx as nx
+
+    from pmnav_bt.map.draft import prune_alcoves
+    from pmnav_bt.map.draft_links import straight_path
+
+    def graph(with_facing_end: bool) -> nx.Graph:
+        # A corridor L-J-R 20 px wide, and a dead end J-A 30 px long off it (short for
+        # its width); with B-C, another dead end points back at A across an 18 px gap.
+        pts = {"J": (50, 50), "L": (50, 0), "R": (50, 110), "A": (20, 50)}
+        edges = [("J", "L"), ("J", "R"), ("J", "A")]
+        if with_facing_end:
+            pts |= {"B": (2, 50), "C": (2, 110)}
+            edges.append(("B", "C"))
+        h = nx.Graph()
+        for n, rc in pts.items():
+            h.add_node(n, rc=np.array(rc, float))
+        for a, b in edges:
+            h.add_edge(a, b, path=straight_path(h.nodes[a]["rc"], h.nodes[b]["rc"]))
+        return h
+
+    dist = np.full((60, 120), 10.0)
+    alone = graph(False)
+    assert prune_alcoves(alone, dist, 3.0) == 1 and "A" not in alone
+    broken = graph(True)
+    assert prune_alcoves(broken, dist, 3.0) == 0 and "A" in broken
