@@ -258,9 +258,11 @@ class PmNavController:
         # A site of several levels: the start level's map, back ends and grid below, and
         # a mission across levels per goal (None: one floor, as any building).
         self.site = self._node_site(p)
+        self.map_file = p["building"]  # how the view and the records find the map again
         if self.site is not None:
             self.pm, self.grid = self.site.start.pm, self.site.start.grid
             self.building, self.backends = self.pm.building, self.site.start.backends
+            self.map_file = self.site.start_file
         else:
             self.building = load_building(p["building"])
             self.pm = parse_building(self.building)
@@ -386,7 +388,7 @@ class PmNavController:
         from pmnav_bt.webview.server import ViewServer, check_host
 
         feed = Feed(f"pmnav-ros {self.node.get_fully_qualified_name()}", live=True,
-                    building=p["building"])  # fmt: skip
+                    building=self.map_file)  # fmt: skip
         host = check_host(p["view_host"], p["view_allow_remote"])
         server = ViewServer(feed, host, int(p["view_port"]), p["view_allow_remote"]).start()
         self.log.info(f"web view: {server.url}")
@@ -581,7 +583,7 @@ class PmNavController:
         )  # fmt: skip
         if p["map_updates_dir"]:  # reviewed later with 'pmnav map updates FILE'
             name = f"{time.strftime('%Y%m%d-%H%M%S')}-run{run.id}{UPDATES_SUFFIX}"
-            watch_map(ctx, UpdatesFile(Path(p["map_updates_dir"]) / name, p["building"]))
+            watch_map(ctx, UpdatesFile(Path(p["map_updates_dir"]) / name, self.map_file))
         viz = _Viz(self, ctx)
         tee = open(p["tree_log"], "a", encoding="utf-8") if p["tree_log"] else None  # noqa: SIM115
         writer = _SnapshotWriter(self.pub_tree, self.pub_structure, tee, self.view_writer)
@@ -598,7 +600,7 @@ class PmNavController:
             self._wait_ready(run, req, w0)
             ctx.config = camera_config(cfg, self.base.camera_width(), self.base.options)
             max_ticks = max(1, int(float(p["max_duration_s"]) * cfg.tree.tick_hz))
-            view = ViewRecorder(ctx, building=p["building"])
+            view = ViewRecorder(ctx, building=self.map_file)
             build = ended_on = None
             if self.site is not None:  # the mission across levels, riding the lifts
                 session = self.node.get_fully_qualified_name()

@@ -95,6 +95,13 @@ class NodeSite:
     def start(self) -> _LevelParts:
         return self.levels[self.start_level]
 
+    @property
+    def start_file(self) -> str:
+        """How the web view, the tree record and the map updates find the start level's
+        map again: its building file (the site's name for a level written inline)."""
+        level = self.sm.site.level(self.start_level)
+        return str(level.path) if level.path is not None else self.sm.site.name
+
     def room(self, goal: str) -> tuple[str, Room]:
         """The level and the room ``goal`` names (as ``resolve_site_room``), or
         UnknownGoalError."""

@@ -27,6 +27,7 @@ def test_a_site_of_several_levels_is_a_site_and_one_floor_is_not():
 
 def test_the_start_level_is_the_first_unless_given(site):
     assert site.start_level == "L1" and site.start.pm is site.sm.maps["L1"]
+    assert site.start_file == str(load_site("hospital_2l").level("L1").path)
     on_l2 = NodeSite(load_site("hospital_2l"), "l2", CONFIG, on_robot=False, seed=0)
     assert on_l2.start_level == "L2"
     with pytest.raises(PmNavError, match="parameter 'start_level': no level 'L9'"):
