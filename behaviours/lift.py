@@ -14,6 +14,7 @@ leaves, in the order ``trees/lift.py`` strings them:
 - ``ReleaseLift``: end the session (a full cabin goes on without us; off at the far end);
 - ``DriveThrough``: straight through the doorway, into the cabin's middle or out to the
   lobby, on odometry (the doorway is 1.6 m wide, the robot 0.34 m);
+- ``StartLevel``: the mission's first leaf: the level it starts on;
 - ``OnNewLevel``: in the cabin on the far level: the old level's estimate, plan and what
   was found blocked are dropped; the estimate restarts at the cabin on the new level's
   map, with the lift's word as its only evidence (a prior, ``ARRIVAL_SIGMA_M``), for
@@ -347,6 +348,22 @@ class DriveThrough(PmNavBehaviour):
 def into_cabin(d: Doorway) -> float:
     """From the lobby point to the cabin's middle (m)."""
     return math.dist(d.lobby, d.cabin_centre())
+
+
+class StartLevel(PmNavBehaviour):
+    """The mission starts on ``level``: the blackboard's ``level`` says so from the first
+    tick (the node's feedback reports it; ``OnNewLevel`` changes it after each ride)."""
+
+    WRITES = ("level",)
+
+    def __init__(self, name: str, ctx: Context, level: str):
+        super().__init__(name, ctx)
+        self.level = level
+
+    def update(self) -> Status:
+        self.bb.set("level", self.level)
+        self.feedback_message = f"level {self.level}"
+        return Status.SUCCESS
 
 
 class OnNewLevel(PmNavBehaviour):

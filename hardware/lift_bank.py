@@ -12,7 +12,8 @@ What one lift does (Open-RMF's AGV mode, the mode a robot uses):
 - **The call.** A granted call waits a seeded delay, uniform in ``[0, call_delay_s]``,
   before the cabin moves: the lift finishing the calls of the people already in it.
 - **The ride.** The door closes (``door_s``: how long the door takes to close or to open),
-  the cabin moves ``ride_s_per_level`` per level, stops at the destination, and the door
+  the cabin moves ``ride_s_per_level`` per level (the timings: ``pmnav_bt/lift_timing.py``,
+  the same lift as the simulator's ``SimLift``), stops at the destination, and the door
   opens and stays open while the session holds the lift there (AGV mode: the robot needs
   time to drive in or out). After the session ends, the door stays open ``dwell_s`` and
   then closes, as a lift's door does after its last passenger.
@@ -31,15 +32,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from pmnav_bt.errors import PmNavError
+from pmnav_bt.lift_timing import BED_LIFT, LiftTiming
 from pmnav_bt.seams import LiftDoor, LiftMotion, LiftState
-
-# Defaults of the simulated lift node: a lift of a small hospital (about 4 m a level at
-# 1 m/s plus its acceleration: 5 s a level; doors 2 s each way, held 3 s after the last
-# passenger; a call served within 10 s).
-RIDE_S_PER_LEVEL = 5.0
-DOOR_S = 2.0
-DWELL_S = 3.0
-CALL_DELAY_S = 10.0
 
 
 @dataclass
@@ -61,17 +55,14 @@ class _Cabin:
 
 class LiftBank:
     """Simulated lifts: ``lifts`` maps each lift's name to the levels it serves, lowest
-    first; see the module doc."""
+    first; ``timing`` how long each takes; see the module doc."""
 
     def __init__(
         self,
         lifts: Mapping[str, Sequence[str]],
         *,
         start_level: str = "",
-        ride_s_per_level: float = RIDE_S_PER_LEVEL,
-        door_s: float = DOOR_S,
-        dwell_s: float = DWELL_S,
-        call_delay_s: float = CALL_DELAY_S,
+        timing: LiftTiming = BED_LIFT,
         seed: int = 0,
         clock: Callable[[], float] = time.monotonic,
         log: Callable[[str], None] = lambda _line: None,
@@ -89,12 +80,7 @@ class LiftBank:
             if start_level and start_level not in levels:
                 raise PmNavError(f"lift {name}: start level {start_level!r} is not one of "
                                  f"{list(levels)}")  # fmt: skip
-        for name, v in (("ride_s_per_level", ride_s_per_level), ("door_s", door_s),
-                        ("dwell_s", dwell_s), ("call_delay_s", call_delay_s)):  # fmt: skip
-            if not v >= 0.0:
-                raise PmNavError(f"{name} must be 0 or more seconds, not {v}")
-        self.ride_s, self.door_s, self.dwell_s = ride_s_per_level, door_s, dwell_s
-        self.call_delay_s = call_delay_s
+        self.timing = timing
         self.clock, self.log = clock, log
         self._t = clock()
         self._cabins = {}
@@ -129,7 +115,7 @@ class LiftBank:
         dest = c.levels.index(level)
         if not c.session:
             c.session, c.refused = session, ""
-            c.start_at = self._t + self._rng[lift].uniform(0.0, self.call_delay_s)
+            c.start_at = self._t + self._rng[lift].uniform(0.0, self.timing.call_delay_s)
             self.log(f"lift {lift}: session {session!r} granted, to {level}")
         elif dest != c.destination:
             self.log(f"lift {lift}: session {session!r} to {level}")
@@ -142,7 +128,7 @@ class LiftBank:
         if c is None or not session or c.session != session:
             return
         c.session, c.want_open = "", False
-        c.close_at = self._t + self.dwell_s
+        c.close_at = self._t + self.timing.dwell_s
         self.log(f"lift {lift}: session {session!r} ended")
 
     def state(self, lift: str) -> LiftState | None:
@@ -188,22 +174,22 @@ class LiftBank:
             t0 = max(t0, c.start_at)
         elif c.position == c.destination:
             t0 = max(t0, c.close_at)
-        left = t1 - t0
+        left, door_s = t1 - t0, self.timing.door_s
         if left <= 0.0:
             return
         if c.position == c.destination and c.session and c.want_open:
-            c.door = 1.0 if self.door_s == 0.0 else min(1.0, c.door + left / self.door_s)
+            c.door = 1.0 if door_s == 0.0 else min(1.0, c.door + left / door_s)
             return
-        need = c.door * self.door_s
+        need = c.door * door_s
         if left < need:
-            c.door -= left / self.door_s
+            c.door -= left / door_s
             return
         c.door, left = 0.0, left - need
         if c.position != c.destination:
             gap = c.destination - c.position
-            need = abs(gap) * self.ride_s
+            need = abs(gap) * self.timing.ride_s_per_level
             if left < need:
-                c.position += (1.0 if gap > 0 else -1.0) * left / self.ride_s
+                c.position += (1.0 if gap > 0 else -1.0) * left / self.timing.ride_s_per_level
                 return
             c.position, left = float(c.destination), left - need
             self._advance(c, t1 - left, t1)  # arrived: the door opens in the time left

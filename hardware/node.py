@@ -19,7 +19,9 @@ API (all standard messages; names relative to the node's namespace):
   (std_msgs/String, JSON): ready or the missing inputs, idle/running, the goal,
   sensor ages, the current fault; with ``lifts``, what each lift last said.
 - with ``lifts``: the building's lifts over Open-RMF's ``/lift_requests`` and
-  ``/lift_states`` (``hardware/lift_client.py``, a ``seams.Lift``: ``self.lift``).
+  ``/lift_states`` (``hardware/lift_client.py``, a ``seams.Lift``: ``self.lift``). In a
+  site of several levels (``building:=hospital_2l``, with ``lifts``) a goal runs the
+  mission across levels from ``start_level`` (``hardware/node_site.py``).
 - out ``tree`` (std_msgs/String, JSON): one snapshot per tick (statuses, feedback,
   blackboard changes, the view entry; the format of ``pmnav tree replay``);
   ``tree/structure`` (latched) holds the tree's nodes.
@@ -112,6 +114,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "lifts": (
         False, "use the building's lifts: requests on /lift_requests, states from "
         "/lift_states (Open-RMF's rmf_lift_msgs; hardware/lift_client.py)",
+    ),
+    "start_level": (
+        "", "in a site of several levels: the level the robot starts on; empty: the first",
     ),
     "status_hz": (1.0, "status topic rate"),
     "viz_hz": (2.0, "pose, trajectory and map -> odom publish rate"),
@@ -250,17 +255,26 @@ class PmNavController:
         if p["tick_hz"] > 0:
             overrides.append(f"tree.tick_hz={float(p['tick_hz'])}")
         self.config = load_config(p["config"] or None, overrides, label="parameter 'overrides'")
-        self.building = load_building(p["building"])
-        self.pm = parse_building(self.building)
-        # Its occupancy grid, where it has one: the walls the localization weighs depth on.
-        self.grid = building_grid(self.building, resolve_building_path(p["building"]).parent)
-        # The back ends, built once on what the tree variant may read (an unknown variant
-        # is refused now, not at the first goal); a back end that reads the simulator's
-        # labels is refused (one line, from the registry) unless the simulated Create 3
-        # publishes them.
-        self.backends = runner.variant_backends(
-            self.config, self.pm, on_robot=not p["segmentation_topic"], seed=int(p["seed"])
-        )
+        # A site of several levels: the start level's map, back ends and grid below, and
+        # a mission across levels per goal (None: one floor, as any building).
+        self.site = self._node_site(p)
+        self.map_file = p["building"]  # how the view and the records find the map again
+        if self.site is not None:
+            self.pm, self.grid = self.site.start.pm, self.site.start.grid
+            self.building, self.backends = self.pm.building, self.site.start.backends
+            self.map_file = self.site.start_file
+        else:
+            self.building = load_building(p["building"])
+            self.pm = parse_building(self.building)
+            # Its occupancy grid, where it has one: the walls the localization weighs depth on.
+            self.grid = building_grid(self.building, resolve_building_path(p["building"]).parent)
+            # The back ends, built once on what the tree variant may read (an unknown variant
+            # is refused now, not at the first goal); a back end that reads the simulator's
+            # labels is refused (one line, from the registry) unless the simulated Create 3
+            # publishes them.
+            self.backends = runner.variant_backends(
+                self.config, self.pm, on_robot=not p["segmentation_topic"], seed=int(p["seed"])
+            )
         self.base = Create3Base(node, create3_options(p))
         self.readiness = Readiness(self.base, p["odom_timeout"], p["camera_timeout"])
         self.map_frame, self.odom_frame = p["map_frame"], p["odom_frame"]
@@ -317,15 +331,42 @@ class PmNavController:
         self._publish_map_markers()
         self.view_server, self.view_writer = self._start_view(p)
         action = node.resolve_topic_name(action_server.ACTION_NAME) if self.action else None
+        where = f"building {self.building.name}, {len(self.building.rooms)} rooms"
+        if self.site is not None:
+            site = self.site.sm.site
+            where = (
+                f"site {site.name}, levels {', '.join(site.level_names)}, starting on "
+                f"{self.site.start_level} ({where}); lift session {node.get_fully_qualified_name()}"
+            )
         self.log.info(
-            f"pmnav-ros started: building {self.building.name}, "
-            f"{len(self.building.rooms)} rooms; goals: action {action}, "
+            f"pmnav-ros started: {where}; goals: action {action}, "
             f"{node.resolve_topic_name('goal')} (a room name), "
             f"{node.resolve_topic_name('goal_pose')} (the nearest door); waiting for sensors"
         )
 
     def _stamp(self):
         return self.node.get_clock().now().to_msg()
+
+    def _node_site(self, p: dict[str, Any]):
+        """The site of several levels ``building`` names (``NodeSite``), else None."""
+        from pmnav_bt.hardware.node_site import NodeSite, site_of_levels
+
+        site = site_of_levels(p["building"])
+        if site is None:
+            if p["start_level"]:
+                raise PmNavError(
+                    f"parameter 'start_level': {p['building']} is a building of one level"
+                )
+            return None
+        if not p["lifts"]:
+            raise PmNavError(
+                f"parameter 'building': {site.name} has several levels, reached by lift: "
+                "give -p lifts:=true"
+            )
+        return NodeSite(
+            site, p["start_level"], self.config, on_robot=not p["segmentation_topic"],
+            seed=int(p["seed"]),
+        )  # fmt: skip
 
     def _lift_client(self, p: dict[str, Any]):
         """The lift system over Open-RMF's topics (``seams.Lift``) with ``lifts``, else None."""
@@ -347,7 +388,7 @@ class PmNavController:
         from pmnav_bt.webview.server import ViewServer, check_host
 
         feed = Feed(f"pmnav-ros {self.node.get_fully_qualified_name()}", live=True,
-                    building=p["building"])  # fmt: skip
+                    building=self.map_file)  # fmt: skip
         host = check_host(p["view_host"], p["view_allow_remote"])
         server = ViewServer(feed, host, int(p["view_port"]), p["view_allow_remote"]).start()
         self.log.info(f"web view: {server.url}")
@@ -468,7 +509,10 @@ class PmNavController:
         from pmnav_bt.planning.resolve import resolve_room
 
         try:
-            room = self.building.room(resolve_room(self.pm, goal))
+            if self.site is not None:
+                room = self.site.room(goal)[1]
+            else:
+                room = self.building.room(resolve_room(self.pm, goal))
         except Exception:  # noqa: BLE001 - an unknown room: the tree reports INVALID_GOAL
             return {"room_id": "", "room_name": ""}
         return {"room_id": room.id, "room_name": room.display_name}
@@ -517,6 +561,7 @@ class PmNavController:
 
     def execute(self, req: GoalRequest) -> dict:
         """Run the tree for one goal and publish its result."""
+        from pmnav_bt.hardware.node_site import UnknownGoalError
         from pmnav_bt.map.updates import SUFFIX as UPDATES_SUFFIX
         from pmnav_bt.map.updates import UpdatesFile
         from pmnav_bt.trees.map_watch import watch_map
@@ -538,7 +583,7 @@ class PmNavController:
         )  # fmt: skip
         if p["map_updates_dir"]:  # reviewed later with 'pmnav map updates FILE'
             name = f"{time.strftime('%Y%m%d-%H%M%S')}-run{run.id}{UPDATES_SUFFIX}"
-            watch_map(ctx, UpdatesFile(Path(p["map_updates_dir"]) / name, p["building"]))
+            watch_map(ctx, UpdatesFile(Path(p["map_updates_dir"]) / name, self.map_file))
         viz = _Viz(self, ctx)
         tee = open(p["tree_log"], "a", encoding="utf-8") if p["tree_log"] else None  # noqa: SIM115
         writer = _SnapshotWriter(self.pub_tree, self.pub_structure, tee, self.view_writer)
@@ -555,10 +600,15 @@ class PmNavController:
             self._wait_ready(run, req, w0)
             ctx.config = camera_config(cfg, self.base.camera_width(), self.base.options)
             max_ticks = max(1, int(float(p["max_duration_s"]) * cfg.tree.tick_hz))
-            view = ViewRecorder(ctx, building=p["building"])
+            view = ViewRecorder(ctx, building=self.map_file)
+            build = ended_on = None
+            if self.site is not None:  # the mission across levels, riding the lifts
+                session = self.node.get_fully_qualified_name()
+                build, ended_on = self.site.mission(ctx, goal, self.lift, session)
             out = run_tree(
-                ctx, goal, max_ticks, log=writer, on_tick=on_tick, sync_workers=False, view=view
-            )
+                ctx, goal, max_ticks, log=writer, on_tick=on_tick, sync_workers=False, view=view,
+                build=build, ended_on=ended_on,
+            )  # fmt: skip
             result.update(
                 success=out.success,
                 code=out.failure.code.value if out.failure else None,
@@ -573,6 +623,8 @@ class PmNavController:
             result.update(success=False, code=FailureCode.CANCELLED.value, message=str(c))
         except NotReadyError as err:
             result.update(success=False, code=FailureCode.SENSOR_TIMEOUT.value, message=str(err))
+        except UnknownGoalError as err:
+            result.update(success=False, code=FailureCode.INVALID_GOAL.value, message=str(err))
         except Exception as err:  # noqa: BLE001 - reported with its code, the node goes on
             if not isinstance(err, PmNavError):
                 self.log.error(traceback.format_exc())

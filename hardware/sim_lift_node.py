@@ -1,7 +1,8 @@
 """``pmnav-sim-lift``: simulated lifts behind Open-RMF's lift topics, like an RMF lift adapter.
 
 A ``LiftBank`` (``hardware/lift_bank.py``: sessions, seeded call delays, the ride time per
-level, the door's travel and dwell) driven by the wall clock:
+level, the door's travel and dwell; by default a hospital bed lift's timings,
+``pmnav_bt/lift_timing.py``) driven by the wall clock:
 
 - in ``/lift_requests`` (rmf_lift_msgs/LiftRequest): AGV or human mode asks a lift to a
   floor with its door open or closed there; REQUEST_END_SESSION releases it. A lift held
@@ -21,21 +22,24 @@ from __future__ import annotations
 import sys
 
 from pmnav_bt.errors import PmNavError
-from pmnav_bt.hardware.lift_bank import CALL_DELAY_S, DOOR_S, DWELL_S, RIDE_S_PER_LEVEL
+from pmnav_bt.lift_timing import BED_LIFT as LIFT
 
 PARAMETERS = {
     "site": ("", "site file or built-in site whose lifts to simulate; empty: lifts and levels"),
     "lifts": ("lift1", "without a site: the lifts' names, comma-separated (LiftRequest.lift_name)"),
     "levels": ("L1,L2", "without a site: the levels every lift serves, lowest first"),
     "start_level": ("", "where the cabins stand at the start; empty: the lowest level"),
-    "ride_s_per_level": (RIDE_S_PER_LEVEL, "seconds from one level to the next"),
-    "door_s": (DOOR_S, "seconds the door takes to open, or to close"),
-    "dwell_s": (DWELL_S, "seconds the door stays open after a session ends"),
-    "call_delay_s": (CALL_DELAY_S, "a granted call waits a seeded delay up to this (s)"),
+    "ride_s_per_level": (LIFT.ride_s_per_level, "seconds from one level to the next"),
+    "door_s": (LIFT.door_s, "seconds the door takes to open, or to close"),
+    "dwell_s": (LIFT.dwell_s, "seconds the door stays open after a session ends"),
+    "call_delay_s": (LIFT.call_delay_s, "a granted call waits a seeded delay up to this (s)"),
     "seed": (0, "seed of the call delays"),
     "publish_hz": (2.0, "LiftState rate (a state also goes out on every change)"),
     "step_hz": (20.0, "how often the lifts' motion is advanced"),
 }
+
+
+TIMING_PARAMETERS = ("ride_s_per_level", "door_s", "dwell_s", "call_delay_s")  # LiftTiming's
 
 
 def _names(text: str, what: str) -> list[str]:
@@ -71,6 +75,7 @@ class SimLiftNode:
         from pmnav_bt.hardware import qos, rmf_lift
         from pmnav_bt.hardware.lift_bank import LiftBank
         from pmnav_bt.hardware.node import declare_parameters
+        from pmnav_bt.lift_timing import LiftTiming
 
         request_type, state_type = rmf_lift.messages()
         self.node = node
@@ -85,10 +90,7 @@ class SimLiftNode:
         self.bank = LiftBank(
             lifts,
             start_level=str(p["start_level"]).strip(),
-            ride_s_per_level=float(p["ride_s_per_level"]),
-            door_s=float(p["door_s"]),
-            dwell_s=float(p["dwell_s"]),
-            call_delay_s=float(p["call_delay_s"]),
+            timing=LiftTiming(**{k: float(p[k]) for k in TIMING_PARAMETERS}),
             seed=int(p["seed"]),
             clock=lambda: clock.now().nanoseconds * 1e-9,
             log=self.log.info,

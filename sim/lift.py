@@ -4,23 +4,20 @@ doors, ride between level worlds with the robot in them, and sometimes come full
 Each lift (``SimLift.add``) has a cabin on every level it serves (``sim/scene/lifts.py``:
 the recess behind the lift landmark's doors in that level's ``SimWorld``). A request
 for a level, by a session, is answered as a building's lift answers a call: after a
-call delay (the lift serves other calls first: ``CALL_DELAY_S``, drawn per call from
-the world's seeded stream ``rng("lift")``), the door shuts if it stood open
-(``DOOR_S``), the cabin rides (``LEVEL_S`` a level), the door opens (``DOOR_S``) and
-stays open while the session holds the lift at that level. A session's request for
-another level from inside the cabin shuts the door and rides at once. When the session
-ends (``release``) the door shuts after ``DWELL_S``.
+call delay (the lift serves other calls first: up to ``call_delay_s``, drawn per call
+from the world's seeded stream ``rng("lift")``), the door shuts if it stood open
+(``door_s``), the cabin rides (``ride_s_per_level`` a level), the door opens
+(``door_s``) and stays open while the session holds the lift at that level. A session's
+request for another level from inside the cabin shuts the door and rides at once. When
+the session ends (``release``) the door shuts after ``dwell_s``. The timings
+(``LiftTiming``, by default a hospital bed lift's) are ``pmnav_bt/lift_timing.py``'s,
+the same lift as the simulated lift node's (``hardware/lift_bank.py``).
 
 A call is answered full with probability ``world.lift_full_p``: the cabin opens with a
 cart in it (people with their trolley, ``Cabin.fill``) and, let go, rides off with it to
 another level. A robot standing on the cabin's floor when it leaves rides with it: at
 the far level the lift hands it to ``rider.carry`` at the same place in that level's
 cabin. Time is the simulation's clock (a clock listener), never wall time.
-
-Timings: a lift door of 1.6 m, two panels opening from the centre, opens or shuts in
-2.5-3.5 s; one storey (about 4 m) at 1 m/s takes some 4 s, with 2 s to start and 2 s to
-level; a door held by no one shuts after about 5 s; at a busy hour a hospital lift
-answers a call in up to a minute or more (``tree.lift_wait_s`` is 3 min).
 """
 
 from __future__ import annotations
@@ -35,14 +32,10 @@ import numpy as np
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.geometry import se2_compose, se2_inverse
+from pmnav_bt.lift_timing import BED_LIFT, LiftTiming
 from pmnav_bt.seams import LiftDoor, LiftMotion, LiftState, Pose2D
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.scene.lifts import Cabin
-
-DOOR_S = 3.0
-LEVEL_S = 8.0
-DWELL_S = 5.0
-CALL_DELAY_S = (0.0, 40.0)
 
 
 class LiftError(PmNavError):
@@ -91,12 +84,19 @@ class _Car:
 class SimLift:
     """The lift system of a simulated building of several levels (``seams.Lift``; see the
     module). ``clock``: the simulation's; ``rider``: the robot; ``full_p``: how often a
-    call is answered full; ``rng``: the seeded stream of call delays and full cabins."""
+    call is answered full; ``rng``: the seeded stream of call delays and full cabins;
+    ``timing``: how long the lift takes."""
 
     def __init__(
-        self, clock: SimClock, rider: Rider, rng: np.random.Generator, full_p: float = 0.0
+        self,
+        clock: SimClock,
+        rider: Rider,
+        rng: np.random.Generator,
+        full_p: float = 0.0,
+        timing: LiftTiming = BED_LIFT,
     ) -> None:
         self.clock, self.rider, self.rng, self.full_p = clock, rider, rng, float(full_p)
+        self.timing = timing
         self._cars: dict[str, _Car] = {}
         clock.add_listener(self._advance)
 
@@ -123,9 +123,10 @@ class SimLift:
         now = self.clock.now()
         if call:
             car.full = bool(self.rng.random() < self.full_p)
-            car.phase, car.until = Phase.CALLED, now + float(self.rng.uniform(*CALL_DELAY_S))
+            delay = float(self.rng.uniform(0.0, self.timing.call_delay_s))
+            car.phase, car.until = Phase.CALLED, now + delay
         elif car.phase == Phase.OPEN:
-            car.phase, car.until = Phase.CLOSING, now + DOOR_S
+            car.phase, car.until = Phase.CLOSING, now + self.timing.door_s
             car.cabins[car.level].set_door(False)
 
     def release(self, lift: str, session: str) -> None:
@@ -136,7 +137,7 @@ class SimLift:
         if car.phase == Phase.CALLED:
             car.phase, car.until = Phase.IDLE, math.inf
         elif car.phase == Phase.OPEN:
-            car.until = self.clock.now() + DWELL_S
+            car.until = self.clock.now() + self.timing.dwell_s
 
     def state(self, lift: str) -> LiftState | None:
         car = self._car(lift)
@@ -183,15 +184,16 @@ class SimLift:
             car.phase, car.until = self._leave_or_open(car, t, closed=True)
         elif car.phase == Phase.RIDING:
             self._arrive(car)
-            car.phase, car.until = Phase.OPENING, t + DOOR_S
+            car.phase, car.until = Phase.OPENING, t + self.timing.door_s
         elif car.phase == Phase.OPENING:
             cabin.set_door(True)
-            car.phase, car.until = Phase.OPEN, t + DWELL_S if not car.session else math.inf
+            dwell = self.timing.dwell_s if not car.session else math.inf
+            car.phase, car.until = Phase.OPEN, t + dwell
         elif car.phase == Phase.OPEN:  # no one holds it: shut; people riding on go on
             cabin.set_door(False)
             if car.full:
                 car.dest = self._elsewhere(car)
-            car.phase, car.until = Phase.CLOSING, t + DOOR_S
+            car.phase, car.until = Phase.CLOSING, t + self.timing.door_s
         else:
             car.until = math.inf
 
@@ -200,18 +202,18 @@ class SimLift:
         cabin = car.cabins[car.level]
         if cabin.is_open:
             cabin.set_door(False)
-            return Phase.CLOSING, t + DOOR_S
+            return Phase.CLOSING, t + self.timing.door_s
         if car.dest == car.level:
             if closed and not car.session:
                 return Phase.IDLE, math.inf
             if car.full and not cabin.cart:
                 cabin.fill()  # they got in on the way: no room for the robot
-            return Phase.OPENING, t + DOOR_S
+            return Phase.OPENING, t + self.timing.door_s
         rider = self.rider
         car.carrying = rider.level == car.level and cabin.holds(*_xy(rider.world_pose()))
         cabin.empty()
         storeys = abs(car.levels.index(car.dest) - car.levels.index(car.level))
-        return Phase.RIDING, t + LEVEL_S * storeys
+        return Phase.RIDING, t + self.timing.ride_s_per_level * storeys
 
     def _arrive(self, car: _Car) -> None:
         """At the destination: the robot carried into this level's cabin, the cart too."""

@@ -3,6 +3,7 @@ between levels::
 
     PM-Nav across levels (beside the Monitor)
       Mission
+        StartLevel                the blackboard's level: the start level
         Localize                  on the start level
         Leg1                      navigate_subtree to the first ride's lift lobby
         Lift1                     lift_subtree: ride, re-localize on the next level
@@ -25,7 +26,7 @@ from collections.abc import Mapping
 import py_trees
 
 from pmnav_bt.behaviours.context import Context
-from pmnav_bt.behaviours.lift import Ride
+from pmnav_bt.behaviours.lift import Ride, StartLevel
 from pmnav_bt.behaviours.motion import Arrive
 from pmnav_bt.map.lift_doorway import doorway
 from pmnav_bt.map.site_map import SiteMap
@@ -36,7 +37,7 @@ from pmnav_bt.trees.lift import lift_subtree
 from pmnav_bt.trees.mission import monitored_mission, sequence
 from pmnav_bt.trees.pmnav import localize_subtree, navigate_subtree
 
-SESSION = "pmnav"  # the lift session the robot asks by (one robot, one session at a time)
+SESSION = "pmnav"  # the simulator's lift session (one robot); a ROS node asks by its name
 
 
 def site_rides(sm: SiteMap, plan: SitePlan, session: str = SESSION) -> list[Ride]:
@@ -60,13 +61,19 @@ def build_site_tree(
     plan: SitePlan,
     lift: Lift,
     refine: bool = True,
+    session: str = SESSION,
 ) -> py_trees.trees.BehaviourTree:
     """The mission of ``plan`` (see the module); ``contexts``: each level's Context by
-    level name (``level_context``), ``lift``: the building's lift system."""
-    rides = site_rides(sm, plan)
+    level name (``level_context``), ``lift``: the building's lift system, ``session``: the
+    name the robot asks for lifts by (unique among the lift system's requesters: Open-RMF
+    lifts serve one session at a time)."""
+    rides = site_rides(sm, plan, session)
     levels = {lv.name: lv.building for lv in sm.site.levels}
     first = contexts[plan.start_level]
-    parts: list[py_trees.behaviour.Behaviour] = [localize_subtree(first)]
+    parts: list[py_trees.behaviour.Behaviour] = [
+        StartLevel("StartLevel", first, plan.start_level),
+        localize_subtree(first),
+    ]
     for i, leg in enumerate(plan.legs):
         ctx = contexts[leg.level]
         if i < len(rides):  # to the lobby of the next ride

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import py_trees
 import pytest
 
 from pmnav_bt.backends import Backends
@@ -38,9 +39,9 @@ def building(sm):
     return sm.site.level("L1").building
 
 
-def mission(make_rig, sm, goal: str, overrides=(), **lift):
+def mission(make_rig, sm, goal: str, overrides=(), session="/robot1/pmnav", **lift):
     """The rig on L1, each level's context, the site plan to ``goal`` and the FakeLift of
-    its first ride (``lift``: its script)."""
+    its first ride (``lift``: its script); the tree asks for lifts by ``session``."""
     rig = make_rig(START, overrides=overrides)
     plan = SitePlanner().plan(sm, "L1", START, goal)
     contexts = {"L1": rig.ctx}
@@ -52,15 +53,25 @@ def mission(make_rig, sm, goal: str, overrides=(), **lift):
             contexts[name] = level_context(rig.ctx, pm, backends=backends)
     ride = plan.rides[0]
     fake = FakeLift(rig.base.clock, levels=("L1", "L2"), name=ride.lift, **lift)
-    return rig, plan, fake, lambda ctx, goal: build_site_tree(contexts, sm, plan, fake)
+    return rig, plan, fake, lambda ctx, goal: build_site_tree(
+        contexts, sm, plan, fake, session=session
+    )
 
 
 def test_a_mission_across_levels_reaches_the_room_on_the_other_level(make_rig, sm):
     rig, plan, lift, build = mission(make_rig, sm, "Laboratory")
     assert plan.goal_level == "L2" and plan.goal == "room208" and len(plan.rides) == 1
-    out = run_tree(rig.ctx, plan.goal, max_ticks=MAX_TICKS, build=build)
+    levels = []  # the blackboard's level after each tick: the action's feedback reports it
+
+    def level(tree) -> None:
+        levels.append(py_trees.blackboard.Blackboard.storage.get("/pmnav/level"))
+
+    out = run_tree(rig.ctx, plan.goal, max_ticks=MAX_TICKS, build=build, on_tick=level)
     assert out.success, out.failure
-    assert [r[1] for r in lift.requests] == ["L1", "L2"]
+    assert [r[1:] for r in lift.requests] == [("L1", "/robot1/pmnav"), ("L2", "/robot1/pmnav")]
+    assert [t for t, _ in lift.releases] and {s for _, s in lift.releases} == {"/robot1/pmnav"}
+    assert levels[0] == "L1" and levels[-1] == "L2"
+    assert [lv for i, lv in enumerate(levels) if i == 0 or lv != levels[i - 1]] == ["L1", "L2"]
     door = sm.maps["L2"].building.room("room208").door
     p = rig.true_pose()
     assert math.dist((p.x, p.y), door) < 1.0

@@ -9,6 +9,7 @@ import pytest
 
 from pmnav_bt.errors import PmNavError
 from pmnav_bt.hardware.lift_bank import LiftBank
+from pmnav_bt.lift_timing import LiftTiming
 from pmnav_bt.seams import Lift, LiftDoor, LiftMotion
 
 
@@ -21,9 +22,12 @@ class Clock:
 
 
 def bank(clock, **kw):
-    args = dict(ride_s_per_level=2.0, door_s=1.0, dwell_s=3.0, call_delay_s=0.0)
+    timing = dict(ride_s_per_level=2.0, door_s=1.0, dwell_s=3.0, call_delay_s=0.0)
+    timing |= {k: kw.pop(k) for k in list(kw) if k in timing}
     levels = ["L1", "L2", "L3"]
-    return LiftBank({"lift1": levels, "lift2": levels}, clock=clock, **(args | kw))
+    return LiftBank(
+        {"lift1": levels, "lift2": levels}, clock=clock, timing=LiftTiming(**timing), **kw
+    )
 
 
 def at(clock, b, t, lift="lift1"):
@@ -125,13 +129,18 @@ def test_unknown_levels_and_lifts_are_logged_and_ignored():
         (dict(lifts={"a": []}), "lift a: level names must be unique and not empty"),
         (dict(lifts={}), "at least one lift"),
         (dict(start_level="L3"), "lift b: start level 'L3' is not one of"),
-        (dict(ride_s_per_level=-1.0), "ride_s_per_level must be 0 or more"),
     ],
 )
 def test_bad_banks_are_refused_in_one_line(kw, match):
     args = dict(lifts={"a": ["L1", "L2", "L3"], "b": ["L1", "L2"]}) | kw
     with pytest.raises(PmNavError, match=match):
         LiftBank(args.pop("lifts"), **args)
+
+
+@pytest.mark.parametrize("name", ["ride_s_per_level", "door_s", "dwell_s", "call_delay_s"])
+def test_bad_timings_are_refused_in_one_line(name):
+    with pytest.raises(PmNavError, match=f"{name} must be 0 or more seconds, not -1.0"):
+        LiftTiming(**{name: -1.0})
 
 
 def test_the_node_takes_a_sites_lifts_or_its_own_list():

@@ -145,3 +145,64 @@ def test_states_and_requests_carry_rmf_fields(ros_required):
     assert (req.request_type, req.door_state) == (LiftRequest.REQUEST_AGV_MODE, 2)
     end = rmf_lift.request_message("lift1", "L3", "robot", Time(sec=3), end=True)
     assert end.request_type == LiftRequest.REQUEST_END_SESSION and end.session_id == "robot"
+
+
+@pytest.mark.timeout(300)  # three nodes start, then the robot localizes and drives
+def test_pmnav_ros_on_a_site_calls_the_lift_for_a_goal_on_another_level(domain_id, tmp_path):
+    """``pmnav-ros -p building:=hospital_2l -p lifts:=true`` (node ``/robot1``) runs a goal on
+    L2 as the mission across levels: its feedback names the start level L1, and at the
+    lift's lobby it calls the lift by its own name, which the simulated lift node grants
+    (the ride itself needs the simulated Create 3 to change levels, which it cannot)."""
+    from rclpy.action import ActionClient
+    from rclpy.node import Node
+
+    from pmnav_bt.hardware.action_server import action_type
+    from pmnav_bt.hardware.lift_client import RosLiftClient
+    from pmnav_bt.hardware.runtime import RosRuntime
+    from pmnav_bt.map.site import load_site
+
+    if action_type() is None:
+        pytest.skip("pmnav_interfaces not built")
+    l1 = load_site("hospital_2l").level("L1")
+    procs = [
+        Proc("pmnav_bt.hardware.sim_lift_node", dict(site="hospital_2l", seed=1, **TIMING),
+             domain_id, tmp_path / "sim_lift.log"),
+        Proc("pmnav_bt.hardware.sim_create3", dict(building=str(l1.path), width=240, height=180),
+             domain_id, tmp_path / "create3.log"),
+        Proc("pmnav_bt.hardware.node", dict(building="hospital_2l", lifts=True,
+             overrides="grounder.backend=sim_gt"), domain_id, tmp_path / "pmnav.log",
+             name="robot1"),
+    ]  # fmt: skip
+    rt = RosRuntime(args=[], domain_id=domain_id)
+    node = Node("site_test", context=rt.context)
+    lifts = RosLiftClient(node)  # only listens: what the lifts say
+    client = ActionClient(node, action_type(), "navigate_to_room")
+    rt.add(node)
+    rt.start()
+    logs = lambda: "\n".join(f"--- {p.log.name}\n{p.tail()}" for p in procs)  # noqa: E731
+    try:
+        assert client.wait_for_server(timeout_sec=60.0), logs()
+        feedback: list = []
+        fut = client.send_goal_async(
+            action_type().Goal(room="Laboratory"),
+            feedback_callback=lambda m: feedback.append(m.feedback),
+        )
+        deadline = time.monotonic() + 240.0
+        held = None
+        while held is None:
+            held = next(
+                (s for name in ("lift1", "lift2") if (s := lifts.state(name)) is not None
+                 and s.session == "/robot1"), None,
+            )  # fmt: skip
+            dead = [p for p in procs if not p.alive()]
+            assert time.monotonic() < deadline and not dead, f"no lift called\n{logs()}"
+            time.sleep(0.2)
+        assert held.destination_level == "L1"  # called to the robot's level
+        levels = {f.level for f in feedback if f.phase != "waiting_for_sensors"}
+        assert levels == {"L1"}, levels
+        handle = fut.result()
+        handle.cancel_goal_async()
+    finally:
+        rt.shutdown()
+        for p in reversed(procs):
+            p.stop()

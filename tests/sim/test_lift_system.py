@@ -10,9 +10,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
+from pmnav_bt.lift_timing import BED_LIFT as T
 from pmnav_bt.seams import LiftDoor, LiftMotion, Pose2D
 from pmnav_bt.sim.clock import SimClock
-from pmnav_bt.sim.lift import CALL_DELAY_S, DOOR_S, LEVEL_S, LiftError, SimLift
+from pmnav_bt.sim.lift import LiftError, SimLift
 
 
 @dataclass
@@ -84,8 +85,8 @@ def test_a_call_is_answered_after_a_seeded_delay_the_ride_and_the_door():
         waits.append(wait_open(clock, lift, "L1"))
         assert cabins["L1"].is_open and not cabins["L3"].is_open
     assert waits[0] == waits[1] != waits[2]  # the seed decides the call's delay
-    ride = 2 * LEVEL_S + DOOR_S
-    assert all(ride <= w <= ride + CALL_DELAY_S[1] + 0.5 for w in waits)
+    ride = 2 * T.ride_s_per_level + T.door_s
+    assert all(ride <= w <= ride + T.call_delay_s + 0.5 for w in waits)
 
 
 def test_the_robot_in_the_cabin_rides_to_the_same_place_in_the_next_levels_cabin():
@@ -96,10 +97,11 @@ def test_the_robot_in_the_cabin_rides_to_the_same_place_in_the_next_levels_cabin
     robot.pose = Pose2D(10.3, -2.0, math.pi / 2)  # drove in, turned round to face out
     lift.request("lift1", "L2", "s")
     assert lift.state("lift1").door == LiftDoor.MOVING
-    clock.wait(DOOR_S + 0.5)
+    clock.wait(T.door_s + 0.5)
     assert lift.state("lift1").motion == LiftMotion.UP
     took = wait_open(clock, lift, "L2")
-    assert LEVEL_S <= took <= LEVEL_S + DOOR_S + 1.0  # no call delay from inside
+    ride = T.ride_s_per_level
+    assert ride <= took <= ride + T.door_s + 1.0  # no call delay from inside
     assert robot.level == "L2" and len(robot.carried) == 1
     # 0.3 m left of L1's cabin's middle (looking into it), facing out; in L2's the same.
     assert robot.pose.x == pytest.approx(40.0) and robot.pose.y == pytest.approx(5.0 + 0.3)
@@ -116,7 +118,7 @@ def test_a_full_cabin_comes_with_its_cart_and_rides_off_with_it_when_let_go():
     wait_open(clock, lift, "L1")
     assert cabins["L1"].cart is not None
     lift.release("lift1", "s")
-    clock.wait(DOOR_S * 2 + 10.0)
+    clock.wait(T.door_s * 2 + 10.0)
     st = lift.state("lift1")
     assert cabins["L1"].cart is None  # it left, cart and all, for another level
     assert st.current_level != "L1" or st.motion != LiftMotion.STOPPED
