@@ -31,6 +31,7 @@ import numpy as np
 
 from pmnav_bt.errors import PlanningError
 from pmnav_bt.geometry import heading, wrap_angle
+from pmnav_bt.lift_timing import BED_LIFT
 from pmnav_bt.map.corridor_search import INF, CorridorSearch, LobbyTree
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.map.site import Site
@@ -42,13 +43,15 @@ from pmnav_bt.seams import CREATE3_MAX_LINEAR, PlanConstraints
 from pmnav_bt.seams import PlanStart as SeamStart
 
 # The ride's cost in corridor metres: what the robot's time in the lift is worth at its
-# driving speed. A call (wait for the cabin, the door, drive in, the door closes; at the
-# other end drive out) takes about 45 s; travel about 5 s a level (4 m floor to floor at
-# 1 m/s, with starting and stopping). At the Create 3's 0.306 m/s that is 13.8 m a call
-# and 1.5 m a level: a lift 14 m nearer is worth a change of lifts.
+# driving speed, from the lift's timing model (pmnav_bt/lift_timing.py, a hospital bed
+# lift). A call costs the mean wait for the cabin (half the longest), its door opening and
+# shutting at both ends, and driving in, turning round and out (about 13 s): 45 s; travel
+# 8 s a level. At the Create 3's 0.306 m/s that is 13.8 m a call and 2.4 m a level: a
+# lift 14 m nearer is worth a change of lifts.
 DRIVE_M_PER_S = CREATE3_MAX_LINEAR
-LIFT_CALL_S = 45.0
-LIFT_LEVEL_S = 5.0
+CABIN_IN_OUT_S = 13.0
+LIFT_CALL_S = BED_LIFT.call_delay_s / 2.0 + 4.0 * BED_LIFT.door_s + CABIN_IN_OUT_S
+LIFT_LEVEL_S = BED_LIFT.ride_s_per_level
 LIFT_CALL_M = LIFT_CALL_S * DRIVE_M_PER_S
 LIFT_LEVEL_M = LIFT_LEVEL_S * DRIVE_M_PER_S
 
