@@ -1,7 +1,7 @@
 """A rolling local costmap in the odometry frame: what stands on the floor near the robot.
 
 What it models: Nav2's local costmap with an obstacle layer and an inflation layer, for a
-depth camera. A fixed window (``SIZE_M`` square, ``RESOLUTION_M`` cells) centred on the
+depth camera. A fixed window (``SIZE_M`` square, 10 m, ``RESOLUTION_M`` cells) centred on the
 robot moves with it; each cell is free or occupied, with the time it was last marked.
 
 - **Marking**: a depth pixel whose point stands above the floor (``FLOOR_BAND_M``, the
@@ -11,9 +11,9 @@ robot moves with it; each cell is free or occupied, with the time it was last ma
 - **Clearing**: a cell is cleared where the camera sees the floor in it, nearer than the
   first obstacle along that bearing (Nav2 ray-traces each ray's 2-D shadow; a camera 1.6 m
   up looks over a low box, so only floor actually seen is free here). Cells out of view
-  (the 3.7 m under and before the camera at its 47 deg vertical field, everything beside
-  and behind) keep what they were: a box seen 3 m ahead is remembered as the robot
-  passes it.
+  (the 3.7 m under and before the camera, everything beside and behind) keep what they
+  were: a box seen 4 m ahead is remembered as the robot passes it. Cells never seen free
+  are unknown (``CostGrid.seen``): a planner leaves its straight line only onto floor seen.
 - **Decay**: a mark not seen again for ``DECAY_S`` is forgotten (someone who walked
   off where the camera no longer looks).
 - **Other sources**: ``mark(points)``: odometry points of a bumper or IR hit.
@@ -38,12 +38,15 @@ from scipy.ndimage import distance_transform_edt
 
 from pmnav_bt.seams import CREATE3_RADIUS_M, Observation
 
-SIZE_M = 6.0  # the window: 3 m round the robot, two seconds' drive and more at 0.306 m/s
+# The window: 5 m round the robot. The camera (1.6 m up, 47 deg vertical field) sees the
+# floor only from 3.7 m ahead, so what it clears lies 3.7-5 m off: a smaller window would
+# keep too little of it.
+SIZE_M = 10.0
 RESOLUTION_M = 0.05  # Nav2's local costmap default
 FLOOR_BAND_M = 0.08  # a point this far above the floor is on something (depth noise, sills)
 ROBOT_HEIGHT_M = 1.7  # the body with its camera mast: anything higher is passed under
-MARK_RANGE_M = 4.0  # depth beyond this marks nothing (coarse; the window's corner is 4.2 m)
-CLEAR_RANGE_M = 4.5  # floor seen farther than this clears nothing
+MARK_RANGE_M = 4.5  # depth beyond this marks nothing (too coarse to steer by)
+CLEAR_RANGE_M = 5.0  # floor seen farther than this clears nothing (the window's edge)
 DECAY_S = 30.0  # a mark unseen this long is forgotten (a person who walked on)
 LETHAL_PAD_M = 0.05  # lethal: within the body's radius and this (a cell's diagonal and more)
 INFLATION_M = 0.25  # cost falls off over this much beyond the lethal distance

@@ -13,9 +13,10 @@ being a local minimum in front of it). Every control period:
    anything (or, where the body already stands closer, no closer than it stands: it may
    always turn away).
    And every pose where the costmap has seen the floor free all round the body, or on
-   the drive's straight line (``passable``): the camera, 1.6 m up, does not see the
-   floor within 1.4-3.7 m of it, so a robot may leave the line only onto floor it saw
-   from farther off (the line itself is trusted as the direct drive trusts it).
+   the drive's straight line, or round something marked (``passable``): the camera,
+   1.6 m up, does not see the floor within 3.7 m of it, so a robot may leave the line
+   only onto floor it saw from farther off or to go round what it saw (the line itself is
+   trusted as the direct drive trusts it).
 4. **Score** (lower is better): progress along the navigation function, the costmap's
    cost along the way (clearance), the heading at the end towards the goal, and the
    distance from the drive's straight line (stay on the corridor's centre line where it
@@ -51,8 +52,12 @@ ANGULAR_SAMPLES = 15
 W_PROGRESS, W_CLEARANCE, W_HEADING, W_LINE = 1.0, 0.5, 0.15, 0.1
 LOCAL_GOAL_MARGIN_M = 0.4  # a goal beyond the window is aimed at this far inside its edge
 GOAL_SEED_M = 0.3  # the navigation function starts from the free cells this near the goal
-OWN_CELLS_M = 0.15  # cells this near the robot are free to the navigation function
+OWN_CELLS_M = 0.3  # cells this near the robot are free to the navigation function
 LINE_BAND_M = 0.05  # the line is trusted this far beyond the lethal distance either side
+# The floor this near something marked is trusted too: the way round it. The camera sees
+# the floor beside a box from afar, but the floor just past it lies in the box's shadow
+# and then under the camera's view; what stood there taller than the box was seen above it.
+ROUND_M = 1.0
 
 
 @dataclass(frozen=True)
@@ -107,9 +112,9 @@ def local_goal(grid: CostGrid, x: float, y: float, goal: tuple[float, float]):
 
 def passable(grid: CostGrid, line) -> np.ndarray:
     """Cells the body's centre may cross: those whose lethal disc lies all on floor seen
-    free or within ``LINE_BAND_M`` and the lethal distance of ``line`` (odometry segment;
-    None: none trusted)."""
-    trusted = grid.seen.copy()
+    free, within ``ROUND_M`` of something marked, or within ``LINE_BAND_M`` and the lethal
+    distance of ``line`` (odometry segment; None: none trusted)."""
+    trusted = grid.seen | (grid.dist <= ROUND_M)
     if line is not None:
         n, r = grid.dist.shape[0], grid.resolution
         cx = grid.origin[0] + (np.arange(n) + 0.5) * r
@@ -194,10 +199,13 @@ def choose(
         fine &= (ok[i, j] | ~inside | own).all(axis=1)
     ok = fine
     ends = (px[:, -1], py[:, -1])
-    if nav is not None and math.isfinite(float(nav.at(np.array([x]), np.array([y]))[0])):
+    to_go = nav.at(*ends) if nav is not None else np.full(len(v), math.inf)
+    if np.isfinite(to_go).any():
         g = nav.goal
-        to_go, start = nav.at(*ends), float(nav.at(np.array([x]), np.array([y]))[0])
-    else:  # no navigation function for this goal (or none reaching here): straight distance
+        start = float(nav.at(np.array([x]), np.array([y]))[0])
+        if not math.isfinite(start):  # the robot stands cut off (too near something): out
+            start = float(to_go[np.isfinite(to_go)].max())
+    else:  # no navigation function for this goal, or none reaching: straight distance
         g = nav.goal if nav is not None else local_goal(grid, x, y, goal)
         to_go, start = np.hypot(ends[0] - g[0], ends[1] - g[1]), math.hypot(x - g[0], y - g[1])
     ok &= np.isfinite(to_go)

@@ -90,11 +90,11 @@ class LocalPlannerSteering:
 
     def __init__(self, costmap: LocalCostmap | None = None) -> None:
         self.costmap = costmap if costmap is not None else LocalCostmap()
-        # The navigation function for an aim (odometry), made in the worker, read in the tick.
-        self._nav: tuple[tuple[float, float], Navigation | None] = ((math.nan, math.nan), None)
+        # The navigation function for an aim (odometry) and the cells passable, made in the
+        # worker with each frame, read in the tick.
+        self._nav: tuple = ((math.nan, math.nan), None, None)
         self._last = (0.0, 0.0, -math.inf)  # the command in force and when it was sent
         self._line: tuple[tuple[float, float], tuple[float, float]] | None = None
-        self._ok: tuple[object, object] = (None, None)  # passable cells, for (grid, line)
         self._lock = threading.Lock()
 
     def sense(self, obs: Observation, now: float) -> None:
@@ -117,9 +117,10 @@ class LocalPlannerSteering:
         grid = self.costmap.snapshot()
         line = self._line if self._line is not None and self._line[1] == g else None
         line = line or ((pose.x, pose.y), g)
-        nav = navigation(grid, pose.x, pose.y, g, passable(grid, line))
+        ok = passable(grid, line)
+        nav = navigation(grid, pose.x, pose.y, g, ok)
         with self._lock:
-            self._nav = (g, nav)
+            self._nav = (g, nav, ok)
         here = (np.array([pose.x]), np.array([pose.y]))
         if math.isfinite(float(nav.at(*here)[0])):
             return None
@@ -142,14 +143,10 @@ class LocalPlannerSteering:
             v0 = w0 = 0.0
         grid = self.costmap.snapshot()
         with self._lock:
-            made_for, nav = self._nav
+            made_for, nav, ok = self._nav
         if nav is None or math.dist(made_for, g) > AIM_SAME_M or nav.grid.origin != grid.origin:
-            nav = None  # made for another aim, or the window moved since: straight distance
+            nav = ok = None  # for another aim, or the window moved: straight on, till the next
         dyn = Dynamics(limits.linear, limits.angular)
-        key = (id(grid), self._line)
-        if self._ok[0] != key:
-            self._ok = (key, passable(grid, self._line))
-        ok = self._ok[1]
         choice = choose(grid, nav, (odom.x, odom.y, odom.yaw), (v0, w0), g, self._line, dyn, ok)
         v, w = (0.0, 0.0) if choice is None else (choice.v, choice.w)
         self._last = (v, w, now)

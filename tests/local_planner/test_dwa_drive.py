@@ -39,14 +39,16 @@ def record_commands(base) -> list[tuple[float, float]]:
 
 @pytest.mark.parametrize("size", [0.4, 0.8])
 def test_dwa_drives_round_a_box_on_the_centre_line_to_the_goal(make_rig, size):
-    rig = make_rig(Pose2D(0.0, 26.5, SOUTH), overrides=DWA)
-    rig.add_obstacle(0.0, 24.0, size=size, height=1.0)
+    """The box is seen from 5 m, with the floor beside it (the camera sees the floor from
+    3.7 m on), and is driven round as it comes: never held."""
+    rig = make_rig(Pose2D(0.0, 29.5, SOUTH), overrides=DWA)
+    rig.add_obstacle(0.0, 24.5, size=size, height=1.0)
     rig.set(target=room4_step(rig))
     sent = record_commands(rig.body)
     seen = rig.run(Approach("Approach", rig.ctx), max_ticks=900)
     rig.expect(seen, Status.SUCCESS)
     assert rig.body.stats.collisions == 0
-    assert rig.true_pose().y < 24.0 - size / 2  # past it, not stopped at it
+    assert rig.true_pose().y < 24.5 - size / 2  # past it, not stopped at it
     assert "obstacle" not in [e.kind for e in rig.ctx.trace]  # never held
     # Within the Create 3's limits, forward only, and the speed changing no faster than
     # its wheels accelerate (0.9 m/s^2: 0.09 m/s a 0.1 s tick).
@@ -59,13 +61,13 @@ def test_dwa_drives_round_a_box_on_the_centre_line_to_the_goal(make_rig, size):
 
 
 def test_dwa_stops_before_a_box_that_shuts_the_corridor(make_rig):
-    rig = make_rig(Pose2D(0.0, 26.5, SOUTH), overrides=DWA)
-    rig.add_obstacle(0.0, 24.0, size=1.6, height=1.9)  # 0.2 m left either side
+    rig = make_rig(Pose2D(0.0, 29.5, SOUTH), overrides=DWA)
+    rig.add_obstacle(0.0, 24.5, size=1.6, height=1.9)  # 0.4 m left either side
     rig.set(target=room4_step(rig))
     seen = rig.run(Approach("Approach", rig.ctx), max_ticks=600)
     rig.expect(seen, Status.FAILURE)
     assert rig.failure.code == FailureCode.BLOCKED
-    assert "the corridor between room1 and room4 blocked for" in rig.failure.message
+    assert "blocked for" in rig.failure.message
     assert rig.body.stats.collisions == 0
-    assert rig.true_pose().y > 24.8 + 0.17  # short of the box
+    assert rig.true_pose().y > 25.3 + 0.17  # short of the box
     assert rig.stopped()
