@@ -48,11 +48,11 @@ def test_no_way_through_a_wall_across_the_window_but_round_a_gap_in_it():
     """The navigation function is the drive's answer to "is the way shut" (it holds)."""
     here = np.array([0.0]), np.array([0.0])
     cm = LocalCostmap()
-    cm.mark(wall(0.8, -4.5, 4.5), now=0.0)
+    cm.mark(wall(0.8, -5.5, 5.5), now=0.0)
     nav = navigation(cm.snapshot(), 0.0, 0.0, (2.0, 0.0))
     assert not math.isfinite(float(nav.at(*here)[0]))
     cm = LocalCostmap()
-    cm.mark(np.vstack((wall(0.8, -4.5, 0.8), wall(0.8, 1.4, 4.5))), now=0.0)  # a 0.6 m gap
+    cm.mark(np.vstack((wall(0.8, -5.5, 0.8), wall(0.8, 1.4, 5.5))), now=0.0)  # a 0.6 m gap
     nav = navigation(cm.snapshot(), 0.0, 0.0, (2.0, 0.0))
     # by the gap at (0.8, 1.1): 1.4 + 1.6 m, less the goal seed 0.3 (straight: 1.7 m)
     assert float(nav.at(*here)[0]) > 2.4
