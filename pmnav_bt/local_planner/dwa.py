@@ -201,8 +201,11 @@ def choose(
     ends = (px[:, -1], py[:, -1])
     to_go = nav.at(*ends) if nav is not None else np.full(len(v), math.inf)
     if np.isfinite(to_go).any():
+        # Never less than the straight distance: the last metres, inside the goal's seed
+        # (where the navigation function is 0), are driven by it.
         g = nav.goal
-        start = float(nav.at(np.array([x]), np.array([y]))[0])
+        to_go = np.maximum(to_go, np.hypot(ends[0] - g[0], ends[1] - g[1]))
+        start = max(float(nav.at(np.array([x]), np.array([y]))[0]), math.hypot(x - g[0], y - g[1]))
         if not math.isfinite(start):  # the robot stands cut off (too near something): out
             start = float(to_go[np.isfinite(to_go)].max())
     else:  # no navigation function for this goal, or none reaching: straight distance

@@ -44,6 +44,7 @@ from pmnav_bt.seams import Observation, Pose2D
 GOAL_TOLERANCE_M = 0.15  # as goto_command's: a drive's goal is reached this near
 AIM_SAME_M = 0.05  # a navigation function made for a goal this near serves this one
 RECENT_COMMAND_S = 0.5  # a command older than this: the body has stopped since
+FINAL_APPROACH_M = 0.5  # this near the goal, with a clear straight way, drive straight in
 STILL_M = 0.02  # frames this near each other were taken standing still
 SHUT_PROBE_M = 3.0  # how far along the way a shut way's distance is looked for
 
@@ -86,7 +87,7 @@ class DirectSteering:
 
 class LocalPlannerSteering:
     """A local costmap and the DWA (see the module's docstring). ``costmap``: the one to
-    mark (None: a fresh 6 m window); the hazards of a robot may ``mark`` it too."""
+    mark (None: a fresh 10 m window); the hazards of a robot may ``mark`` it too."""
 
     def __init__(self, costmap: LocalCostmap | None = None) -> None:
         self.costmap = costmap if costmap is not None else LocalCostmap()
@@ -142,15 +143,31 @@ class LocalPlannerSteering:
         if now - then > RECENT_COMMAND_S:
             v0 = w0 = 0.0
         grid = self.costmap.snapshot()
+        dyn = Dynamics(limits.linear, limits.angular)
+        if _final_approach(grid, odom, g):  # the last half metre, clear: straight in
+            v, w, _ = goto_command(odom, *g, limits)
+            v = min(v, v0 + dyn.accel_linear * dyn.period)
+            self._last = (v, w, now)
+            return v, w, False
         with self._lock:
             made_for, nav, ok = self._nav
         if nav is None or math.dist(made_for, g) > AIM_SAME_M or nav.grid.origin != grid.origin:
             nav = ok = None  # for another aim, or the window moved: straight on, till the next
-        dyn = Dynamics(limits.linear, limits.angular)
         choice = choose(grid, nav, (odom.x, odom.y, odom.yaw), (v0, w0), g, self._line, dyn, ok)
         v, w = (0.0, 0.0) if choice is None else (choice.v, choice.w)
         self._last = (v, w, now)
         return v, w, False
+
+
+def _final_approach(grid, odom: Pose2D, goal: tuple[float, float]) -> bool:
+    """Whether the goal is within ``FINAL_APPROACH_M`` with nothing lethal on the straight
+    way to it: the DWA's 1.8 s rollouts overshoot so short a way, and weave."""
+    d = math.hypot(goal[0] - odom.x, goal[1] - odom.y)
+    if d > FINAL_APPROACH_M:
+        return False
+    s = np.linspace(0.0, 1.0, max(2, int(d / grid.resolution) + 2))
+    clear = grid.clearance(odom.x + s * (goal[0] - odom.x), odom.y + s * (goal[1] - odom.y))
+    return bool((clear >= min(grid.lethal_m, float(clear[0]))).all())
 
 
 def _to_odom(tf: Transform, p: tuple[float, float]) -> tuple[float, float]:
