@@ -100,7 +100,6 @@ class LocalCostmap:
             raise ValueError(f"a costmap of {size} m in {resolution} m cells is not sensible")
         self.n = int(round(size / resolution))
         self.resolution = resolution
-        self.radius = radius
         self.lethal_m = radius + LETHAL_PAD_M
         self.decay_s = decay_s
         self._origin = (-size / 2.0, -size / 2.0)

@@ -20,9 +20,7 @@ being a local minimum in front of it). Every control period:
 4. **Score** (lower is better): progress along the navigation function, the costmap's
    cost along the way (clearance), the heading at the end towards the goal, and the
    distance from the drive's straight line (stay on the corridor's centre line where it
-   is free); progress counts against the fastest the window allows, so that a robot
-   stopped near something starts again. Standing still is chosen only where nothing else
-   is admissible; none admissible: stop (``None``).
+   is free). None admissible: stop (``None``).
 
 The navigation function (``navigation``: fast marching from the goal over the cells that
 are not lethal, scikit-fmm) is also the planner's answer to "is there a way at all" in
@@ -216,10 +214,7 @@ def choose(
     ok &= np.isfinite(to_go)
     if not ok.any():
         return None
-    # Progress against what the window allows now (from a stop, 0.09 m/s: a start is worth
-    # as much as full speed is when moving; else the clearance term keeps a robot that
-    # stopped near something standing there).
-    progress = (to_go - start) / (max(float(v.max()), 0.05) * HORIZON_S)
+    progress = (to_go - start) / (dyn.max_linear * HORIZON_S)
     cost = grid.cost(clear).max(axis=1)
     bearing = np.arctan2(g[1] - py[:, -1], g[0] - px[:, -1]) - th[:, -1]
     facing = np.abs((bearing + math.pi) % (2.0 * math.pi) - math.pi) / math.pi
@@ -232,9 +227,6 @@ def choose(
         + W_HEADING * facing
         + W_LINE * np.minimum(off_line, 1.0)
     )
-    standing = (v == 0.0) & (np.abs(w) < 1e-6)
-    if (ok & ~standing).any():
-        ok &= ~standing  # standing still is what is left when nothing else is admissible
     score = np.where(ok, score, math.inf)
     k = int(np.argmin(score))
     return Choice(float(v[k]), float(w[k]), float(score[k]), int(ok.sum()))

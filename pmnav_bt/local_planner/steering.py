@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import threading
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -45,7 +45,6 @@ GOAL_TOLERANCE_M = 0.15  # as goto_command's: a drive's goal is reached this nea
 AIM_SAME_M = 0.05  # a navigation function made for a goal this near serves this one
 RECENT_COMMAND_S = 0.5  # a command older than this: the body has stopped since
 FINAL_APPROACH_M = 0.5  # this near the goal, with a clear straight way, drive straight in
-TIGHT_PAD_M = 0.01  # wedged, the DWA may pass this near things (Create 3: 1 cm)
 STILL_M = 0.02  # frames this near each other were taken standing still
 SHUT_PROBE_M = 3.0  # how far along the way a shut way's distance is looked for
 
@@ -154,14 +153,7 @@ class LocalPlannerSteering:
             made_for, nav, ok = self._nav
         if nav is None or math.dist(made_for, g) > AIM_SAME_M or nav.grid.origin != grid.origin:
             nav = ok = None  # for another aim, or the window moved: straight on, till the next
-        here = (odom.x, odom.y, odom.yaw)
-        choice = choose(grid, nav, here, (v0, w0), g, self._line, dyn, ok)
-        if choice is None or choice.v == 0.0:
-            # Wedged, no way forward (a real wall's corner within the lethal pad after a
-            # turn): the body's own radius and a centimetre, before turning on the spot.
-            tight = replace(grid, lethal_m=self.costmap.radius + TIGHT_PAD_M)
-            wedged = choose(tight, nav, here, (v0, w0), g, self._line, dyn, ok)
-            choice = wedged if wedged is not None and wedged.v > 0.0 else choice
+        choice = choose(grid, nav, (odom.x, odom.y, odom.yaw), (v0, w0), g, self._line, dyn, ok)
         v, w = (0.0, 0.0) if choice is None else (choice.v, choice.w)
         self._last = (v, w, now)
         return v, w, False
