@@ -14,6 +14,7 @@ import numpy as np
 from pmnav_bt.config import Config
 from pmnav_bt.control import Limits, Odometer
 from pmnav_bt.geometry import se2_compose, wrap_angle
+from pmnav_bt.local_planner.steering import DirectSteering, Steering, make_steering
 from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.map.updates import NO_MAP_UPDATES, MapUpdateSink
 from pmnav_bt.pose.evidence.floor_model import CORRIDORS, WallSource
@@ -60,6 +61,7 @@ class Context:
     budget_actions: int = 500
     map_updates: MapUpdateSink = NO_MAP_UPDATES  # where disagreements with the map go
     misreads: Misreads | None = None  # plates read that named nothing (trees.map_watch)
+    steering: Steering = field(default_factory=DirectSteering)  # the drives' local planner
 
     def __post_init__(self) -> None:
         if not isinstance(self.base, CalibratedBase):
@@ -89,6 +91,7 @@ class Context:
             detour_check=detour_check,
             walls=walls,
             budget_actions=budget if budget is not None else config.tree.budget_actions,
+            steering=make_steering(config.tree.local_planner),
         )
 
     @property

@@ -21,7 +21,6 @@ from py_trees.common import Status
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
 from pmnav_bt.behaviours.pose import keep_on_axis, measure_walls
-from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
 from pmnav_bt.map.wording import shut_way_words
@@ -147,7 +146,8 @@ class DriveTo(PmNavBehaviour):
         elif now - self._best_t > NO_PROGRESS_S:
             base.stop()
             return self.fail(FailureCode.BLOCKED, f"no progress for {NO_PROGRESS_S:.0f} s")
-        v, w, done = goto_command(est, *aim, self.ctx.limits)
+        tf, limits = self.get("map_T_odom"), self.ctx.limits
+        v, w, done = self.ctx.steering.command(est, base.pose(), aim, tf, limits, now)
         if done and self._detour is not None:  # past the obstacle: on to the goal
             self._detour = None
             self._progress_afresh()
@@ -171,22 +171,25 @@ class DriveTo(PmNavBehaviour):
             if now - self._watch_t >= WATCH_PERIOD_S:
                 self._watch_t = now
                 base, goal, target = self.ctx.base, self._aim(), self.get("target")
-                tf, clear = self.get("map_T_odom"), self.ctx.detour_check
+                tf, clear, steer = self.get("map_T_odom"), self.ctx.detour_check, self.ctx.steering
                 before = self._last_frame
                 moving = self._hold is not None and self._hold.moving
 
                 def watch(cancelled):
                     obs = base.observe()
+                    steer.sense(obs, now)
                     est = map_pose(tf, obs.pose)
                     found = self.inspect(obs, est, target)
                     found["walls"] = measure_walls(self.ctx.grounder, obs)
                     found["ahead"] = ahead = _toward_goal(obs, est, goal)
                     blocked = _closer_than_goal(ahead, est, goal)
+                    if blocked is not None and before is not None and steer.movers(before, obs):
+                        way = wrap_angle(heading((est.x, est.y), goal) - est.yaw)
+                        found["moved"] = moved(before, obs, way, blocked + MOVER_REACH_M)
+                    mover = moving or bool(found.get("moved"))
+                    blocked = steer.way_shut(obs, tf, goal, blocked, mover)
                     if blocked is not None:
-                        if before is not None:
-                            way = wrap_angle(heading((est.x, est.y), goal) - est.yaw)
-                            found["moved"] = moved(before, obs, way, blocked + MOVER_REACH_M)
-                        space = PERSON_SPACE_M if moving or found.get("moved") else 0.0
+                        space = PERSON_SPACE_M if mover else 0.0
                         found["detour"] = detour(obs, est, goal, blocked, clear, space)
                     return obs, blocked, found
 

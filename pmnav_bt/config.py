@@ -297,6 +297,21 @@ class TreeConfig(_Section):
     step_timeout_s: float = Field(
         180.0, gt=0.0, le=86_400.0, description="clock seconds per plan step"
     )
+    local_planner: str = Field(
+        "direct",
+        description="how a drive steers to its goal, by name (pmnav_bt/local_planner/steering.py): "
+        "direct (straight at it; what stands in the way holds the drive, clutter is gone round "
+        "by a detour point) or dwa (a rolling local costmap from depth and the dynamic window "
+        "approach within the body's limits: clutter is driven round as it comes)",
+    )
+
+    @field_validator("local_planner")
+    @classmethod
+    def _registered_steering(cls, name: str) -> str:
+        from pmnav_bt.local_planner.steering import STEERINGS
+
+        return _named(STEERINGS, name)
+
     max_linear: float = Field(CREATE3_MAX_LINEAR, gt=0.0, le=5.0, description="m/s (Create 3)")
     max_angular: float = Field(CREATE3_MAX_ANGULAR, gt=0.0, le=10.0, description="rad/s (Create 3)")
     lift_wait_s: float = Field(
