@@ -37,6 +37,21 @@ def test_builtin_sites_and_their_levels_are_package_data():
     assert list((ROOT / "pmnav_bt" / "data" / "sites").glob("*/*.yaml"))
 
 
+def test_every_data_file_is_package_data():
+    """Each file the core reads from pmnav_bt/data/ ships in the wheel (the sign ranges
+    once did not)."""
+    cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    data = ROOT / "pmnav_bt" / "data"
+    shipped = {f for glob in cfg["package-data"]["pmnav_bt.data"] for f in data.glob(glob)}
+    files = {
+        f
+        for f in data.rglob("*")
+        if f.is_file() and f.suffix != ".py" and "__pycache__" not in f.parts
+    }
+    missing = sorted(str(f.relative_to(data)) for f in files - shipped)
+    assert not missing, f"missing from [tool.setuptools.package-data] pmnav_bt.data: {missing}"
+
+
 def test_the_core_imports_no_tree_simulator_or_ros_at_import_time():
     import subprocess
     import sys
