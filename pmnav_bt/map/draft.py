@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -415,6 +416,20 @@ def prune_alcoves(h: nx.Graph, dist: np.ndarray, ratio: float) -> int:
     another dead end within twice its width (one corridor the graph broke in two).
     Repeated until none goes; returns how many went.
     """
+
+    def goes(nodes: list, path: np.ndarray) -> bool:
+        rc = np.clip(path.round().astype(int), 0, np.array(dist.shape) - 1)
+        width = 2.0 * float(np.median(dist[rc[:, 0], rc[:, 1]]))
+        if _path_len(path) >= ratio * width:
+            return False
+        return not (_carries_on(h, nodes[-1], path) or _faces_an_end(h, nodes, path, 2.0 * width))
+
+    return _prune_dead_ends(h, goes)
+
+
+def _prune_dead_ends(h: nx.Graph, goes: Callable[[list, np.ndarray], bool]) -> int:
+    """Remove every dead end (its chain of nodes and centre-line path) that ``goes``,
+    repeated until none goes (a stem is a dead end once its arms went); how many went."""
     gone = 0
     changed = True
     while changed:
@@ -423,18 +438,10 @@ def prune_alcoves(h: nx.Graph, dist: np.ndarray, ratio: float) -> int:
             if end not in h or h.degree(end) != 1:
                 continue
             chain = _dead_end_chain(h, end)
-            if chain is None:
-                continue
-            nodes, path = chain
-            rc = np.clip(path.round().astype(int), 0, np.array(dist.shape) - 1)
-            width = 2.0 * float(np.median(dist[rc[:, 0], rc[:, 1]]))
-            if _path_len(path) >= ratio * width:
-                continue
-            if _carries_on(h, nodes[-1], path) or _faces_an_end(h, nodes, path, 2.0 * width):
-                continue
-            h.remove_nodes_from(nodes)
-            gone += 1
-            changed = True
+            if chain is not None and goes(*chain):
+                h.remove_nodes_from(chain[0])
+                gone += 1
+                changed = True
     return gone
 
 
@@ -452,21 +459,9 @@ def prune_fans(
     no wall at all (free space drawn on unknown) cannot tell a fan from a corridor:
     nothing goes.
     """
-    gone = 0
     if not seen.any():
-        return gone
-    changed = True
-    while changed:
-        changed = False
-        for end in [n for n in h.nodes if h.degree(n) == 1]:
-            if end not in h or h.degree(end) != 1:
-                continue
-            chain = _dead_end_chain(h, end)
-            if chain is not None and _wall_share(chain[1], dist, seen, free) < wall_min:
-                h.remove_nodes_from(chain[0])
-                gone += 1
-                changed = True
-    return gone
+        return 0
+    return _prune_dead_ends(h, lambda _nodes, path: _wall_share(path, dist, seen, free) < wall_min)
 
 
 def _wall_share(path: np.ndarray, dist: np.ndarray, seen: np.ndarray, free: np.ndarray) -> float:
