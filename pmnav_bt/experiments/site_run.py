@@ -111,6 +111,7 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
             )  # fmt: skip
         final, level, stats = body.world_pose(), body.level, body.stats
         contacts = sum(w.people.contacts for w in worlds.values())
+        full_calls = lift.full_calls
         lift.close()
         body.close()
     finally:
@@ -140,6 +141,8 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
         soft_spl=float("nan") if not ok else soft_spl(shortest, 0.0, stats.path_length),
         distance_to_door=dist,
         route_length=ep.route_length,
+        rides=ep.rides,
+        lifts_full=full_calls,
     )
     plots: dict[str, Path] = {}
     if out_dir is not None:
