@@ -200,6 +200,7 @@ def run(
             return
     if episode_file is not None:
         from pmnav_bt.sim.episodes import episode_map, load_episodes
+        from pmnav_bt.sim.site_episodes import SiteEpisode
 
         if goal is not None or start is not None:
             raise PmNavError("--episodes runs a stored episode: drop --goal and --start")
@@ -207,6 +208,11 @@ def run(
         if not 0 <= index < len(eps):
             raise PmNavError(f"--index {index}: {episode_file} has {len(eps)} episodes")
         ep = eps[index]
+        if isinstance(ep, SiteEpisode):  # across levels: a world per level, a plot per level
+            from pmnav_bt.experiments.site_run import show_site_run
+
+            show_site_run(ep, cfg, out)
+            return
         episode_map(ep)  # a missing, changed or other building, a start outside: now
     elif goal is None:
         raise PmNavError("give --goal ROOM (or --episodes FILE --index N)")

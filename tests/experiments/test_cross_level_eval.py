@@ -120,3 +120,15 @@ def test_an_oracle_cross_level_evaluation_on_hospital_2l(tmp_path):
     assert r.error is None and r.success, r.failure_reason
     assert r.rides == 1 and r.lifts_full == 0 and r.tier == CROSS_LEVEL
     assert 0 < r.spl <= 1 and math.isfinite(r.shortest_path_length)
+
+
+def test_sim_run_takes_a_stored_site_episode(tmp_path, capsys):
+    f = _site_file(tmp_path)
+    eps = save_episodes(generate_site_episodes(str(f), 1), tmp_path / "eps.json")
+    f.unlink()  # the run opens the episode's own site: its error says so, in one line
+    with pytest.raises(SystemExit) as info:
+        main(["sim", "run", "--episodes", str(eps), "--out", str(tmp_path / "o")])
+    out, err = capsys.readouterr()
+    last = err.strip().splitlines()[-1]
+    assert info.value.code == 2 and "(cross_level), start on L" in out  # the site's run
+    assert last.startswith("pmnav: error: ") and "two.yaml" in last
