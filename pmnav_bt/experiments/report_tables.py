@@ -47,7 +47,9 @@ def tiers_present(results: Results) -> list[str]:
 
 def table1(results: Results) -> str:
     """SR/SPL per tier for the variants of Table 1 that ran, then the paper's rows."""
-    tiers = [t for t in TIER_NAMES if t in tiers_present(results)] or list(TIER_NAMES)
+    tiers = [t for t in TIER_NAMES if t in tiers_present(results)]
+    if not tiers:
+        return f"(no {', '.join(TIER_NAMES)} episodes in these results)"
     head = "| method | " + " | ".join(f"{t} SR | {t} SPL" for t in tiers) + " | runs |"
     lines = [head, "|---|" + "---|---|" * len(tiers) + "---|"]
     for name, rs in results.items():
