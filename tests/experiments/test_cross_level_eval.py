@@ -111,8 +111,8 @@ def test_the_cross_level_table_counts_rides_full_lifts_and_failures():
     assert cross_level_table({"coarse_only": results["coarse_only"]}) is None
 
 
-@pytest.mark.slow
 def test_an_oracle_cross_level_evaluation_on_hospital_2l(tmp_path):
+    # One ride in the clean world (about 15 s on an idle core): the site's run in evaluate.
     eps = generate_site_episodes("hospital_2l", 1, seed=0)
     rs = evaluate(eps, variant_configs(Config(), ["pmnav_oracle"]), jobs=1)
     (r,) = rs["pmnav_oracle"]
