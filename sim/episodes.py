@@ -218,6 +218,10 @@ def _in_limits(key: str, v: Any) -> bool:
 def _episode_from_dict(d: Any, where: str) -> tuple[Episode | None, list[Problem]]:
     if not isinstance(d, dict):
         return None, [Problem(where, f"expected an object, got {type(d).__name__}")]
+    if "site" in d:  # an episode across the levels of a site (tier cross_level)
+        from pmnav_bt.sim.site_episodes import site_episode_from_dict  # it imports this module
+
+        return site_episode_from_dict(d, where)
     problems = []
     known = {f.name for f in fields(Episode)}
     for k in d:

@@ -98,6 +98,7 @@ class SimLift:
         self.clock, self.rider, self.rng, self.full_p = clock, rider, rng, float(full_p)
         self.timing = timing
         self._cars: dict[str, _Car] = {}
+        self.full_calls = 0  # calls answered by a full cabin (an evaluation's "lift full met")
         clock.add_listener(self._advance)
 
     def add(self, lift: str, name: str, cabins: Mapping[str, Cabin], at: str) -> None:
@@ -123,6 +124,7 @@ class SimLift:
         now = self.clock.now()
         if call:
             car.full = bool(self.rng.random() < self.full_p)
+            self.full_calls += car.full
             delay = float(self.rng.uniform(0.0, self.timing.call_delay_s))
             car.phase, car.until = Phase.CALLED, now + delay
         elif car.phase == Phase.OPEN:

@@ -1,32 +1,37 @@
 """Episodes across levels (issue 40): a start on one level of a site, a goal room on
 another, reached by lift (the tier ``cross_level``).
 
-A ``SiteEpisode`` names its site (a site file or a built-in site), the start level and
+A ``SiteEpisode`` names its site (a built-in site by its name, so that an episode file
+travels to another machine as the one-level episodes of built-ins do; any other by its
+file's absolute path: ``site_ref``), the start level and
 pose (that level's map frame, on a corridor centre line, along the corridor), the goal
 room and its level. Its route is the ``SitePlan`` from the start (``planning/site_plan.py``):
 ``route_length`` is the corridor metres of its legs together, the rides not counted.
-Generation is seeded: the same site, n and seed give the same episodes.
+Generation is seeded: the same site, n and seed give the same episodes. They are written
+to and read from the episode file of ``sim/episodes.py`` beside the one-level episodes (an
+entry with a ``site`` key is a ``SiteEpisode``: ``site_episode_from_dict``).
 """
 
 from __future__ import annotations
 
 import math
 import zlib
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, fields
+from typing import Any
 
 import numpy as np
 
-from pmnav_bt.errors import PmNavError
+from pmnav_bt.errors import PmNavError, Problem
 from pmnav_bt.eval.task import action_budget
+from pmnav_bt.eval.tiers import CROSS_LEVEL
 from pmnav_bt.geometry import wrap_angle
-from pmnav_bt.map.site import Site, load_site
+from pmnav_bt.map.site import BUILTIN_SITES_DIR, Site, load_site
 from pmnav_bt.map.site_map import SiteMap, parse_site
 from pmnav_bt.planning.resolve import resolve_site_room, resolve_start
 from pmnav_bt.planning.site_plan import SitePlan, SitePlanner
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.sim.episodes import _candidates
 
-CROSS_LEVEL = "cross_level"  # the tier of an episode whose goal is on another level
 # The actions a lift ride adds to an episode's budget (eval/task.py's rule for the legs):
 # to the lobby, into the cabin, round, out, and on arrival a localization from scratch
 # (a panorama of 6-12 views and a fix, as at the start). One ride in hospital_2l's
@@ -56,6 +61,14 @@ class SiteEpisode:
     tier: str = CROSS_LEVEL
 
     @property
+    def building(self) -> str:
+        """The site, where an evaluation names an episode's building (its results' rows)."""
+        return self.site
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @property
     def start_pose(self) -> Pose2D:
         return Pose2D(self.start_x, self.start_y, self.start_yaw)
 
@@ -71,6 +84,61 @@ def site_map(site: str | Site) -> SiteMap:
     if len(s.levels) < 2:
         raise SiteEpisodeError(f"{s.name} has one level: its episodes are 'pmnav sim episodes'")
     return parse_site(s)
+
+
+def site_ref(s: Site) -> str:
+    """How an episode names its site: a built-in by its name, any other by its file."""
+    if s.path is None:
+        raise SiteEpisodeError(f"site {s.name} has no file: its episodes cannot name it")
+    path = s.path.resolve()
+    if path == (BUILTIN_SITES_DIR / f"{path.stem}.yaml").resolve():
+        return path.stem
+    return str(path)
+
+
+_TYPES: dict[str, tuple[type, ...]] = {
+    "id": (str,),
+    "site": (str,),
+    "start_level": (str,),
+    "start_x": (int, float),
+    "start_y": (int, float),
+    "start_yaw": (int, float),
+    "goal": (str,),
+    "goal_level": (str,),
+    "route_length": (int, float),
+    "seed": (int,),
+    "rides": (int,),
+    "tier": (str,),
+}
+
+
+def site_episode_from_dict(d: dict, where: str) -> tuple[SiteEpisode | None, list[Problem]]:
+    """A ``SiteEpisode`` from its entry in an episode file, or the entry's problems (an
+    unknown or missing key, a wrong type, a tier other than cross_level). The site itself
+    is opened when the episode runs."""
+    problems = [Problem(f"{where}.{k}", "unknown key") for k in d if k not in _TYPES]
+    for k, types in _TYPES.items():
+        if k not in d:
+            if k != "tier":
+                problems.append(Problem(f"{where}.{k}", "required key is missing"))
+            continue
+        v = d[k]
+        ok = isinstance(v, types) and not isinstance(v, bool)
+        if ok and isinstance(v, float) and not math.isfinite(v):
+            ok = False
+        if not ok:
+            want = " or ".join(t.__name__ for t in types)
+            problems.append(Problem(f"{where}.{k}", f"expected {want}, got {v!r:.60}"))
+    if not problems and d.get("tier", CROSS_LEVEL) != CROSS_LEVEL:
+        problems.append(Problem(f"{where}.tier", f"an episode with a site is {CROSS_LEVEL}"))
+    if not problems and (d["rides"] < 1 or d["route_length"] < 0):
+        problems.append(Problem(f"{where}.rides", "expected >= 1 ride, a route >= 0 m"))
+    if problems:
+        return None, problems
+    kw = {f.name: d[f.name] for f in fields(SiteEpisode) if f.name in d}
+    for k in ("start_x", "start_y", "start_yaw", "route_length"):
+        kw[k] = float(kw[k])
+    return SiteEpisode(**kw), []
 
 
 def site_plan(sm: SiteMap, ep: SiteEpisode) -> SitePlan:
@@ -111,7 +179,7 @@ def _episode(sm, ident, level, xy, yaw, goal_level, room, seed) -> SiteEpisode:
     plan = SitePlanner().plan(sm, level, pose, f"{goal_level}/{room}")
     return SiteEpisode(
         id=ident,
-        site=sm.site.name,
+        site=site_ref(sm.site),
         start_level=level,
         start_x=pose.x,
         start_y=pose.y,

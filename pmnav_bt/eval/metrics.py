@@ -107,6 +107,8 @@ class EpisodeResult:
     route_length: float = float("nan")  # corridor route (tiers and budget), metres
     error: str | None = None
     people_contacts: int | None = None
+    rides: int | None = None  # lift rides on the episode's route (cross_level); else None
+    lifts_full: int | None = None  # calls the lift answered full (cross_level); else None
 
     def to_dict(self, with_trace: bool = False) -> dict[str, Any]:
         d = asdict(self)

@@ -120,16 +120,22 @@ TIERS: dict[str, TierSpec] = {
     )
 }
 TIER_NAMES: tuple[str, ...] = tuple(TIERS)  # in display order
+# The tier of an episode whose goal is on another level of a site, reached by lift
+# (``sim/site_episodes.py``): judged by the levels, not by a route's length or shape, so it
+# is no TierSpec. Only a site of several levels poses it.
+CROSS_LEVEL = "cross_level"
+ALL_TIERS: tuple[str, ...] = (*TIER_NAMES, CROSS_LEVEL)
 
 
 def parse_tiers(text: str) -> list[str]:
-    """'all', one tier name or a comma-separated list -> tier names; ValueError if unknown."""
+    """'all', one tier name or a comma-separated list -> tier names; ValueError if unknown.
+    'all' includes cross_level: a one-level building simply poses none of it."""
     if text.strip() == "all":
-        return list(TIER_NAMES)
+        return list(ALL_TIERS)
     names = [t.strip() for t in text.split(",") if t.strip()]
-    bad = [t for t in names if t not in TIERS]
+    bad = [t for t in names if t not in ALL_TIERS]
     if bad or not names:
-        known = ", ".join(TIERS)
+        known = ", ".join(ALL_TIERS)
         raise ValueError(f"unknown tier {', '.join(bad) or text!r}: choose {known} or all")
     return names
 
@@ -157,5 +163,11 @@ def tier_definition(budget: str | None = None) -> str:
         f"Success: stop within {SUCCESS_RADIUS_M:g} m of the door point. SPL's shortest path: "
         "the free-space geodesic (corridors less the robot's radius, landmarks as obstacles) "
         "from the start to the success disc. " + (budget or budget_rule()),
+        f"- {CROSS_LEVEL}: a start on one level of a site, the goal room on another, reached "
+        "by lift (a site of several levels only). Success: stop within "
+        f"{SUCCESS_RADIUS_M:g} m of the door on the goal level. SPL's shortest path: each "
+        "leg's free-space geodesic (to the next lift's lobby, or the success disc) and the "
+        "drive into each cabin and out. Budget: the rule above on the legs' corridor metres, "
+        "and 100 actions a ride.",
     ]
     return "\n".join(lines)

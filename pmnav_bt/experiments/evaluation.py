@@ -260,16 +260,39 @@ def _plot(
 
 def episodes_for(buildings: Iterable[str], tiers: Iterable[str], n: int, seed: int):
     """Generated episodes per building and tier; tiers a building cannot pose are skipped
-    with a note."""
+    with a note. A site of several levels poses only cross_level (its one-level tiers are
+    skipped with a note); a one-level building poses no cross_level: with other tiers
+    asked for too (``--tier all``) it is skipped in silence, alone it is noted."""
+    from pmnav_bt.eval.tiers import CROSS_LEVEL
+    from pmnav_bt.experiments.site_run import site_of_levels
     from pmnav_bt.sim.episodes import EpisodeGenerationError, generate_episodes
+    from pmnav_bt.sim.site_episodes import generate_site_episodes
 
-    out, notes = [], []
+    tiers = list(tiers)
+    one_level_tiers = [t for t in tiers if t != CROSS_LEVEL]
+    out, notes, flat = [], [], []
     for b in buildings:
-        for tier in tiers:
+        if site_of_levels(b):
+            if one_level_tiers:
+                notes.append(
+                    f"{b} is a site of several levels: its episodes are {CROSS_LEVEL}, "
+                    f"not {', '.join(one_level_tiers)}"
+                )
+            if CROSS_LEVEL in tiers:
+                out += generate_site_episodes(b, n, seed=seed)
+            continue
+        if CROSS_LEVEL in tiers:
+            flat.append(b)
+        for tier in one_level_tiers:
             try:
                 out += generate_episodes(b, tier, n, seed=seed)
             except EpisodeGenerationError as err:
                 notes.append(str(err))
+    if flat and not one_level_tiers:
+        notes.append(
+            f"no {CROSS_LEVEL} episodes in {', '.join(flat)}: one level each (a site of "
+            "several levels, such as hospital_2l, poses them)"
+        )
     return out, notes
 
 
@@ -291,10 +314,16 @@ def _error_result(episode, error: str) -> EpisodeResult:
 def _run_one(args) -> dict:
     """One episode in a worker (pool process or Ray task); a crash becomes an errored
     result (counted apart from navigation failures), not a lost run."""
+    from pmnav_bt.experiments.site_run import run_site_episode
+    from pmnav_bt.sim.site_episodes import SiteEpisode
+
     episode, config_json = args
     config = Config.model_validate_json(config_json)
     try:
-        run = run_episode(episode, config, out_dir=None, plot=False)
+        if isinstance(episode, SiteEpisode):  # across levels: its own world per level
+            run = run_site_episode(episode, config)
+        else:
+            run = run_episode(episode, config, out_dir=None, plot=False)
     except Exception as err:  # noqa: BLE001 - reported in the results, with its type
         return _error_result(episode, f"{type(err).__name__}: {err}").to_dict()
     return run.result.to_dict()

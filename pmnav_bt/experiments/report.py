@@ -125,6 +125,20 @@ def render_report(folder: Path) -> Path:
         "",
         "![SR and SPL per tier](plots/sr_spl.png)",
         "",
+    ]
+    cross = T.cross_level_table(results)
+    if cross is not None:
+        lines += [
+            "## Across levels: start and goal on different levels, by lift",
+            "",
+            "Tier cross_level (sites of several levels): success is stopping within 1 m of "
+            "the door on the goal level. Rides: lift rides on the episodes' routes; lift "
+            "full met: calls the lift answered with a full cabin (`world.lift_full_p`).",
+            "",
+            cross,
+            "",
+        ]
+    lines += [
         "## Table 3: localization by landmark density, beside the paper",
         "",
     ]
@@ -258,13 +272,19 @@ def pick_trajectories(results: dict, k: int) -> list[tuple[str, str]]:
 
 def run_trajectories(out: Path, episodes: list, configs: dict, picks) -> None:
     from pmnav_bt.experiments.evaluation import run_episode
+    from pmnav_bt.experiments.site_run import run_site_episode
+    from pmnav_bt.sim.site_episodes import SiteEpisode
 
     by_id = {e.id: e for e in episodes}
     for name, eid in picks:
         folder = out / "trajectories" / name
         if list(folder.glob(f"{eid}*.png")):
             continue
-        run_episode(by_id[eid], configs[name], out_dir=folder)
+        ep = by_id[eid]
+        if isinstance(ep, SiteEpisode):  # a plot per level
+            run_site_episode(ep, configs[name], out_dir=folder)
+        else:
+            run_episode(ep, configs[name], out_dir=folder)
         for log in folder.glob("*.tree.jsonl"):
             log.unlink()  # the plot is what the report links; logs stay out of it
 

@@ -10,7 +10,7 @@ from collections import Counter
 
 from pmnav_bt.config import Config
 from pmnav_bt.eval.metrics import EpisodeResult, aggregate_by_tier, contact_totals
-from pmnav_bt.eval.tiers import TIER_NAMES
+from pmnav_bt.eval.tiers import CROSS_LEVEL, TIER_NAMES
 from pmnav_bt.experiments.variants import find_variant, variant_title
 
 # The paper's Table 1 (simulation): method -> tier -> (SR %, SPL %).
@@ -47,7 +47,9 @@ def tiers_present(results: Results) -> list[str]:
 
 def table1(results: Results) -> str:
     """SR/SPL per tier for the variants of Table 1 that ran, then the paper's rows."""
-    tiers = [t for t in TIER_NAMES if t in tiers_present(results)] or list(TIER_NAMES)
+    tiers = [t for t in TIER_NAMES if t in tiers_present(results)]
+    if not tiers:
+        return f"(no {', '.join(TIER_NAMES)} episodes in these results)"
     head = "| method | " + " | ".join(f"{t} SR | {t} SPL" for t in tiers) + " | runs |"
     lines = [head, "|---|" + "---|---|" * len(tiers) + "---|"]
     for name, rs in results.items():
@@ -140,6 +142,32 @@ def failures_table(results: Results) -> str:
     ]
     for n, cnt in counts.items():
         lines.append(f"| {variant_title(n)} | " + " | ".join(str(cnt[c]) for c in codes) + " |")
+    return "\n".join(lines)
+
+
+def cross_level_table(results: Results) -> str | None:
+    """The episodes across levels (tier cross_level), a row per variant: runs, SR and SPL
+    (%, over the runs that ran), the lift rides on their routes, the calls the lift
+    answered full ("lift full met") and the failure codes with their counts; None when no
+    result is of that tier."""
+    rows = {n: [r for r in rs if r.tier == CROSS_LEVEL] for n, rs in results.items()}
+    rows = {n: rs for n, rs in rows.items() if rs}
+    if not rows:
+        return None
+    lines = [
+        "| variant | runs | SR | SPL | rides | lift full met | failures |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for n, rs in rows.items():
+        ran = [r for r in rs if r.error is None]
+        sr, spl = tier_stats(rs).get(CROSS_LEVEL, (math.nan, math.nan, 0))[:2]
+        rides = sum(r.rides or 0 for r in ran)
+        full = sum(r.lifts_full or 0 for r in ran)
+        codes = Counter(c for r in rs if (c := failure_code(r)) is not None)
+        fails = ", ".join(f"{c} {k}" for c, k in sorted(codes.items())) or "none"
+        lines.append(
+            f"| {variant_title(n)} | {len(rs)} | {_cell(sr, spl)} | {rides} | {full} | {fails} |"
+        )
     return "\n".join(lines)
 
 

@@ -122,8 +122,10 @@ def _hold_gui(world) -> None:  # pragma: no cover - needs a display
 
 @app.command()
 def episodes(
-    building: str = typer.Argument(..., help="A building file or built-in name."),
-    tier: str = typer.Option("easy", "--tier", help="easy, medium, hard, a list, or all."),
+    building: str = typer.Argument(..., help="A building or site file, or a built-in name."),
+    tier: str = typer.Option(
+        "easy", "--tier", help="easy, medium, hard, cross_level (a site of levels), a list, or all."
+    ),
     n: int = typer.Option(20, "-n", min=1, help="Episodes per tier."),
     seed: int = typer.Option(0, "--seed"),
     out: Path | None = typer.Option(None, "--out", help="JSON file (default: standard output)."),
@@ -132,20 +134,18 @@ def episodes(
 
     The tier definitions go to standard error.
     """
-    from pmnav_bt.sim.episodes import (
-        episodes_json,
-        generate_episodes,
-        save_episodes,
-        tier_definition,
-    )
+    from pmnav_bt.experiments.evaluation import episodes_for
+    from pmnav_bt.sim.episodes import episodes_json, save_episodes, tier_definition
 
     cli_values.count(n, "-n")
     cli_values.seed(seed)
     if out is not None:
         check_output_file(out, "--out", (".json",))
-    eps = []
-    for t in tier_names(tier):
-        eps += generate_episodes(building, t, n, seed=seed)
+    eps, notes = episodes_for([building], tier_names(tier), n, seed)
+    if not eps:
+        raise PmNavError("; ".join(notes) or "no episodes")
+    for note in notes:
+        typer.echo(f"note: {note}", err=True)
     text = episodes_json(eps)
     typer.echo(tier_definition(), err=True)
     if out is None:
@@ -200,6 +200,7 @@ def run(
             return
     if episode_file is not None:
         from pmnav_bt.sim.episodes import episode_map, load_episodes
+        from pmnav_bt.sim.site_episodes import SiteEpisode
 
         if goal is not None or start is not None:
             raise PmNavError("--episodes runs a stored episode: drop --goal and --start")
@@ -207,6 +208,11 @@ def run(
         if not 0 <= index < len(eps):
             raise PmNavError(f"--index {index}: {episode_file} has {len(eps)} episodes")
         ep = eps[index]
+        if isinstance(ep, SiteEpisode):  # across levels: a world per level, a plot per level
+            from pmnav_bt.experiments.site_run import show_site_run
+
+            show_site_run(ep, cfg, out)
+            return
         episode_map(ep)  # a missing, changed or other building, a start outside: now
     elif goal is None:
         raise PmNavError("give --goal ROOM (or --episodes FILE --index N)")
@@ -339,7 +345,9 @@ def eval_(
         "functional:12 takes hospital, school and office in turn), or FAMILY_heldout:N (held-out "
         "members, for evaluation only: functional_heldout:12).",
     ),
-    tier: str = typer.Option("all", "--tier", help="easy, medium, hard, a list, or all."),
+    tier: str = typer.Option(
+        "all", "--tier", help="easy, medium, hard, cross_level (sites of levels), a list, or all."
+    ),
     n: int = typer.Option(20, "-n", min=1, help="Episodes per tier per building."),
     seed: int = typer.Option(0, "--seed"),
     variants: str = typer.Option(

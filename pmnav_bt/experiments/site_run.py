@@ -111,6 +111,7 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
             )  # fmt: skip
         final, level, stats = body.world_pose(), body.level, body.stats
         contacts = sum(w.people.contacts for w in worlds.values())
+        full_calls = lift.full_calls
         lift.close()
         body.close()
     finally:
@@ -140,6 +141,8 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
         soft_spl=float("nan") if not ok else soft_spl(shortest, 0.0, stats.path_length),
         distance_to_door=dist,
         route_length=ep.route_length,
+        rides=ep.rides,
+        lifts_full=full_calls,
     )
     plots: dict[str, Path] = {}
     if out_dir is not None:
@@ -221,10 +224,17 @@ def site_of_levels(name: str) -> bool:
 
 def run_site(name: str, goal: str, start: str | None, seed: int, config: Config, out: Path) -> None:
     """``pmnav sim run`` in a site of several levels: one episode to ``goal``, printed."""
+    from pmnav_bt.sim.site_episodes import custom_site_episode
+
+    show_site_run(custom_site_episode(name, goal, start, seed), config, out)
+
+
+def show_site_run(ep: SiteEpisode, config: Config, out: Path) -> None:
+    """Run one episode across levels (``pmnav sim run``: to a goal, or a stored one from
+    ``--episodes``) and print it."""
     import typer
 
     from pmnav_bt.registry import grounder_label
-    from pmnav_bt.sim.site_episodes import custom_site_episode
     from pmnav_bt.tree_variants import TREE_VARIANTS
 
     spec = TREE_VARIANTS.spec(config.tree.variant)
@@ -232,7 +242,6 @@ def run_site(name: str, goal: str, start: str | None, seed: int, config: Config,
         raise PmNavError(
             f"tree.variant {config.tree.variant} reads no map: it cannot plan across levels"
         )
-    ep = custom_site_episode(name, goal, start, seed)
     typer.echo(
         f"{spec.label} [{grounder_label(config.grounder.backend)}] in {ep.site}: {ep.id} "
         f"({ep.tier}), start on {ep.start_level} ({ep.start_x:.1f}, "
