@@ -36,6 +36,7 @@ from pmnav_bt.eval.tiers import (
     PathFacts,
     TierSpec,
     classify,
+    start_candidates,
     tier_definition,
     within,
 )
@@ -90,7 +91,6 @@ __all__ = [
     "tier_definition",
 ]
 
-_GRID_M = 0.05  # spacing of candidate start points along the centre lines
 
 EPISODES_SCHEMA_VERSION = 2
 
@@ -552,22 +552,6 @@ def _as_map(b: Building | PrioriMap | str | Path) -> tuple[PrioriMap, str, str]:
     return parse_building(open_building(path)), str(path), building_sha256(path)
 
 
-def _candidates(pm: PrioriMap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Start candidates on the centre lines: xy (N,2), segment index (N,), s along it (N,)."""
-    keys = np.array([n.pos for n in pm.key_waypoints], dtype=float)
-    xy, seg, ss = [], [], []
-    for k, sg in enumerate(pm.segments):
-        a, b = pm.node_xy(sg.a), pm.node_xy(sg.b)
-        s = np.arange(0.0, sg.length + 1e-9, _GRID_M)
-        p = a + (s / max(sg.length, 1e-9))[:, None] * (b - a)
-        clear = np.linalg.norm(p[:, None, :] - keys[None], axis=2).min(axis=1)
-        ok = clear >= START_CLEARANCE_M
-        xy.append(p[ok])
-        seg.append(np.full(int(ok.sum()), k))
-        ss.append(s[ok])
-    return np.concatenate(xy), np.concatenate(seg), np.concatenate(ss)
-
-
 def _structure_hint(pm: PrioriMap) -> str:
     kinds = [n.kind for n in pm.key_waypoints]
     cyc = len(nx.cycle_basis(pm.building.corridor_graph()))
@@ -594,7 +578,7 @@ def generate_episodes(
     pm, building_path, sha = _as_map(building)
     name = pm.building.name
     rng = np.random.default_rng([seed, zlib.crc32(name.encode()), list(TIERS).index(tier)])
-    xy, seg_idx, s_along = _candidates(pm)
+    xy, seg_idx, s_along = start_candidates(pm)
     lo, hi = spec.length_band
 
     # Per goal: the candidate starts whose length and route structure fit the tier.

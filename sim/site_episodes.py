@@ -23,14 +23,13 @@ import numpy as np
 
 from pmnav_bt.errors import PmNavError, Problem
 from pmnav_bt.eval.task import action_budget
-from pmnav_bt.eval.tiers import CROSS_LEVEL
+from pmnav_bt.eval.tiers import CROSS_LEVEL, start_candidates
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.map.site import BUILTIN_SITES_DIR, Site, load_site
 from pmnav_bt.map.site_map import SiteMap, parse_site
 from pmnav_bt.planning.resolve import resolve_site_room, resolve_start
 from pmnav_bt.planning.site_plan import SitePlan, SitePlanner
 from pmnav_bt.seams import Pose2D
-from pmnav_bt.sim.episodes import _candidates
 
 # The actions a lift ride adds to an episode's budget (eval/task.py's rule for the legs):
 # to the lobby, into the cabin, round, out, and on arrival a localization from scratch
@@ -209,7 +208,7 @@ def generate_site_episodes(site: str | Site, n: int, seed: int = 0) -> list[Site
         rooms = sorted(r.id for r in sm.maps[goal_level].building.rooms)
         room = rooms[int(rng.integers(len(rooms)))]
         pm = sm.maps[level]
-        xy, seg_idx, _ = _candidates(pm)
+        xy, seg_idx, _ = start_candidates(pm)
         i = int(rng.integers(len(xy)))
         seg = pm.segments[int(seg_idx[i])]
         yaw = wrap_angle(seg.heading + (math.pi if rng.random() < 0.5 else 0.0))

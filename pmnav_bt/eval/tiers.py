@@ -10,13 +10,38 @@ header of every result.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
 
 from pmnav_bt.eval.task import STOP_OFFSET_M, SUCCESS_RADIUS_M, budget_rule
+
+if TYPE_CHECKING:  # pragma: no cover
+    from pmnav_bt.map.priori_map import PrioriMap
 
 STEP_M = 1.0  # one paper "step" (RQ1 step counts fit moves of about a metre)
 VISIBLE_RANGE_M = 10.0  # a door sign is readable up to this distance
 VISIBLE_HALF_FOV_DEG = 25.0  # door centre within +-this of the start heading (60 deg camera)
 START_CLEARANCE_M = 1.5  # starts at least this far from any key waypoint (junction, end)
+START_GRID_M = 0.05  # spacing of candidate start points along the centre lines
+
+
+def start_candidates(pm: PrioriMap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where an episode may start: points on the corridor centre lines every
+    ``START_GRID_M``, at least ``START_CLEARANCE_M`` from every key waypoint. Returns their
+    xy (N, 2), segment index (N,) and distance along the segment (N,)."""
+    keys = np.array([n.pos for n in pm.key_waypoints], dtype=float)
+    xy, seg, ss = [], [], []
+    for k, sg in enumerate(pm.segments):
+        a, b = pm.node_xy(sg.a), pm.node_xy(sg.b)
+        s = np.arange(0.0, sg.length + 1e-9, START_GRID_M)
+        p = a + (s / max(sg.length, 1e-9))[:, None] * (b - a)
+        clear = np.linalg.norm(p[:, None, :] - keys[None], axis=2).min(axis=1)
+        ok = clear >= START_CLEARANCE_M
+        xy.append(p[ok])
+        seg.append(np.full(int(ok.sum()), k))
+        ss.append(s[ok])
+    return np.concatenate(xy), np.concatenate(seg), np.concatenate(ss)
 
 
 @dataclass(frozen=True)
