@@ -23,6 +23,7 @@ from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbn
 from pmnav_bt.behaviours.pose import keep_on_axis, measure_walls
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
+from pmnav_bt.hazards import body_hazards
 from pmnav_bt.map.wording import shut_way_words
 from pmnav_bt.perception.corner import band_reach, is_corner, is_open_way, mask_ratios
 from pmnav_bt.perception.geometry import free_distance
@@ -98,6 +99,7 @@ class DriveTo(PmNavBehaviour):
         self._bumps = 0
         self._watch_job = None
         self._watch_t = -math.inf
+        self._felt_t = -math.inf  # hazards the body felt since then go to the steering
         self._detour: tuple[float, float] | None = None  # a point round an obstacle
         self._detours = 0
         self._hold: Hold | None = None  # stopped for something in the way
@@ -172,12 +174,14 @@ class DriveTo(PmNavBehaviour):
                 self._watch_t = now
                 base, goal, target = self.ctx.base, self._aim(), self.get("target")
                 tf, clear, steer = self.get("map_T_odom"), self.ctx.detour_check, self.ctx.steering
-                before = self._last_frame
+                before, felt_since = self._last_frame, self._felt_t
+                self._felt_t = now
                 moving = self._hold is not None and self._hold.moving
 
                 def watch(cancelled):
                     obs = base.observe()
                     steer.sense(obs, now)
+                    steer.feel(body_hazards(base, since=felt_since), obs.pose, now)
                     est = map_pose(tf, obs.pose)
                     found = self.inspect(obs, est, target)
                     found["walls"] = measure_walls(self.ctx.grounder, obs)

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import threading
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -36,6 +37,7 @@ import numpy as np
 
 from pmnav_bt.control import Limits, goto_command
 from pmnav_bt.geometry import se2_apply, se2_inverse
+from pmnav_bt.hazards import Hazard, HazardKind
 from pmnav_bt.local_planner.costmap import LocalCostmap
 from pmnav_bt.local_planner.dwa import Dynamics, Navigation, choose, navigation, passable
 from pmnav_bt.registry import Named
@@ -49,12 +51,15 @@ STILL_M = 0.02  # frames this near each other were taken standing still
 SHUT_PROBE_M = 3.0  # how far along the way a shut way's distance is looked for
 
 Transform = tuple[float, float, float] | None  # map_T_odom (None: identity)
+MARKED_HAZARDS = frozenset({HazardKind.BUMP, HazardKind.CLIFF})  # felt where the thing is
 
 
 class Steering(Protocol):
     """The seam between a drive's goal and its wheels (see the module's docstring)."""
 
     def sense(self, obs: Observation, now: float) -> None: ...
+
+    def feel(self, hazards: Sequence[Hazard], pose: Pose2D, now: float) -> None: ...
 
     def movers(self, before: Observation, after: Observation) -> bool: ...
 
@@ -74,6 +79,9 @@ class DirectSteering:
 
     def sense(self, obs: Observation, now: float) -> None:
         return None
+
+    def feel(self, hazards: Sequence[Hazard], pose: Pose2D, now: float) -> None:
+        return None  # the body stops at a bump itself; nothing to remember
 
     def movers(self, before: Observation, after: Observation) -> bool:
         return True  # the drive stops at the first frame that shows something in the way
@@ -100,6 +108,15 @@ class LocalPlannerSteering:
 
     def sense(self, obs: Observation, now: float) -> None:
         self.costmap.add_depth(obs, now)
+
+    def feel(self, hazards: Sequence[Hazard], pose: Pose2D, now: float) -> None:
+        """Mark where the bumper touched something or a cliff sensor found the floor's
+        end (a wheel stall is felt at the wheels, not where the obstacle is), the window
+        round the robot's odometry ``pose`` (a body may feel with no depth frame)."""
+        points = [h.point for h in hazards if h.kind in MARKED_HAZARDS]
+        if points:
+            self.costmap.recentre(pose.x, pose.y)
+            self.costmap.mark(points, now)
 
     def movers(self, before: Observation, after: Observation) -> bool:
         """Only between frames from where the robot stood still (held, or stopped with no
