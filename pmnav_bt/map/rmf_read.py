@@ -53,11 +53,19 @@ class Link:
 
 @dataclass(frozen=True)
 class LiftDoor:
-    """A lift's door on this level: the lift, the door and the door's centre (metres)."""
+    """A lift's door on this level: the lift, the door and the door's centre (metres), and
+    the ``cabin``'s floor (four corners, metres): the shaft the door opens into, which is
+    no corridor (RMF's lanes run on into it, to the cabin's middle)."""
 
     lift: str
     door: str
     pos: tuple[float, float]
+    cabin: tuple[tuple[float, float], ...] = ()
+
+    @property
+    def along(self) -> np.ndarray:
+        """The direction of the wall the door is in (the cabin's width)."""
+        return np.subtract(self.cabin[1], self.cabin[0])
 
 
 @dataclass
@@ -263,6 +271,11 @@ def _lift_doors(lifts: Any, levels: dict, lvl: RmfLevel, src: str) -> list[LiftD
         cx, cy, yaw = (_number(lift.get(k), src, f"{f}.{k}") for k in ("x", "y", "yaw"))
         centre = np.array([cx * scale, -cy * scale])
         rot = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+        half = np.array([_number(lift.get(k), src, f"{f}.{k}") for k in ("width", "depth")]) / 2
+        cabin = tuple(
+            (float(q[0]), float(q[1]))
+            for q in (centre + rot @ (half * sx) for sx in ((-1, -1), (1, -1), (1, 1), (-1, 1)))
+        )
         doors = lift.get("doors") or {}
         names = served[lvl.name] if isinstance(served[lvl.name], list) else []
         for dname in names:
@@ -272,5 +285,5 @@ def _lift_doors(lifts: Any, levels: dict, lvl: RmfLevel, src: str) -> list[LiftD
             off = np.array([_number(d.get(k), src, f"{f}.doors.{dname}.{k}") for k in "xy"])
             pos = centre + rot @ off
             _check_extent(pos[None], src, f)
-            out.append(LiftDoor(str(name), str(dname), (float(pos[0]), float(pos[1]))))
+            out.append(LiftDoor(str(name), str(dname), (float(pos[0]), float(pos[1])), cabin))
     return out
