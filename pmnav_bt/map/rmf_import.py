@@ -41,7 +41,7 @@ from pmnav_bt.map.grid import largest_component
 from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
 from pmnav_bt.map.rmf_grid import level_grid, passage_doors
 from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
-from pmnav_bt.map.rmf_spurs import add_spur, turn_at_door
+from pmnav_bt.map.rmf_spurs import LIFT_PAST_M, PAST_M, add_spur, turn_at_door
 
 START_REACH_M = 3.0  # a dead end this near a charger or spawn point is the start
 MIN_DOOR_M = 0.3  # a door narrower than this is a drawing slip
@@ -254,12 +254,15 @@ def _add_spurs(
         return float(d[0] - cor.edges[j[0]][2] / 2.0 - DOOR_REACH_SLACK)
 
     slack = [DOOR_REACH_SLACK] * len(doors) + [LIFT_OFF_WALL_M] * len(lift_doors)
+    past = [PAST_M] * len(doors) + [LIFT_PAST_M] * len(lift_doors)
     doors = doors + lift_doors
-    added = sum(turn_at_door(cor, plan, free, c, along) for _, c, along in doors)
+    added = sum(
+        turn_at_door(cor, plan, free, c, along, past[k]) for k, (_, c, along) in enumerate(doors)
+    )
     far = sorted((gap(c) + DOOR_REACH_SLACK - slack[k], k) for k, (_, c, _) in enumerate(doors))
     for g, k in far:
         if g > 0 and gap(doors[k][1]) + DOOR_REACH_SLACK - slack[k] > 0:
-            added += add_spur(cor, plan, free, doors[k][1], doors[k][2])
+            added += add_spur(cor, plan, free, doors[k][1], doors[k][2], past[k])
     return added
 
 
