@@ -694,11 +694,14 @@ class SimWorld:
     def _occupy(self, wall: int, s: float, half: float) -> None:
         self._placer.occupy(wall, s, half)
 
-    def _snap(self, what: str, pt: tuple[float, float], half: float) -> tuple[int, float]:
+    def _snap(
+        self, what: str, pt: tuple[float, float], half: float, *, at_foot: bool = False
+    ) -> tuple[int, float]:
         """Wall and position along it for an item ``2*half`` wide nearest to ``pt`` (with
         grid walls, the real wall behind that place: ``_mount``); what does not fit there
-        is logged (``pmnav validate`` warns of the same, ``map.wall_items``)."""
-        placed = self._placer.place(what, pt, half)
+        is logged (``pmnav validate`` warns of the same, ``map.wall_items``). ``at_foot``:
+        a lift, hung at its point's foot (``WallPlacer.place``)."""
+        placed = self._placer.place(what, pt, half, at_foot=at_foot)
         for problem in placed.problems:
             log.warning("%s", problem)
         return self._mount(placed.wall, placed.s, half, pt), placed.s
@@ -866,7 +869,7 @@ class SimWorld:
     def _build_elevator(self, lm: Landmark, label: str) -> WallItem:
         fw = ELEVATOR_FRAME_M
         total = ELEVATOR.span_m  # the doors, their frame and the call-button panel beside it
-        wi, s = self._snap(landmark_item(lm.id), lm.pos, total / 2.0)
+        wi, s = self._snap(landmark_item(lm.id), lm.pos, total / 2.0, at_foot=True)
         s_door = s + ELEVATOR_PANEL_M / 2.0  # the call panel sits on the viewer's right (-s)
         half = ELEVATOR_WIDTH_M / 4.0
         leaves = self._elevator_leaves.setdefault(lm.id, [])

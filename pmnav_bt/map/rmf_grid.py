@@ -52,6 +52,10 @@ def level_grid(level: RmfLevel, open_doors: frozenset[int] = frozenset()) -> Flo
     for link in level.walls + doors:
         a, b = (tuple(int(round(v)) for v in px[k]) for k in (link.a, link.b))
         cv2.line(walls, a, b, 1, thick)
+    shafts = [np.array(d.cabin) for d in level.lift_doors if d.cabin]
+    if shafts:
+        cv2.polylines(walls, [np.rint(plan.world_to_pixel(c)).astype(np.int32) for c in shafts],
+                      True, 1, thick)
     inside = np.zeros((h, w), np.uint8)
     if level.floors:
         polys = [np.rint(px[f]).astype(np.int32) for f in level.floors if len(f) >= 3]

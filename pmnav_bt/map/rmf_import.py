@@ -41,11 +41,14 @@ from pmnav_bt.map.grid import largest_component
 from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
 from pmnav_bt.map.rmf_grid import level_grid, passage_doors
 from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
-from pmnav_bt.map.rmf_spurs import add_spur, turn_at_door
+from pmnav_bt.map.rmf_spurs import LIFT_PAST_M, PAST_M, add_spur, turn_at_door
 
 START_REACH_M = 3.0  # a dead end this near a charger or spawn point is the start
 MIN_DOOR_M = 0.3  # a door narrower than this is a drawing slip
 MAX_ID = 64  # the building format's id length
+# A lift door this far beyond its corridor's wall (half its width off the centre line) is
+# on the wall still (the corridors' widths are medians, the drawing's walls wander).
+LIFT_OFF_WALL_M = 0.1
 
 
 class RmfImportError(PmNavError):
@@ -87,7 +90,8 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
         )
     skipped = list(cor.skipped)
     doors = _doors(lvl, passages, skipped)
-    spurs = _add_spurs(cor, plan, free, doors)
+    lift_doors = [(ld, np.asarray(ld.pos), ld.along) for ld in lvl.lift_doors if ld.cabin]
+    spurs = _add_spurs(cor, plan, free, doors, lift_doors)
     ids: set[str] = set()
     names = _waypoint_names(cor, lvl, _entrances(lvl, plan), skipped, ids)
     seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
@@ -231,9 +235,17 @@ def _entrances(lvl: RmfLevel, plan: FloorPlanImage) -> list[np.ndarray]:
     return out
 
 
-def _add_spurs(cor: Corridors, plan: FloorPlanImage, free: np.ndarray, doors: list) -> int:
+def _add_spurs(
+    cor: Corridors, plan: FloorPlanImage, free: np.ndarray, doors: list, lift_doors: list
+) -> int:
     """Turns in front of the doors a dead end runs into, then spurs to the doors beyond
-    reach of every centre line, nearest first; how many of both."""
+    reach of every centre line, nearest first; how many of both.
+
+    A lift's door gets its spur (its lobby) unless it is on a corridor's wall already:
+    the simulator hangs the lift's doors and frame (``ELEVATOR.span_m``) centred on the
+    wall at the door, with its cabin behind, so a lift door a little off the wall (a
+    corridor narrower in the drawing's centre-line model than at the lift, or a lane run
+    on into the cabin) would hang elsewhere, where its shaft is not."""
 
     def gap(centre) -> float:
         seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
@@ -241,11 +253,16 @@ def _add_spurs(cor: Corridors, plan: FloorPlanImage, free: np.ndarray, doors: li
         j, _, d = project_points_to_segments(np.asarray(centre)[None], seg_a, seg_b)
         return float(d[0] - cor.edges[j[0]][2] / 2.0 - DOOR_REACH_SLACK)
 
-    added = sum(turn_at_door(cor, plan, free, c, along) for _, c, along in doors)
-    far = sorted((gap(c), k) for k, (_, c, _) in enumerate(doors))
+    slack = [DOOR_REACH_SLACK] * len(doors) + [LIFT_OFF_WALL_M] * len(lift_doors)
+    past = [PAST_M] * len(doors) + [LIFT_PAST_M] * len(lift_doors)
+    doors = doors + lift_doors
+    added = sum(
+        turn_at_door(cor, plan, free, c, along, past[k]) for k, (_, c, along) in enumerate(doors)
+    )
+    far = sorted((gap(c) + DOOR_REACH_SLACK - slack[k], k) for k, (_, c, _) in enumerate(doors))
     for g, k in far:
-        if g > 0 and gap(doors[k][1]) > 0:
-            added += add_spur(cor, plan, free, doors[k][1], doors[k][2])
+        if g > 0 and gap(doors[k][1]) + DOOR_REACH_SLACK - slack[k] > 0:
+            added += add_spur(cor, plan, free, doors[k][1], doors[k][2], past[k])
     return added
 
 

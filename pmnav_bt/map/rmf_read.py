@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from shapely.geometry import Point, Polygon
 
 from pmnav_bt.loading import InputFileError, load_yaml
 
@@ -53,11 +54,19 @@ class Link:
 
 @dataclass(frozen=True)
 class LiftDoor:
-    """A lift's door on this level: the lift, the door and the door's centre (metres)."""
+    """A lift's door on this level: the lift, the door and the door's centre (metres), and
+    the ``cabin``'s floor (four corners, metres): the shaft the door opens into, which is
+    no corridor (RMF's lanes run on into it, to the cabin's middle)."""
 
     lift: str
     door: str
     pos: tuple[float, float]
+    cabin: tuple[tuple[float, float], ...] = ()
+
+    @property
+    def along(self) -> np.ndarray:
+        """The direction of the wall the door is in (the cabin's width)."""
+        return np.subtract(self.cabin[1], self.cabin[0])
 
 
 @dataclass
@@ -129,7 +138,17 @@ def read_level(path: str | Path, level: str | None = None) -> RmfLevel:
         links["lanes"], floors, fname if isinstance(fname, str) and fname else None,
     )
     lvl.lift_doors = _lift_doors(data.get("lifts"), levels, lvl, src)
+    lvl.lanes = _lanes_off_cabins(lvl)
     return lvl
+
+
+def _lanes_off_cabins(lvl: RmfLevel) -> list:
+    """The level's lanes less those with an end in a lift's cabin: RMF runs a lane on
+    through a lift's door to the cabin's middle for the ride, which is no corridor (kept,
+    it would make one into the lift's shaft, and the door would be at its dead end)."""
+    cabins = [Polygon(d.cabin) for d in lvl.lift_doors if d.cabin]
+    inside = {k for k, q in enumerate(lvl.xy) if any(c.contains(Point(q)) for c in cabins)}
+    return [ln for ln in lvl.lanes if ln.a not in inside and ln.b not in inside]
 
 
 # -- checks ---------------------------------------------------------------------------
@@ -263,6 +282,11 @@ def _lift_doors(lifts: Any, levels: dict, lvl: RmfLevel, src: str) -> list[LiftD
         cx, cy, yaw = (_number(lift.get(k), src, f"{f}.{k}") for k in ("x", "y", "yaw"))
         centre = np.array([cx * scale, -cy * scale])
         rot = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+        cabin: tuple[tuple[float, float], ...] = ()
+        if "width" in lift and "depth" in lift:  # the cabin's size, metres
+            half = np.array([_number(lift[k], src, f"{f}.{k}") for k in ("width", "depth")]) / 2
+            corners = (centre + rot @ (half * sx) for sx in ((-1, -1), (1, -1), (1, 1), (-1, 1)))
+            cabin = tuple((float(q[0]), float(q[1])) for q in corners)
         doors = lift.get("doors") or {}
         names = served[lvl.name] if isinstance(served[lvl.name], list) else []
         for dname in names:
@@ -272,5 +296,5 @@ def _lift_doors(lifts: Any, levels: dict, lvl: RmfLevel, src: str) -> list[LiftD
             off = np.array([_number(d.get(k), src, f"{f}.doors.{dname}.{k}") for k in "xy"])
             pos = centre + rot @ off
             _check_extent(pos[None], src, f)
-            out.append(LiftDoor(str(name), str(dname), (float(pos[0]), float(pos[1]))))
+            out.append(LiftDoor(str(name), str(dname), (float(pos[0]), float(pos[1])), cabin))
     return out

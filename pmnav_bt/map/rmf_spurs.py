@@ -18,17 +18,26 @@ import numpy as np
 
 from pmnav_bt.geometry import project_points_to_segments
 from pmnav_bt.map.floorplan import FloorPlanImage
+from pmnav_bt.map.landmark_kinds import ELEVATOR
 from pmnav_bt.map.rmf_corridors import MIN_EDGE_M, Corridors
 
 SPUR_HALF_M = 0.9  # the spur's centre line runs this far in front of the door's wall
 SPUR_MAX_M = 12.0  # a door farther than this along its wall from the network gets no spur
 PAST_M = 0.6  # the spur ends this far past the door's centre
+# ... a lift's: its doors, frame and call panel (ELEVATOR.span_m) and the spur's square
+# end (half its width) stand on a straight wall, clear of the spur's bend
+LIFT_PAST_M = ELEVATOR.span_m / 2.0 + SPUR_HALF_M
 COLLINEAR_M = 0.1  # a ray this near an earlier spur's line continues that spur
 END_ON_COS = 0.7  # a dead end within 45 deg of a door's normal runs into the door
 
 
 def add_spur(
-    cor: Corridors, plan: FloorPlanImage, free: np.ndarray, door: np.ndarray, along: np.ndarray
+    cor: Corridors,
+    plan: FloorPlanImage,
+    free: np.ndarray,
+    door: np.ndarray,
+    along: np.ndarray,
+    past: float = PAST_M,
 ) -> bool:
     """Add a spur to the door centred at ``door`` in a wall running along ``along``.
 
@@ -47,13 +56,13 @@ def add_spur(
             if hit is None:
                 continue
             dist, k, foot = hit
-            end = front - way * along * PAST_M
+            end = front - way * along * past
             if not _clear(plan, free, foot, end):
                 continue
             if best is None or dist < best[0]:
                 best = (dist, k, foot, end)
     if best is None:
-        return _add_bent_spur(cor, plan, free, door, along, normal)
+        return _add_bent_spur(cor, plan, free, door, along, normal, past)
     _, k, foot, end = best
     if np.linalg.norm(end - foot) < MIN_EDGE_M:
         return False
@@ -65,7 +74,12 @@ def add_spur(
 
 
 def turn_at_door(
-    cor: Corridors, plan: FloorPlanImage, free: np.ndarray, door: np.ndarray, along: np.ndarray
+    cor: Corridors,
+    plan: FloorPlanImage,
+    free: np.ndarray,
+    door: np.ndarray,
+    along: np.ndarray,
+    past: float = PAST_M,
 ) -> bool:
     """A dead end that runs into the door (a lane cut where it went through it) stops
     half a spur width in front of the door's wall and turns along it to just past the
@@ -90,7 +104,7 @@ def turn_at_door(
     stop = float(np.dot(cor.pos[other] - front, normal) / np.dot(axis, -normal))
     knee = cor.pos[other] + axis * stop
     way = along if np.dot(front - knee, along) >= 0 else -along
-    tip = front + way * PAST_M
+    tip = front + way * past
     if stop < MIN_EDGE_M or not _clear(plan, free, knee, tip):
         return False
     cor.pos[end] = knee
@@ -100,7 +114,7 @@ def turn_at_door(
     return True
 
 
-def _add_bent_spur(cor, plan, free, door, along, normal) -> bool:
+def _add_bent_spur(cor, plan, free, door, along, normal, past) -> bool:
     """Where no straight spur fits: from the nearest point of the network straight to just
     before the door (in front of its wall), then along the wall to just past it."""
     seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
@@ -110,7 +124,7 @@ def _add_bent_spur(cor, plan, free, door, along, normal) -> bool:
         j, t, d = project_points_to_segments(front[None], seg_a, seg_b)
         foot = seg_a[j[0]] + t[0] * (seg_b[j[0]] - seg_a[j[0]])
         way = 1.0 if np.dot(front - foot, along) < 0 else -1.0  # the knee nearer the network
-        knee, end = front + way * along * PAST_M, front - way * along * PAST_M
+        knee, end = front + way * along * past, front - way * along * past
         if not (d[0] <= SPUR_MAX_M and plan.mask_at(free, front[None])[0]
                 and _clear(plan, free, foot, knee) and _clear(plan, free, knee, end)
                 and np.linalg.norm(knee - foot) >= MIN_EDGE_M):

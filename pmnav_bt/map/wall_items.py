@@ -31,7 +31,7 @@ from pmnav_bt.errors import Problem
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.floorplan import DOOR_WIDTH_M
 from pmnav_bt.map.free_space import free_space_polygon, free_space_rings
-from pmnav_bt.map.landmark_kinds import landmark_shape
+from pmnav_bt.map.landmark_kinds import ELEVATOR, landmark_shape
 
 DOOR_FRAME_M = 0.08  # a door frame's width each side of the leaf
 DOOR_SPAN_M = DOOR_WIDTH_M + 2 * DOOR_FRAME_M  # the wall a door takes, with its frame
@@ -137,10 +137,16 @@ class WallPlacer:
         """Make ``wall`` (a real wall an item on ``like`` hangs on) share its stretches."""
         self._taken[wall] = self._taken.setdefault(like, [])
 
-    def place(self, what: str, pt: Sequence[float], half: float) -> Placement:
+    def place(
+        self, what: str, pt: Sequence[float], half: float, *, at_foot: bool = False
+    ) -> Placement:
         """Hang ``what`` (``2 * half`` wide) on the wall nearest ``pt``: centred at the
         foot of ``pt`` and kept within the wall's ends (on a wall too short for it,
-        centred on the wall), its stretch taken, and what is wrong there."""
+        centred on the wall), its stretch taken, and what is wrong there.
+
+        ``at_foot`` keeps it at the foot even where it then sticks out past an end: a
+        lift, whose doorway and cabin are where the drawing has its door, whatever the
+        corridors' walls round it."""
         wi, s = self.nearest(pt)
         w = self.walls[wi]
         where = "({:.2f}, {:.2f})".format(*w.point(w.length / 2.0))
@@ -151,9 +157,15 @@ class WallPlacer:
                 f"{where}) is {w.length:.2f} m long: it sticks out past the wall's ends; "
                 "move it to a longer wall"
             )
-            s = w.length / 2.0
-        else:
+            s = s if at_foot else w.length / 2.0
+        elif not at_foot:
             s = float(np.clip(s, half, w.length - half))
+        elif not half <= s <= w.length - half:
+            out = max(half - s, s + half - w.length)
+            problems.append(
+                f"{what} at ({w.point(s)[0]:.2f}, {w.point(s)[1]:.2f}) sticks out {out:.2f} m "
+                "past its wall's end (it hangs where its point is); give it a straight wall"
+            )
         other = self._clash(wi, s - half, s + half)
         if other is not None:
             at = "({:.2f}, {:.2f})".format(*w.point(s))
@@ -177,7 +189,9 @@ def wall_item_warnings(b: Building) -> list[Problem]:
         (f"landmarks[{i}].pos", landmark_item(lm.id), lm.pos, landmark_shape(lm.kind).span_m / 2)
         for i, lm in enumerate(b.landmarks)
     ]
+    lifts = {landmark_item(lm.id) for lm in b.landmarks if landmark_shape(lm.kind) is ELEVATOR}
     out = []
     for field, what, pos, half in items:
-        out += [Problem(field, m) for m in placer.place(what, pos, half).problems]
+        placed = placer.place(what, pos, half, at_foot=what in lifts)
+        out += [Problem(field, m) for m in placed.problems]
     return out

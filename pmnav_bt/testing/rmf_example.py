@@ -88,3 +88,29 @@ def example_rmf_two_levels() -> dict:
         }
     }
     return data
+
+
+def example_rmf_lane_into_lift() -> dict:
+    """The two-level example with its lift drawn as RMF drawings often have one: the
+    cabin (2.5 x 3 m) floored and walled on three sides, the corridor's south wall open
+    at its door, and a lane on through the door to the cabin's middle (where a robot
+    rides)."""
+    data = example_rmf_two_levels()
+    data["lifts"]["lift_a"].update(width=2.5, depth=3.0)
+    x = round(LIFT_DOOR[0] / SCALE_M_PER_PX)  # the door's column; the south wall is row 160
+    for lvl in data["levels"].values():
+        v, n = lvl["vertices"], len(lvl["vertices"])
+        v += [[x - 30, 160, 0, ""], [x + 30, 160, 0, ""]]  # n, n+1: the opening
+        v += [[x - 25, 160, 0, ""], [x - 25, 220, 0, ""], [x + 25, 220, 0, ""]]  # n+2..n+4
+        v += [[x + 25, 160, 0, ""], [x, 120, 0, ""], [x, 190, 0, ""]]  # n+5..n+7
+        wall = lvl["walls"][0][2]
+        lvl["walls"] = [w for w in lvl["walls"] if w[:2] != [4, 5]] + [
+            [4, n + 1, wall], [n, 5, wall], [n + 2, n + 3, wall], [n + 3, n + 4, wall],
+            [n + 4, n + 5, wall],
+        ]
+        lvl["floors"].append({"vertices": [n + 2, n + 3, n + 4, n + 5], "parameters": {}})
+        lane = lvl["lanes"][0][2]
+        lvl["lanes"] = [ln for ln in lvl["lanes"] if ln[:2] != [12, 11]] + [
+            [12, n + 6, lane], [n + 6, 11, lane], [n + 6, n + 7, lane],
+        ]
+    return data

@@ -8,14 +8,18 @@ import yaml
 
 from pmnav_bt.experiments.cli import main
 from pmnav_bt.map.catalogue import load_building
+from pmnav_bt.map.free_space import free_space_polygon
+from pmnav_bt.map.landmark_kinds import ELEVATOR
 from pmnav_bt.map.rmf_import import RmfImportError
 from pmnav_bt.map.rmf_site import import_rmf_site
 from pmnav_bt.map.site import read_site_file
 from pmnav_bt.map.site_map import parse_site
+from pmnav_bt.map.wall_items import WallPlacer, annotated_walls, landmark_item
 from pmnav_bt.planning.site_plan import SitePlanner
 from pmnav_bt.testing.rmf_example import (
     LIFT_DOOR,
     example_rmf,
+    example_rmf_lane_into_lift,
     example_rmf_two_levels,
     write_example_rmf,
 )
@@ -103,3 +107,33 @@ def test_the_rmf_clinic_imports_as_a_site_of_two_levels(rmf_maps, tmp_path, caps
     room = sm.maps["L2"].building.rooms[0].id
     p = SitePlanner().plan(sm, "L1", "start", f"L2/{room}")
     assert len(p.rides) == 1 and p.legs[-1].plan.goal == room
+
+
+def lift_walls(site) -> list[tuple[str, str, float, tuple[str, ...]]]:
+    """(level, lift, distance from its point to the wall it hangs on, what is wrong there)
+    for every lift lobby of ``site``, hung as the simulator hangs it."""
+    out = []
+    for lift in site.lifts:
+        for level, lobby in lift.lobbies.items():
+            b = site.level(level).building
+            walls = annotated_walls(free_space_polygon(b))
+            lm = b.landmark(lobby)
+            placed = WallPlacer(walls).place(
+                landmark_item(lobby), lm.pos, ELEVATOR.span_m / 2.0, at_foot=True
+            )
+            foot = walls[placed.wall].point(placed.s)
+            gap = float(((foot[0] - lm.pos[0]) ** 2 + (foot[1] - lm.pos[1]) ** 2) ** 0.5)
+            out.append((level, lift.id, gap, placed.problems))
+    return out
+
+
+def test_a_lane_on_into_the_lift_leaves_its_door_on_a_straight_corridor_wall(tmp_path):
+    """RMF lanes run on through a lift's door to its cabin's middle; the cabin is the
+    lift's shaft, not a corridor, so the lift's doors and frame hang on the corridor's
+    wall at the drawing's door, with wall enough either side (no notch of a corridor
+    run into the shaft)."""
+    rmf = write_example_rmf(tmp_path, example_rmf_lane_into_lift())
+    site = import_rmf_site(rmf, tmp_path / "site.yaml").site
+    for level, lift, gap, problems in lift_walls(site):
+        assert gap < 0.2 and problems == (), (level, lift, gap, problems)
+
