@@ -23,6 +23,7 @@ JUNCTION_CLEARANCE = 2.5  # no door closer than this to a junction
 # A lift or stairs is slid along its wall in these steps until no door hangs through it;
 # a door takes its leaf and a frame each side (pmnav_bt/map/wall_items.DOOR_SPAN_M).
 LANDMARK_SLIDE_M = 0.25
+LANDMARK_CORNER_M = 0.5  # the wall left between the corner and a lift's (or stairs') end
 DOOR_CLEARANCE_M = DOOR_WIDTH_M / 2.0 + 0.1
 
 
@@ -30,7 +31,8 @@ def _landmark_spot(
     g: nx.Graph, pos: dict, junction, corridor_width: float, span: float, rooms: list[dict]
 ) -> list[float]:
     """Where a lift or stairs ``span`` wide goes at ``junction``: on the right-hand wall of
-    a corridor leaving it (the one going +y where there is one), just past the corner, slid
+    a corridor leaving it (the one going +y where there is one), its end just past the
+    corner (it hangs where its point is: past the corner it would stick out), slid
     along that wall away from the junction until no door hangs through it."""
     x, y = pos[junction]
     ways = sorted(
@@ -47,7 +49,7 @@ def _landmark_spot(
         for r in rooms
         if abs((r["door"][0] - wall[0]) * uy - (r["door"][1] - wall[1]) * ux) < 1e-6
     ]
-    s = corridor_width / 2.0 + 0.5
+    s = corridor_width / 2.0 + span / 2.0 + LANDMARK_CORNER_M  # clear of the corner
     while any(abs(d - s) < reach for d in along):
         s += LANDMARK_SLIDE_M
     return [round(wall[0] + ux * s, 3), round(wall[1] + uy * s, 3)]
