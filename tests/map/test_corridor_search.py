@@ -49,8 +49,11 @@ def test_a_search_never_crosses_a_blocked_segment_and_stops_at_its_targets(level
     way = search.path(far)[::-1]
     assert way[0] == source
     assert all(graph.edges[a, b]["segment"] not in blocked for a, b in pairwise(way))
+    # an open search stops once it has its target: it does not settle the whole level
     near = min((n for n in want if n != source), key=want.get)
-    assert CorridorSearch(level, {source: (0.0, 0.0)}).run({near}).dist.keys() < want.keys()
+    reached = CorridorSearch(level, {source: (0.0, 0.0)}).run({near}).dist
+    assert reached[near] <= want[near] + 1e-9  # open ways are never longer
+    assert len(reached) < graph.number_of_nodes()
 
 
 def test_the_site_map_keeps_each_lobby_tree():
