@@ -116,9 +116,8 @@ def validate(
     try:
         b = open_building(file)
     except BuildingFileError as err:
-        for line in err.lines():
+        for line in err.listing():
             typer.echo(line, err=True)
-        typer.echo(f"{len(err.problems)} problem(s)", err=True)
         raise typer.Exit(1) from None
     pm = parse_building(b)
     typer.echo(

@@ -44,6 +44,10 @@ class BuildingFileError(PmNavError):
         """Every problem, one line each, prefixed by the file."""
         return [f"{self.path}: {p}" for p in self.problems]
 
+    def listing(self) -> list[str]:
+        """What ``pmnav validate`` prints: every problem's line, then their count."""
+        return [*self.lines(), f"{len(self.problems)} problem(s)"]
+
 
 class UnknownNameError(PmNavError):
     """A room, landmark, segment or waypoint name that is unknown or ambiguous."""

@@ -52,9 +52,8 @@ def validate_site(file: str, strict: bool, level: str | None) -> None:
     try:
         site = open_site(file)
     except BuildingFileError as err:
-        for line in err.lines():
+        for line in err.listing():
             typer.echo(line, err=True)
-        typer.echo(f"{len(err.problems)} problem(s)", err=True)
         raise typer.Exit(1) from None
     sm = parse_site(site)
     names = [site.level(level).name] if level is not None else list(site.level_names)
