@@ -411,6 +411,15 @@ class PmNavController:
         from pmnav_bt.hardware import qos
 
         p, sensor, ev, latched = self.params, qos.sensor(), qos.events(), qos.latched()
+        lifts = []
+        if self.lift is not None:  # what was asked of the lifts and what they said
+            from pmnav_bt.hardware import rmf_lift
+
+            request, state = rmf_lift.messages()
+            lifts = [
+                (rmf_lift.REQUESTS_TOPIC, request, qos.lift_requests()),
+                (rmf_lift.STATES_TOPIC, state, qos.lift_states()),
+            ]
         return [
             (p["image_topic"], Image, sensor),
             (p["camera_info_topic"], CameraInfo, sensor),
@@ -425,6 +434,7 @@ class PmNavController:
             ("tree/structure", String, latched),
             ("result", String, ev),
             ("/diagnostics", DiagnosticArray, ev),
+            *lifts,
         ]
 
     # -- goals -------------------------------------------------------------------------------

@@ -27,8 +27,17 @@ from pmnav_bt.hardware.env import ros_env
 class Proc:
     """A node started as ``python -m module --ros-args ...``, output to a log file."""
 
-    def __init__(self, module: str, params: dict, domain_id: int, log: Path, name: str = ""):
-        args = [sys.executable, "-m", module, "--ros-args"]
+    def __init__(
+        self,
+        module: str,
+        params: dict,
+        domain_id: int,
+        log: Path,
+        name: str = "",
+        options: tuple[str, ...] = (),
+    ):
+        """``options`` go before ``--ros-args`` (the node's own, as ``--record FILE``)."""
+        args = [sys.executable, "-m", module, *options, "--ros-args"]
         for k, v in params.items():
             if isinstance(v, bool):
                 v = "true" if v else "false"

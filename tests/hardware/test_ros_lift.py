@@ -113,10 +113,15 @@ def test_ride_and_session_conflict_over_dds(lifts):
 
 def test_pmnav_ros_hears_the_lifts_with_the_lifts_parameter(domain_id, tmp_path, probe):
     """``pmnav-ros -p lifts:=true`` runs the lift client: its status says what each lift
-    of the simulated two-level hospital said on /lift_states."""
+    of the simulated two-level hospital said on /lift_states, and ``--record`` keeps those
+    states in the run's MCAP file beside the robot's own topics."""
+    from mcap_ros2.reader import read_ros2_messages
+
+    record = tmp_path / "run.mcap"
     sim = Proc("pmnav_bt.hardware.sim_lift_node", dict(site="hospital_2l"), domain_id,
                tmp_path / "sim_lift.log")  # fmt: skip
-    ctl = Proc("pmnav_bt.hardware.node", {"lifts": True}, domain_id, tmp_path / "pmnav.log")
+    ctl = Proc("pmnav_bt.hardware.node", {"lifts": True}, domain_id, tmp_path / "pmnav.log",
+               options=("--record", str(record)))  # fmt: skip
     try:
         st = probe.wait_for(
             lambda: (probe.status or {}).get("lifts", {}).get(LIFT), 90.0, "lift1 in the status",
@@ -124,8 +129,11 @@ def test_pmnav_ros_hears_the_lifts_with_the_lifts_parameter(domain_id, tmp_path,
         )  # fmt: skip
         assert st == "at L1, to L1, door closed, stopped, session none"
     finally:
-        ctl.stop()
+        ctl.stop(timeout=15.0)
         sim.stop()
+    states = [m.ros_msg for m in read_ros2_messages(str(record), topics=["/lift_states"])]
+    assert {s.lift_name for s in states} >= {"lift1", "lift2"}, ctl.tail()
+    assert all(s.current_floor == "L1" for s in states if s.lift_name == LIFT)
 
 
 def test_states_and_requests_carry_rmf_fields(ros_required):
