@@ -289,3 +289,57 @@ def test_an_alcove_goes_unless_it_points_at_another_dead_end():
     assert prune_alcoves(alone, dist, 3.0) == 1 and "A" not in alone
     broken = graph(True)
     assert prune_alcoves(broken, dist, 3.0) == 0 and "A" in broken
+
+
+def _greyed_grid(tmp_path, free_thresh: float):
+    """A walled 28 m corridor whose north wall is missing for 10 m, where map_saver's
+    never-seen grey (205) lies beyond, 7.6 m deep: a room the scanner never entered."""
+    import cv2
+
+    res, (w, h) = 0.05, (680, 320)
+    img = np.full((h, w), 205, np.uint8)
+    corridor = np.zeros((h, w), np.uint8)
+    corridor[h - 88 : h - 40, 40:600] = 1  # x 2..30 m, y 2..4.4 m
+    img[cv2.dilate(corridor, np.ones((5, 5), np.uint8)) > 0] = 0
+    img[h - 240 : h - 85, 200:400] = 205  # x 10..20 m, y 4.25..12 m: no wall, never seen
+    img[corridor > 0] = 254
+    plan = FloorPlanImage(img, res, (0.0, 0.0, 0.0), free_thresh=free_thresh)
+    return save_ros_map(plan, tmp_path / f"g{free_thresh}.yaml")
+
+
+def test_never_seen_grey_read_as_free_is_no_floor_for_the_draft(tmp_path):
+    from pmnav_bt.map.grid import free_mask, never_seen_free
+
+    # map_server with free_thresh 0.25 (the hospital's) reads the grey free: the corridor
+    # and the room never entered make one wide space.
+    loose = load_ros_map(_greyed_grid(tmp_path, 0.25))
+    assert free_mask(loose)[100, 300] and never_seen_free(loose)[100, 300]
+    assert not free_mask(loose, seen_only=True)[100, 300]
+    b, _, _ = draft_building(_greyed_grid(tmp_path, 0.25), tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert all(w.pos[1] < 4.4 for w in b.waypoints), [w.pos for w in b.waypoints]
+    # With map_saver's own threshold the grey is unknown already: nothing to leave out.
+    strict = load_ros_map(_greyed_grid(tmp_path, 0.196))
+    assert not never_seen_free(strict).any()
+    # A map drawn all in that grey (no lighter free cell) is left as it reads.
+    flat = FloorPlanImage(np.full((40, 60), 205, np.uint8), 0.1, (0.0, 0.0, 0.0), free_thresh=0.25)
+    assert not never_seen_free(flat).any()
+
+
+def test_a_waypoint_moves_to_its_corridors_crossing_only_along_free_space():
+    import networkx as nx
+
+    from pmnav_bt.map.draft import _place_nodes
+
+    # Two corridors meet at J, drafted 1 m short of where their lines cross, (0, 0):
+    # J moves there, unless the way there is walled (a room's skeleton bending
+    # whose lines cross beyond its wall).
+    h = nx.Graph([("J", "A"), ("J", "B")])
+    world = {"J": np.array([1.0, 0.0]), "A": np.array([10.0, 0.0]), "B": np.array([0.0, 10.0])}
+    lines = {}
+    for m, c, d in (("A", (5.0, 0.0), (1.0, 0.0)), ("B", (0.0, 5.0), (0.0, 1.0))):
+        lines[("J", m)] = lines[(m, "J")] = (np.array(c), np.array(d))
+    moved = _place_nodes(h, world, lines, lambda a, b: True)
+    assert np.allclose(moved["J"], (0.0, 0.0), atol=1e-6)
+    kept = _place_nodes(h, world, lines, lambda a, b: False)
+    assert np.allclose(kept["J"], (1.0, 0.0))
