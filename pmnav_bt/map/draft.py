@@ -891,6 +891,10 @@ def draft_source(
             raise DraftError(f"{option} must be a positive number{unit}, not {v!r}")
     if (knobs or {}).get("wall_min", 0.0) > 1.0:
         raise DraftError(f"--wall-min is a share of a border, 0 to 1, not {knobs['wall_min']!r}")
+    if (knobs or {}).get("lined_min", 0.0) > 1.0:
+        raise DraftError(
+            f"--lined-min is a share of a corridor's sides, 0 to 1, not {knobs['lined_min']!r}"
+        )
     params = DraftParams(**(knobs or {}))
     if source.suffix.lower() in (".yaml", ".yml"):
         if scale is not None or scale_from is not None:

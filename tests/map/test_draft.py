@@ -252,15 +252,17 @@ def test_walls_saved_as_grey_likelihoods_are_seen_and_unknown_is_not():
     assert seen_mask(FloorPlanImage(img, 0.1, (0.0, 0.0, 0.0))).sum() == 60 * 40 - 20 * 40
 
 
-def test_map_draft_wall_min_is_a_share(tmp_path, capsys):
+@pytest.mark.parametrize(
+    "option, says",
+    [("--wall-min", "a share of a border, 0 to 1"), ("--lined-min", "a share of a corridor's")],
+)
+def test_map_draft_shares_are_shares(tmp_path, capsys, option, says):
     from pmnav_bt.cli import main
 
     grid = _grid(tmp_path, [(2, 2, 30, 4.4)])
     with pytest.raises(SystemExit) as ex:
-        main(["map", "draft", str(grid), "-o", str(tmp_path / "b.yaml"), "--wall-min", "2"])
-    assert ex.value.code == 2 and "--wall-min is a share of a border, 0 to 1" in (
-        capsys.readouterr().err
-    )
+        main(["map", "draft", str(grid), "-o", str(tmp_path / "b.yaml"), option, "2"])
+    assert ex.value.code == 2 and f"{option} is {says}" in capsys.readouterr().err
 
 
 def test_an_alcove_goes_unless_it_points_at_another_dead_end():
