@@ -755,7 +755,8 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
                 continue  # the mouth of a corridor meeting this one, not a door
             xy = [round(float(x), 2) for x in door]
             rooms.append({"id": f"room{len(rooms) + 1}", "door": xy})
-    rooms = _reachable_doors(rooms, edges, {names[n]: pos[n] for n in h.nodes})
+    # Judged from the waypoints as written (rounded to 1 cm), as the building file checks.
+    rooms = _reachable_doors(rooms, edges, {w["id"]: np.array(w["pos"]) for w in waypoints})
     return Draft(waypoints, edges, rooms, open_areas, warnings, free, corridor, skel)
 
 

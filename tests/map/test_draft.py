@@ -345,3 +345,15 @@ def test_a_waypoint_moves_to_its_corridors_crossing_only_along_free_space():
     assert np.allclose(moved["J"], (0.0, 0.0), atol=1e-6)
     kept = _place_nodes(h, world, lines, lambda a, b: False)
     assert np.allclose(kept["J"], (1.0, 0.0))
+
+
+def test_the_draft_of_the_rmf_office_walls_grid_loads(rmf_maps, tmp_path):
+    from pmnav_bt.map.rmf_import import import_rmf, write_import
+
+    # The draft kept a door 1.4996 m from its corridor (reachable: at most 1.50 m) that
+    # its own file, with the waypoints rounded to 1 cm, put 1.51 m away: an error
+    # instead of a draft.
+    out = tmp_path / "office.yaml"
+    write_import(import_rmf(rmf_maps / "office" / "office.building.yaml", out, None), out)
+    b, _, _ = draft_building(tmp_path / "office_walls.yaml", tmp_path / "draft.yaml")
+    assert len(b.edges) >= 5 and b.rooms
