@@ -28,6 +28,7 @@ WALL_TOL_M = 0.25
 # Rays look this many times the piece's median half width (and at least 1 m) for a wall:
 # a wall farther than that is across a room, not the corridor's.
 REACH = 3.0
+SAMPLE_M = 0.2  # one look square to the line every this far along it
 
 
 def lined_share(path: np.ndarray, space: np.ndarray, dist: np.ndarray, res: float) -> float:
@@ -46,7 +47,8 @@ def lined_share(path: np.ndarray, space: np.ndarray, dist: np.ndarray, res: floa
     u = vt[0]
     t = (path - c) @ u
     lo, hi = float(t.min()) + half, float(t.max()) - half
-    ts = np.arange(lo, hi + 1e-9, 1.0) if hi > lo else np.array([(t.min() + t.max()) / 2.0])
+    step = max(1.0, SAMPLE_M / res)
+    ts = np.arange(lo, hi + 1e-9, step) if hi > lo else np.array([(t.min() + t.max()) / 2.0])
     normal = np.array([-u[1], u[0]])
     reach = max(REACH * half, 1.0 / res)
     steps = np.arange(1.0, reach + 1.0)

@@ -25,9 +25,10 @@ def free_mask(
     ``seen_only`` leaves out the cells map_saver marks never seen that a loose
     ``free_thresh`` reads free (``never_seen_free``).
     """
-    free = plan.occupancy() == 0
+    occupancy = plan.occupancy()
+    free = occupancy == 0
     if seen_only:
-        free &= ~never_seen_free(plan)
+        free &= ~never_seen_free(plan, occupancy)
     free = free.astype(np.uint8)
     k = max(1, round(clean_m / plan.resolution))
     if k > 1:
@@ -45,7 +46,7 @@ def free_mask(
     return free
 
 
-def never_seen_free(plan: FloorPlanImage) -> np.ndarray:
+def never_seen_free(plan: FloorPlanImage, occupancy: np.ndarray | None = None) -> np.ndarray:
     """Cells in map_saver's never-seen grey that the map's thresholds read as free.
 
     map_saver saves unknown cells as ``NEVER_SEEN_SHADE``, which its default
@@ -53,9 +54,10 @@ def never_seen_free(plan: FloorPlanImage) -> np.ndarray:
     hospital's 0.25) reads the rooms the scanner never entered as free floor, and a
     corridor beside them as part of a hall. Only where the map also has lighter free
     cells (what was seen free): a map drawn all in that grey is left as it reads.
+    ``occupancy``: the plan's, when already computed.
     """
     grey = plan.grey().round()
-    free = plan.occupancy() == 0
+    free = (plan.occupancy() if occupancy is None else occupancy) == 0
     shade = free & (grey == NEVER_SEEN_SHADE)
     if not shade.any() or not (free & (grey > NEVER_SEEN_SHADE)).any():
         return np.zeros(free.shape, bool)
