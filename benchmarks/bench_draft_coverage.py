@@ -10,6 +10,10 @@ validate a generated building of 100 m x 100 m (target: under 30 s on 2 cores).
 
 Maps not in the repository (the RMF drawings, the CCIA university floor) are read from
 ../shared/maps or $PMNAV_SHARED_MAPS and left out, with a line saying so, when absent.
+The RMF buildings are drafted twice: from their drawings, and from the walls grid
+``pmnav map import-rmf`` writes (``*-walls`` rows), which is measured against the
+building's robot lanes as imported (not a hand annotation: lanes run along most
+corridors, but not all, and some run through halls).
 ``--images DIR`` writes DIR/draft_<map>_coverage.png: the grid, the annotation in red,
 the draft in blue.
 """
@@ -25,13 +29,15 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from shapely.geometry import LineString
 
 from pmnav_bt.map.building import save_building
 from pmnav_bt.map.checks import building_warnings
 from pmnav_bt.map.draft import draft_building, draft_drawing
-from pmnav_bt.map.draft_coverage import load_annotation, measure
+from pmnav_bt.map.draft_coverage import Annotation, load_annotation, measure
 from pmnav_bt.map.floorplan import load_floor_plan, rasterize_building, save_ros_map
 from pmnav_bt.map.generate import generate_building
+from pmnav_bt.map.rmf_import import import_rmf, write_import
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "map" / "data"
@@ -51,6 +57,20 @@ MAPS = {
     "clinic": (_shared() / "rmf/clinic/clinic.png", 0.7 / 26.001, None),
     "office": (_shared() / "rmf/office/office.png", 20.089 / 2374.04, None),
 }
+
+
+# name: (RMF building file, level or None): drafted from the walls grid import-rmf writes
+RMF_WALLS = {
+    "clinic-L1-walls": (_shared() / "rmf/clinic/clinic.building.yaml", "L1"),
+    "clinic-L2-walls": (_shared() / "rmf/clinic/clinic.building.yaml", "L2"),
+    "office-walls": (_shared() / "rmf/office/office.building.yaml", None),
+}
+
+
+def _lanes(b) -> Annotation:
+    """An imported RMF building's corridors (its lanes) as an annotation, no open areas."""
+    pos = {w.id: w.pos for w in b.waypoints}
+    return Annotation("", [LineString([pos[e.a], pos[e.b]]) for e in b.edges], [])
 
 
 def _draw(b, base: Path, ann, path: Path) -> None:
@@ -73,11 +93,20 @@ def _draw(b, base: Path, ann, path: Path) -> None:
 
 
 def _one(name: str, images: Path | None, tmp: Path) -> str:
-    src, scale, ann_path = MAPS[name]
+    if name in RMF_WALLS:
+        src, level = RMF_WALLS[name]
+    else:
+        src, scale, ann_path = MAPS[name]
     if not src.is_file():
-        return f"{name:9s} left out: {src} is absent"
+        return f"{name:15s} left out: {src} is absent"
     out = tmp / name / "building.yaml"
     out.parent.mkdir(parents=True, exist_ok=True)
+    ann = None
+    if name in RMF_WALLS:
+        imp = import_rmf(src, tmp / name / "imported.yaml", level)
+        write_import(imp, tmp / name / "imported.yaml")
+        ann = _lanes(imp.building)
+        src, scale = tmp / name / "imported_walls.yaml", None
     t = time.perf_counter()
     if scale is None:
         b, d, text = draft_building(src, out)
@@ -85,11 +114,12 @@ def _one(name: str, images: Path | None, tmp: Path) -> str:
         b, d, text = draft_drawing(src, out, scale)
     secs = time.perf_counter() - t
     out.write_text(text, encoding="utf-8")
-    ann = load_annotation(ann_path) if ann_path and ann_path.is_file() else None
+    if name not in RMF_WALLS and ann_path and ann_path.is_file():
+        ann = load_annotation(ann_path)
     if images is not None:
         _draw(b, out.parent, ann, images / f"draft_{name}_coverage.png")
     length = sum(math.dist(b.waypoint(e.a).pos, b.waypoint(e.b).pos) for e in b.edges)
-    row = f"{name:9s} {len(b.waypoints):5d} {len(b.edges):5d} {length:8.0f} "
+    row = f"{name:15s} {len(b.waypoints):5d} {len(b.edges):5d} {length:8.0f} "
     if ann is None:
         return row + f"{'-':>8s} {'-':>8s} {'-':>8s} {secs:6.1f}"
     m = measure(b, ann)
@@ -119,11 +149,12 @@ def _big(tmp: Path, side_m: float) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--maps", nargs="+", default=list(MAPS), choices=list(MAPS))
+    names = [*MAPS, *RMF_WALLS]
+    ap.add_argument("--maps", nargs="+", default=names, choices=names)
     ap.add_argument("--images", type=Path, help="write draft_<map>_coverage.png here")
     ap.add_argument("--side", type=float, default=100.0, help="size of the timed building (m)")
     args = ap.parse_args()
-    print(f"{'map':9s} {'wps':>5s} {'edges':>5s} {'drafted':>8s} {'annot.':>8s} "
+    print(f"{'map':15s} {'wps':>5s} {'edges':>5s} {'drafted':>8s} {'annot.':>8s} "
           f"{'cover':>8s} {'spur.':>8s} {'s':>6s}")
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.maps:

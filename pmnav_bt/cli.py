@@ -184,6 +184,9 @@ def map_draft(
     wall_min: float | None = typer.Option(
         None, help="A dead end with less of its border wall (not unknown) is a laser fan (0-1)."
     ),
+    lined_min: float | None = typer.Option(
+        None, help="A loop or dead end with less of its sides lined by parallel walls goes (0-1)."
+    ),
     clutter: float | None = typer.Option(None, help="Obstacles this small (m) are filled."),
 ) -> None:
     """Draft a building file from an occupancy grid or a drawing ('pmnav map draft SRC -o FILE')."""
@@ -201,6 +204,7 @@ def map_draft(
             ("corridor_ratio", corridor_ratio),
             ("link_max_m", link_max),
             ("wall_min", wall_min),
+            ("lined_min", lined_min),
             ("clutter_m", clutter),
         )
         if v is not None

@@ -56,7 +56,8 @@ from pmnav_bt.map.building import (
     building_from_data,
 )
 from pmnav_bt.map.corridor_space import SpaceParams, corridor_space
-from pmnav_bt.map.draft_links import hall_hubs, link_parts
+from pmnav_bt.map.corridor_walls import cut_unlined_loops, edge_share
+from pmnav_bt.map.draft_links import free_along, hall_hubs, link_parts
 from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map, save_ros_map
 from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask, seen_mask
 
@@ -98,6 +99,9 @@ class DraftParams:
     room_widening: float = 1.5  # a dead end this many times wider behind its mouth is a room
     # A dead end with less of its border wall (the rest never seen) is a laser fan.
     wall_min: float = 0.3
+    # A corridor on a loop, or a dead end, with less of its sides lined by walls parallel
+    # to it is a way through a room or a fan, not a corridor (corridor_walls.py).
+    lined_min: float = 0.5
 
     def space(self) -> SpaceParams:
         return SpaceParams(
@@ -464,6 +468,28 @@ def prune_fans(
     return _prune_dead_ends(h, lambda _nodes, path: _wall_share(path, dist, seen, free) < wall_min)
 
 
+def prune_unlined(
+    h: nx.Graph, space: np.ndarray, dist: np.ndarray, res: float, lined_min: float
+) -> int:
+    """Remove what no two parallel walls line: ways through rooms, round furniture, up fans.
+
+    A corridor runs between two walls parallel to it (``corridor_walls.lined_share``).
+    First the corridors on loops whose share is under ``lined_min`` go
+    (``cut_unlined_loops``); then every dead end whose length-weighted share is under
+    it, repeated until none goes. Returns how many went (loop corridors and dead ends).
+    """
+    gone = cut_unlined_loops(h, space, dist, res, lined_min)
+
+    def goes(nodes: list, _path: np.ndarray) -> bool:
+        junction = next(m for m in h.neighbors(nodes[-1]) if m not in nodes)
+        edges = list(zip(nodes, [*nodes[1:], junction], strict=True))
+        lengths = [len(h.edges[e]["path"]) for e in edges]
+        shares = [edge_share(h, a, b, space, dist, res) for a, b in edges]
+        return float(np.average(shares, weights=lengths)) < lined_min
+
+    return gone + _prune_dead_ends(h, goes)
+
+
 def _wall_share(path: np.ndarray, dist: np.ndarray, seen: np.ndarray, free: np.ndarray) -> float:
     """The share of seen cells among the non-free cells bordering a centre line's space."""
     rc = np.clip(path.round().astype(int), 0, np.array(dist.shape) - 1)
@@ -555,8 +581,14 @@ def _fit_lines(h: nx.Graph, world: dict, dist_m: dict) -> dict:
     return lines
 
 
-def _place_nodes(h: nx.Graph, world: dict, lines: dict) -> dict:
-    """Each key waypoint at the least-squares crossing of its corridors' centre lines."""
+def _place_nodes(
+    h: nx.Graph, world: dict, lines: dict, free_way: Callable[[np.ndarray, np.ndarray], bool]
+) -> dict:
+    """Each key waypoint at the least-squares crossing of its corridors' centre lines.
+
+    ``free_way(a, b)`` says whether the straight way between two map points is free: a
+    waypoint moves to its crossing only along one.
+    """
     out = {}
     for n in h.nodes:
         ls = [lines[(n, m)] for m in h.neighbors(n)]
@@ -577,7 +609,9 @@ def _place_nodes(h: nx.Graph, world: dict, lines: dict) -> dict:
                 a += m
                 b += m @ c
             p = np.linalg.solve(a, b)
-            out[n] = p if np.linalg.norm(p - p0) < 3.0 else p0
+            # Not farther than 3 m, and never through a wall (a room's skeleton bends
+            # whose lines cross beyond the room's wall).
+            out[n] = p if np.linalg.norm(p - p0) < 3.0 and free_way(p0, p) else p0
         else:  # an end, or nearly straight: project onto the lines
             out[n] = np.mean([c + d * np.dot(p0 - c, d) for c, d in ls], axis=0)
     return out
@@ -635,7 +669,7 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
     res = plan.resolution
     if abs(plan.origin[2]) > 1e-9:
         raise DraftError(f"{plan.source}: origin yaw must be 0 for a draft (got {plan.origin[2]})")
-    free = free_mask(plan, params.clean_m, params.clutter_m)
+    free = free_mask(plan, params.clean_m, params.clutter_m, seen_only=True)
     if not free.any():
         raise DraftError(f"{plan.source}: the grid has no free cells")
     corridor, _ = corridor_space(free, res, params.space())
@@ -659,6 +693,7 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
     prune_room_spurs(h, dist, res, params.room_widening)
     prune_alcoves(h, dist, params.corridor_ratio)
     prune_fans(h, dist, seen_mask(plan), free, params.wall_min)
+    prune_unlined(h, corridor, dist, res, params.lined_min)
     hall_hubs(h, open_mask, free, dist)
     warnings = []
     for rc, n_px in link_parts(h, free, params.link_max_m / res):
@@ -682,7 +717,11 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
         rc = d["path"].round().astype(int)
         d["half"] = (dist[rc[:, 0], rc[:, 1]] - 0.5) * res
     lines = _fit_lines(h, world, half)
-    pos = _place_nodes(h, world, lines)
+    def free_way(a: np.ndarray, b: np.ndarray) -> bool:
+        rc = plan.world_to_pixel(np.array([a, b]))[:, ::-1]
+        return free_along(free, rc[0], rc[1])
+
+    pos = _place_nodes(h, world, lines, free_way)
 
     # Widths from the distance transform along the fitted centre line, as the robot drives it.
     widths = {}
@@ -716,7 +755,8 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
                 continue  # the mouth of a corridor meeting this one, not a door
             xy = [round(float(x), 2) for x in door]
             rooms.append({"id": f"room{len(rooms) + 1}", "door": xy})
-    rooms = _reachable_doors(rooms, edges, {names[n]: pos[n] for n in h.nodes})
+    # Judged from the waypoints as written (rounded to 1 cm), as the building file checks.
+    rooms = _reachable_doors(rooms, edges, {w["id"]: np.array(w["pos"]) for w in waypoints})
     return Draft(waypoints, edges, rooms, open_areas, warnings, free, corridor, skel)
 
 
@@ -852,6 +892,10 @@ def draft_source(
             raise DraftError(f"{option} must be a positive number{unit}, not {v!r}")
     if (knobs or {}).get("wall_min", 0.0) > 1.0:
         raise DraftError(f"--wall-min is a share of a border, 0 to 1, not {knobs['wall_min']!r}")
+    if (knobs or {}).get("lined_min", 0.0) > 1.0:
+        raise DraftError(
+            f"--lined-min is a share of a corridor's sides, 0 to 1, not {knobs['lined_min']!r}"
+        )
     params = DraftParams(**(knobs or {}))
     if source.suffix.lower() in (".yaml", ".yml"):
         if scale is not None or scale_from is not None:

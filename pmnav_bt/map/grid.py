@@ -9,13 +9,27 @@ from pmnav_bt.map.floorplan import FloorPlanImage
 
 CLEAN_M = 0.1  # close free-space holes smaller than this (laser speckle)
 CLUTTER_M = 1.25  # fill obstacles no longer than this in free space (bins, desks)
+# map_saver writes every cell it never saw in this grey (occupancy 0.196, its default
+# free_thresh, so that map_server reads it unknown).
+NEVER_SEEN_SHADE = 205
 
 
 def free_mask(
-    plan: FloorPlanImage, clean_m: float = CLEAN_M, clutter_m: float = CLUTTER_M
+    plan: FloorPlanImage,
+    clean_m: float = CLEAN_M,
+    clutter_m: float = CLUTTER_M,
+    seen_only: bool = False,
 ) -> np.ndarray:
-    """map_server's free cells (bool, rows as in the image), specks closed, largest part only."""
-    free = (plan.occupancy() == 0).astype(np.uint8)
+    """map_server's free cells (bool, rows as in the image), specks closed, largest part only.
+
+    ``seen_only`` leaves out the cells map_saver marks never seen that a loose
+    ``free_thresh`` reads free (``never_seen_free``).
+    """
+    occupancy = plan.occupancy()
+    free = occupancy == 0
+    if seen_only:
+        free &= ~never_seen_free(plan, occupancy)
+    free = free.astype(np.uint8)
     k = max(1, round(clean_m / plan.resolution))
     if k > 1:
         free = cv2.morphologyEx(free, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
@@ -30,6 +44,24 @@ def free_mask(
         if inside and max(bw, bh) <= small:
             free[lab == i] = True
     return free
+
+
+def never_seen_free(plan: FloorPlanImage, occupancy: np.ndarray | None = None) -> np.ndarray:
+    """Cells in map_saver's never-seen grey that the map's thresholds read as free.
+
+    map_saver saves unknown cells as ``NEVER_SEEN_SHADE``, which its default
+    ``free_thresh`` (0.196) reads unknown; a map published with a looser one (the
+    hospital's 0.25) reads the rooms the scanner never entered as free floor, and a
+    corridor beside them as part of a hall. Only where the map also has lighter free
+    cells (what was seen free): a map drawn all in that grey is left as it reads.
+    ``occupancy``: the plan's, when already computed.
+    """
+    grey = plan.grey().round()
+    free = (plan.occupancy() if occupancy is None else occupancy) == 0
+    shade = free & (grey == NEVER_SEEN_SHADE)
+    if not shade.any() or not (free & (grey > NEVER_SEEN_SHADE)).any():
+        return np.zeros(free.shape, bool)
+    return shade
 
 
 def seen_mask(plan: FloorPlanImage) -> np.ndarray:

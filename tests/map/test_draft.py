@@ -252,15 +252,17 @@ def test_walls_saved_as_grey_likelihoods_are_seen_and_unknown_is_not():
     assert seen_mask(FloorPlanImage(img, 0.1, (0.0, 0.0, 0.0))).sum() == 60 * 40 - 20 * 40
 
 
-def test_map_draft_wall_min_is_a_share(tmp_path, capsys):
+@pytest.mark.parametrize(
+    "option, says",
+    [("--wall-min", "a share of a border, 0 to 1"), ("--lined-min", "a share of a corridor's")],
+)
+def test_map_draft_shares_are_shares(tmp_path, capsys, option, says):
     from pmnav_bt.cli import main
 
     grid = _grid(tmp_path, [(2, 2, 30, 4.4)])
     with pytest.raises(SystemExit) as ex:
-        main(["map", "draft", str(grid), "-o", str(tmp_path / "b.yaml"), "--wall-min", "2"])
-    assert ex.value.code == 2 and "--wall-min is a share of a border, 0 to 1" in (
-        capsys.readouterr().err
-    )
+        main(["map", "draft", str(grid), "-o", str(tmp_path / "b.yaml"), option, "2"])
+    assert ex.value.code == 2 and f"{option} is {says}" in capsys.readouterr().err
 
 
 def test_an_alcove_goes_unless_it_points_at_another_dead_end():
@@ -289,3 +291,69 @@ def test_an_alcove_goes_unless_it_points_at_another_dead_end():
     assert prune_alcoves(alone, dist, 3.0) == 1 and "A" not in alone
     broken = graph(True)
     assert prune_alcoves(broken, dist, 3.0) == 0 and "A" in broken
+
+
+def _greyed_grid(tmp_path, free_thresh: float):
+    """A walled 28 m corridor whose north wall is missing for 10 m, where map_saver's
+    never-seen grey (205) lies beyond, 7.6 m deep: a room the scanner never entered."""
+    import cv2
+
+    res, (w, h) = 0.05, (680, 320)
+    img = np.full((h, w), 205, np.uint8)
+    corridor = np.zeros((h, w), np.uint8)
+    corridor[h - 88 : h - 40, 40:600] = 1  # x 2..30 m, y 2..4.4 m
+    img[cv2.dilate(corridor, np.ones((5, 5), np.uint8)) > 0] = 0
+    img[h - 240 : h - 85, 200:400] = 205  # x 10..20 m, y 4.25..12 m: no wall, never seen
+    img[corridor > 0] = 254
+    plan = FloorPlanImage(img, res, (0.0, 0.0, 0.0), free_thresh=free_thresh)
+    return save_ros_map(plan, tmp_path / f"g{free_thresh}.yaml")
+
+
+def test_never_seen_grey_read_as_free_is_no_floor_for_the_draft(tmp_path):
+    from pmnav_bt.map.grid import free_mask, never_seen_free
+
+    # map_server with free_thresh 0.25 (the hospital's) reads the grey free: the corridor
+    # and the room never entered make one wide space.
+    loose = load_ros_map(_greyed_grid(tmp_path, 0.25))
+    assert free_mask(loose)[100, 300] and never_seen_free(loose)[100, 300]
+    assert not free_mask(loose, seen_only=True)[100, 300]
+    b, _, _ = draft_building(_greyed_grid(tmp_path, 0.25), tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert all(w.pos[1] < 4.4 for w in b.waypoints), [w.pos for w in b.waypoints]
+    # With map_saver's own threshold the grey is unknown already: nothing to leave out.
+    strict = load_ros_map(_greyed_grid(tmp_path, 0.196))
+    assert not never_seen_free(strict).any()
+    # A map drawn all in that grey (no lighter free cell) is left as it reads.
+    flat = FloorPlanImage(np.full((40, 60), 205, np.uint8), 0.1, (0.0, 0.0, 0.0), free_thresh=0.25)
+    assert not never_seen_free(flat).any()
+
+
+def test_a_waypoint_moves_to_its_corridors_crossing_only_along_free_space():
+    import networkx as nx
+
+    from pmnav_bt.map.draft import _place_nodes
+
+    # Two corridors meet at J, drafted 1 m short of where their lines cross, (0, 0):
+    # J moves there, unless the way there is walled (a room's skeleton bending
+    # whose lines cross beyond its wall).
+    h = nx.Graph([("J", "A"), ("J", "B")])
+    world = {"J": np.array([1.0, 0.0]), "A": np.array([10.0, 0.0]), "B": np.array([0.0, 10.0])}
+    lines = {}
+    for m, c, d in (("A", (5.0, 0.0), (1.0, 0.0)), ("B", (0.0, 5.0), (0.0, 1.0))):
+        lines[("J", m)] = lines[(m, "J")] = (np.array(c), np.array(d))
+    moved = _place_nodes(h, world, lines, lambda a, b: True)
+    assert np.allclose(moved["J"], (0.0, 0.0), atol=1e-6)
+    kept = _place_nodes(h, world, lines, lambda a, b: False)
+    assert np.allclose(kept["J"], (1.0, 0.0))
+
+
+def test_the_draft_of_the_rmf_office_walls_grid_loads(rmf_maps, tmp_path):
+    from pmnav_bt.map.rmf_import import import_rmf, write_import
+
+    # The draft kept a door 1.4996 m from its corridor (reachable: at most 1.50 m) that
+    # its own file, with the waypoints rounded to 1 cm, put 1.51 m away: an error
+    # instead of a draft.
+    out = tmp_path / "office.yaml"
+    write_import(import_rmf(rmf_maps / "office" / "office.building.yaml", out, None), out)
+    b, _, _ = draft_building(tmp_path / "office_walls.yaml", tmp_path / "draft.yaml")
+    assert len(b.edges) >= 5 and b.rooms
