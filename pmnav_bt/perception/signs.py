@@ -13,6 +13,7 @@ models also read Chinese).
 from __future__ import annotations
 
 import functools
+import math
 import threading
 from dataclasses import dataclass, replace
 
@@ -27,6 +28,8 @@ Box = tuple[float, float, float, float]  # x0, y0, x1, y1 (pixels)
 LINE_PX = 32.0  # text-line height the detector sees after upscaling a crop
 MIN_LINE_PX = 5  # lines lower than this in the frame cannot be read: not candidates
 PAD_LINES = 0.8  # crop padding around a plate candidate, in line heights
+INK_CONTRAST = 40  # text differs from its plate by at least this much (largest RGB channel)
+LINE_PER_CAP = 1.3  # a text line's height over a character's
 
 
 @dataclass(frozen=True)
@@ -137,6 +140,43 @@ def join_characters(
         else:
             out.append([b, 1 if char_like(b) else 0, b])
     return [(g[0], max(1, g[1])) for g in out]
+
+
+def ink_line_height(crop: np.ndarray, box: Box) -> float | None:
+    """The text-line height (pixels) the characters inside ``box`` of ``crop`` measure,
+    whatever their colour and the plate's: None where none stand apart.
+
+    The candidate finder's line height is a guess where text and plate close into one
+    blob (a coloured plate's border is as strong an edge as its text): the blob is taken
+    for one line, and a plate of three lines is shrunk three times too small to read.
+    Here the plate's own colour is the median of the box; ink is what differs from it
+    (Otsu's threshold on the largest channel difference, either polarity); characters
+    are ink components that do not touch the box's edge (the plate's border and its
+    backing do) and are taller than wide at most 4 times (not rules or frames). A text
+    line is about 1.3 times their median height: the capitals' for numbers, nearer the
+    lower case's for names (an estimate too small costs only a larger upscale; one too
+    large makes the text unreadable)."""
+    x0, y0 = max(0, int(box[0])), max(0, int(box[1]))
+    x1, y1 = min(crop.shape[1], int(math.ceil(box[2]))), min(crop.shape[0], int(math.ceil(box[3])))
+    region = crop[y0:y1, x0:x1].astype(np.int16)
+    if region.shape[0] < 6 or region.shape[1] < 6:
+        return None
+    bg = np.median(region.reshape(-1, 3), axis=0)
+    diff = np.abs(region - bg).max(axis=2).astype(np.uint8)
+    if int(diff.max()) < INK_CONTRAST:
+        return None
+    _, ink = cv2.threshold(diff, 0, 1, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
+    n, _, stats, _ = cv2.connectedComponentsWithStats(ink, connectivity=8)
+    rh, rw = ink.shape
+    heights = [
+        int(bh)
+        for x, y, bw, bh, _ in stats[1:]
+        if x > 0 and y > 0 and x + bw < rw and y + bh < rh
+        and 2 <= bh <= 0.8 * rh and bw <= 4 * bh and bh <= 4 * bw
+    ]
+    if not heights:
+        return None
+    return float(LINE_PER_CAP * np.median(heights))
 
 
 def group_lines(lines: list[tuple[Box, float]]) -> list[tuple[Box, float]]:
@@ -275,6 +315,14 @@ class SignReader:
         crop = src.crop((x0, y0, x1, y1))
         if crop.size == 0:
             return []
+        inked = ink_line_height(crop, (box[0] - x0, box[1] - y0, box[2] - x0, box[3] - y0))
+        if inked is not None and inked < line_h:
+            # smaller text than guessed: less padding too (the crop is upscaled the more)
+            line_h, pad = inked, PAD_LINES * inked
+            cx0, cy0 = int(max(x0, box[0] - pad)), int(max(y0, box[1] - pad))
+            cx1, cy1 = int(min(x1, box[2] + pad + 1)), int(min(y1, box[3] + pad + 1))
+            crop = crop[cy0 - y0 : cy1 - y0, cx0 - x0 : cx1 - x0]
+            x0, y0 = cx0, cy0
         scale = float(np.clip(LINE_PX / max(line_h, 1.0), 0.5, 6.0))
         big = cv2.resize(crop, None, fx=scale, fy=scale, interpolation=cv2.INTER_CUBIC)
         bgr = np.ascontiguousarray(big[:, :, ::-1])

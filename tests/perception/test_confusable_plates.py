@@ -21,7 +21,8 @@ from pmnav_bt.sim.scene.signage import CLEAN_STYLE
 # 0.9992, above any wrong "1" in the confusion table; a building holding both codes cannot be
 # told apart by this reader (numbering schemes skip I and O for this reason). Nor O112 and
 # 0112: every O is read 0 (the table), so neither is ever named (test_sign_match).
-PAIRS = [("B117", "8117"), ("1G", "1C"), ("2.04", "2.40"), ("S204", "5204")]
+# 104 and 101: once a false target in an evaluation (4 is read 1: the confusion table).
+PAIRS = [("B117", "8117"), ("1G", "1C"), ("2.04", "2.40"), ("S204", "5204"), ("104", "101")]
 FONTS = ("dejavu_sans", "dejavu_serif_bold", "hershey")
 CAP_PX = (5.0, 7.0, 10.0, 16.0)  # from barely legible to clear
 

@@ -42,6 +42,7 @@ NEIGHBOURS = {
     "Z/2": ("Z21", "221", 0),
     "G/6": ("1G", "16", 1),
     "letter": ("1C", "1G", 1),
+    "4/1": ("104", "101", 2),  # once taken: a "104" plate read "101" named room 101
 }
 
 
