@@ -53,14 +53,16 @@ Mounting = Literal["beside", "beside_left", "beside_right", "on_door", "above_do
 
 WINDOW_M = 2.6  # along the wall either side of the plate: a beside plate's far door edge
 # is 0.15 + 1.16 m past the plate's edge, a flag's foot 0.15 m from the frame
-NEAR_M = 4.0  # wall pixels this near the plate fit its wall
+NEAR_M = 3.0  # wall pixels this near the plate fit its wall ...
+WALL_STRIDE = 4  # ... every this many pixels (the fit's cost is in its points)
 BAND_M = (1.1, 2.0)  # heights looked at: above a bumper rail (0.9-1.02 m), below a frame's top
 REF_BAND_M = (2.25, 2.6)  # the wall's own colour: above the door frames (2.18 m)
 ON_WALL_M = 0.12  # a point this near the wall plane is on it (frames stand 4 cm out)
 BEHIND_M = 0.12  # ... this far behind it: an opening, a glazed or recessed leaf
 IN_FRONT_M = 0.25  # ... this far in front: something standing before the wall
-MIN_CONTRAST = 20.0  # CIELAB distance from the wall's colour of a door pixel ...
-LIGHTNESS_WEIGHT = 0.5  # ... lightness at half weight (a face shaded otherwise)
+MIN_CONTRAST = 20.0  # CIELAB distance from the wall's colour of a door pixel (only faces of
+# the one wall plane are compared, so a face shaded otherwise, which ``door_sightings``
+# weighs lightness down for, does not arise: a grey frame on a grey wall differs in it)
 MIN_REF_PX = 30  # pixels above the doors for the wall's colour to be known
 BIN_M = 0.1
 MIN_BIN_PX = 3  # a bin with fewer pixels is not seen
@@ -72,7 +74,7 @@ FRAME_RUN_M = 0.3  # a run this short may be one jamb of a frame
 MIN_CUT_RUN_M = 0.3  # a run cut by the view's edge needs this much of it seen
 ON_PLATE_M = 0.1  # a run this near the plate's foot is under it
 REACH_M = 0.45  # a beside plate's door starts within its half width + this (0.15 m gap)
-TIE_M = 0.2  # doors either side this alike in nearness: the priors choose
+TIE_M = 0.1  # doors either side alike in nearness to a bin: the priors choose
 ON_PLANE_M = 0.1  # a flat plate's centre this near a wall line hangs on it (a door
 # plate stands a leaf's thickness out)
 FLAG_OUT_M = (0.1, 0.8)  # a flag's points stand this far out of its wall (a 5 cm bracket,
@@ -159,14 +161,19 @@ def door_runs(
     if ok.sum() < MIN_BIN_PX:
         return []
     lab = cv2.cvtColor(obs.rgb, cv2.COLOR_RGB2LAB).astype(np.float32)
-    ref = _wall_colour(obs, pts, wall, lab, box)
     behind = h[ok] < -BEHIND_M
+    on_wall = np.abs(h[ok]) <= ON_WALL_M
+    colour = lab[ok]
+    ref = _wall_colour(obs, pts, wall, lab, box)
+    if ref is None and on_wall.sum() >= MIN_REF_PX:
+        # Too near to see above the doors: the band's own median. Where a leaf fills the
+        # view that is the leaf's colour, and its frame's jambs stand out of it instead.
+        ref = np.median(colour[on_wall], axis=0)
     if ref is None:
         door = behind
     else:
-        diff = (lab[ok] - ref) * np.array([LIGHTNESS_WEIGHT, 1.0, 1.0], np.float32)
-        unlike = np.linalg.norm(diff, axis=1) > MIN_CONTRAST
-        door = behind | ((np.abs(h[ok]) <= ON_WALL_M) & unlike)
+        unlike = np.linalg.norm(colour - ref, axis=1) > MIN_CONTRAST
+        door = behind | (on_wall & unlike)
     return _runs(s[ok], door)
 
 
@@ -178,7 +185,7 @@ def _wall_of(obs, pts: np.ndarray, plate: PlatePose, box) -> WallFrame:
     c = plate.centre[:2]
     in_box = _box_mask(obs, box, margin=0)
     wall_mask = surfaces(obs).wall & ~in_box
-    p = wall_points(obs, wall_mask)
+    p = wall_points(obs, wall_mask, stride=WALL_STRIDE)
     p = p[np.linalg.norm(p - c, axis=1) <= NEAR_M] if len(p) else p
     own = pts[in_box][:, :2]
     own = own[np.isfinite(own).all(axis=1)]
