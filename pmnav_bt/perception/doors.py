@@ -1,4 +1,8 @@
-"""A room's door from its sign: the sign is read, the door is where the building puts it.
+"""A room's door from its sign by one convention: the door is where the building puts it.
+
+This is the prior ``door_scene.door_for_plate`` falls back to when it sees no door near a
+read plate, and keeps where the door it sees confirms it (docs/perception.md, "From a
+sign to its door").
 
 A door sign hangs on the wall beside its door, at a known centre-to-centre distance
 (``sign_to_door``, a building convention: 1.14 m in the simulator, a 1.16 m door frame,
