@@ -32,24 +32,25 @@ flag, whose plate stands across the corridor. So the door is looked for in RGB-D
 Where the run seen on the convention's side agrees with the convention (its centre within
 ``AGREE_M`` of ``sign_to_door``: the bins and the frame's edges are 0.1 m coarse), the
 convention's exact spot is kept, so a building that follows it (the clean world) places
-its doors exactly as before. It runs once per read room plate (a few ms at 320x240).
+most of its doors exactly as before, and none more than 0.25 m away. It runs once per
+read room plate: about 30 ms of CPU at 320x240, most of it the wall fit
+(``benchmarks/bench_door_from_sign.py``).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
 
 import cv2
 import numpy as np
 
 from pmnav_bt.map.building import Building
+from pmnav_bt.map.signage import Mounting
 from pmnav_bt.perception.depth import PlatePose, back_project, polygon_mask, surfaces, wall_rect
 from pmnav_bt.perception.doors import DoorEstimate, DoorLayout, door_beside, door_from_sign
 from pmnav_bt.pose.walls import wall_lines, wall_points
-
-Mounting = Literal["beside", "beside_left", "beside_right", "on_door", "above_door", "flag"]
+from pmnav_bt.seams import Observation
 
 WINDOW_M = 2.6  # along the wall either side of the plate: a beside plate's far door edge
 # is 0.15 + 1.16 m past the plate's edge, a flag's foot 0.15 m from the frame
@@ -120,7 +121,7 @@ def mounting_prior(building: Building, room_id: str) -> Mounting | None:
 
 
 def door_for_plate(
-    obs,
+    obs: Observation,
     plate: PlatePose,
     box: tuple[float, float, float, float],
     layout: DoorLayout,
@@ -141,7 +142,7 @@ def door_for_plate(
 
 
 def door_runs(
-    obs, pts: np.ndarray, wall: WallFrame, box: tuple[float, float, float, float]
+    obs: Observation, pts: np.ndarray, wall: WallFrame, box: tuple[float, float, float, float]
 ) -> list[DoorRun]:
     """The door runs along ``wall`` within ``WINDOW_M`` of its foot (see the module
     docstring, step 2), nearest the foot first."""
@@ -177,7 +178,7 @@ def door_runs(
     return _runs(s[ok], door)
 
 
-def _wall_of(obs, pts: np.ndarray, plate: PlatePose, box) -> WallFrame:
+def _wall_of(obs: Observation, pts: np.ndarray, plate: PlatePose, box) -> WallFrame:
     """The wall ``plate`` hangs on or projects from (step 1). The lines are fitted on the
     wall pixels near the plate outside its box; the box's own points then tell a flat
     plate (on the line) from a flag (standing out of it, ``FLAG_OUT_M``), whose points all
@@ -205,7 +206,7 @@ def _wall_of(obs, pts: np.ndarray, plate: PlatePose, box) -> WallFrame:
     return WallFrame(plate.normal[:2].copy(), plate.left[:2].copy(), c.copy(), flag=False)
 
 
-def _wall_colour(obs, pts, wall: WallFrame, lab, box) -> np.ndarray | None:
+def _wall_colour(obs: Observation, pts, wall: WallFrame, lab, box) -> np.ndarray | None:
     """The wall's own colour: the median of its pixels above the doors (None: too few)."""
     h = pts[..., :2] @ wall.normal - float(wall.normal @ wall.foot)
     z = pts[..., 2] + obs.camera_height
@@ -217,7 +218,7 @@ def _wall_colour(obs, pts, wall: WallFrame, lab, box) -> np.ndarray | None:
     return np.median(lab[m], axis=0)
 
 
-def _box_mask(obs, box, margin: int = PLATE_MARGIN_PX) -> np.ndarray:
+def _box_mask(obs: Observation, box, margin: int = PLATE_MARGIN_PX) -> np.ndarray:
     """The pixels of the plate's ``box``, grown by ``margin``."""
     hgt, wid = obs.rgb.shape[:2]
     m = np.zeros((hgt, wid), bool)
@@ -323,7 +324,7 @@ def _prior_side(prior: Mounting | None, layout: DoorLayout) -> str:
 
 
 def _convention(
-    obs, s: float, plate: PlatePose, wall: WallFrame, layout: DoorLayout
+    obs: Observation, s: float, plate: PlatePose, wall: WallFrame, layout: DoorLayout
 ) -> DoorEstimate | None:
     """The convention's spot where the door seen confirms it (see the module docstring)."""
     if wall.flag:
@@ -334,7 +335,9 @@ def _convention(
     return None
 
 
-def _estimate(obs, wall: WallFrame, s: float, layout: DoorLayout, seen: bool) -> DoorEstimate:
+def _estimate(
+    obs: Observation, wall: WallFrame, s: float, layout: DoorLayout, seen: bool
+) -> DoorEstimate:
     """The door centred ``s`` along ``wall`` from the plate's foot, at mid-height, its mask."""
     floor_z = -obs.camera_height
     xy = wall.foot + s * wall.left
@@ -351,7 +354,7 @@ def _estimate(obs, wall: WallFrame, s: float, layout: DoorLayout, seen: bool) ->
 
 
 def _fallback(
-    obs, plate: PlatePose, wall: WallFrame, layout: DoorLayout, prior: Mounting | None
+    obs: Observation, plate: PlatePose, wall: WallFrame, layout: DoorLayout, prior: Mounting | None
 ) -> DoorEstimate:
     """No door seen near the plate: the priors (step 4)."""
     if prior in ("on_door", "above_door"):
