@@ -42,6 +42,21 @@ def plates(world: SimWorld) -> list[tuple[Entity, WallItem]]:
     return out
 
 
+def built_mounting(sign: WallItem, door: WallItem) -> str:
+    """How the world hung room sign ``sign`` relative to its ``door`` (``PlateStyle.mounting``
+    as built: an ``on_door`` plate of an open door hangs beside it), told from their places:
+    ``flag``, ``on_door``, ``above_door``, or ``beside_left`` / ``beside_right`` (the plate on
+    the viewer's left / right of the door, facing the wall)."""
+    n = np.asarray(door.normal, float)
+    if abs(float(np.asarray(sign.normal, float) @ n)) < 0.5:
+        return "flag"
+    left = np.array([n[1], -n[0]])
+    along = float((np.asarray(sign.centre, float) - np.asarray(door.centre, float)) @ left)
+    if abs(along) < 0.1:
+        return "on_door" if sign.z[1] <= door.z[1] else "above_door"
+    return "beside_left" if along > 0 else "beside_right"
+
+
 def view_pose(
     item: WallItem, distance: float, angle: float, side: int, jitter: float
 ) -> tuple[Pose2D, float]:
@@ -87,20 +102,26 @@ def sample_views(
             continue
         if world.clearance(pose.x, pose.y, RADIUS) < 0.02:
             continue
-        f = render_camera(
-            world, pose.x, pose.y, pose.yaw, k, height=CAMERA_HEIGHT, segmentation=segmentation
-        )
-        with world.lock:
-            labels = dict(world.labels)
-        obs = Observation(
-            rgb=f.rgb,
-            pose=pose,
-            stamp=0.0,
-            intrinsics=k,
-            depth=f.depth,
-            segmentation=f.segmentation,
-            labels=labels,
-            camera_height=CAMERA_HEIGHT,
-        )
         made += 1
-        yield SignView(entity, item.text, d, a, obs)
+        yield SignView(entity, item.text, d, a, observe(world, pose, k, segmentation))
+
+
+def observe(
+    world: SimWorld, pose: Pose2D, k: CameraIntrinsics, segmentation: bool = True
+) -> Observation:
+    """The robot camera's frame from ``pose`` (RGB, depth, and labels if ``segmentation``)."""
+    f = render_camera(
+        world, pose.x, pose.y, pose.yaw, k, height=CAMERA_HEIGHT, segmentation=segmentation
+    )
+    with world.lock:
+        labels = dict(world.labels)
+    return Observation(
+        rgb=f.rgb,
+        pose=pose,
+        stamp=0.0,
+        intrinsics=k,
+        depth=f.depth,
+        segmentation=f.segmentation,
+        labels=labels,
+        camera_height=CAMERA_HEIGHT,
+    )

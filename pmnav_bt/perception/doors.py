@@ -1,4 +1,8 @@
-"""A room's door from its sign: the sign is read, the door is where the building puts it.
+"""A room's door from its sign by one convention: the door is where the building puts it.
+
+This is the prior ``door_scene.door_for_plate`` falls back to when it sees no door near a
+read plate, and keeps where the door it sees confirms it (docs/perception.md, "From a
+sign to its door").
 
 A door sign hangs on the wall beside its door, at a known centre-to-centre distance
 (``sign_to_door``, a building convention: 1.14 m in the simulator, a 1.16 m door frame,
@@ -41,11 +45,12 @@ class DoorLayout:
 
 @dataclass(frozen=True)
 class DoorEstimate:
-    """A door derived from its sign: centre (camera body frame, mid-height), the side of the
-    sign it is on, whether the image told the side, and its image mask (None: out of view)."""
+    """A door derived from its sign: centre (camera body frame, mid-height), where it is
+    from the sign (on its ``left`` or ``right``, or ``at`` it: the plate on or above the
+    door), whether the image told that, and its image mask (None: out of view)."""
 
     centre: np.ndarray
-    side: Side
+    side: Side | Literal["at"]
     seen: bool
     mask: np.ndarray | None
 
@@ -79,6 +84,15 @@ def door_from_sign(obs: Observation, plate: PlatePose, layout: DoorLayout) -> Do
         else:
             scores[side] = float(np.linalg.norm(colour - ref[0]))
     side, seen = _choose(scores, layout.default_side)
+    return door_beside(obs, plate, layout, side, seen)
+
+
+def door_beside(
+    obs: Observation, plate: PlatePose, layout: DoorLayout, side: Side, seen: bool
+) -> DoorEstimate:
+    """The door ``sign_to_door`` on ``side`` of the sign ``plate``, at mid-height, with its
+    image mask; ``seen``: whether the image told the side."""
+    floor_z = -obs.camera_height
     sgn = 1.0 if side == "left" else -1.0
     centre = plate.centre + sgn * layout.sign_to_door * plate.left
     centre = np.array([centre[0], centre[1], floor_z + layout.door_height / 2.0])

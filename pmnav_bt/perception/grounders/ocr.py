@@ -6,8 +6,9 @@
   sign's, its ``point`` where the named entity is, the point the priori-map knows it by:
   for a room its door (derived from the sign, as ``detect`` does), for a landmark its
   sign; None without depth. Localization pairs these points with the map's.
-- ``detect(room)``: the room's *door*, derived from its sign (``doors.door_from_sign``):
-  box and mask of the door rectangle projected into the image, ``point`` its centre.
+- ``detect(room)``: the room's *door*, found in RGB-D around its sign
+  (``door_scene.door_for_plate``; the file's signage mounting a prior): box and mask of
+  the door rectangle projected into the image, ``point`` its centre.
   Without depth the door cannot be placed: the sign's detection stands in for it.
 - ``detect(landmark)``: the landmark's sign.
 - ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
@@ -32,7 +33,8 @@ import numpy as np
 from pmnav_bt.backends import BackendDeps
 from pmnav_bt.map.building import Building
 from pmnav_bt.perception import depth as depth_geom
-from pmnav_bt.perception.doors import DoorLayout, door_from_sign
+from pmnav_bt.perception.door_scene import door_for_plate, mounting_prior
+from pmnav_bt.perception.doors import DoorLayout
 from pmnav_bt.perception.grounders.plate_memory import PlateMemory
 from pmnav_bt.perception.sign_match import Evidence, Match, SignMatcher, decide
 from pmnav_bt.perception.signs import MIN_LINE_PX, Box, SignReader, SignText, scale_sign
@@ -187,7 +189,8 @@ class OcrGrounder:
         return _by_candidate(found, [scale_sign(t, 1.0 / s) for t in self.reader.read(r, cands)])
 
     def _door(self, obs: Observation, sign: Detection, plate: depth_geom.PlatePose) -> Detection:
-        door = door_from_sign(obs, plate, self.layout)
+        prior = mounting_prior(self.building, sign.entity.id)  # type: ignore[union-attr]
+        door = door_for_plate(obs, plate, sign.box, self.layout, prior)
         if door.mask is not None:
             ys, xs = np.nonzero(door.mask)
             box = (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
