@@ -37,7 +37,8 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
     """Run ``ep`` (see the module); write its tree log and plots to ``out_dir``."""
     from pmnav_bt.behaviours.lift import into_cabin
     from pmnav_bt.eval.geodesic import GeodesicField
-    from pmnav_bt.sim.episodes import goal_geodesic
+    from pmnav_bt.pose.evidence.floor_model import building_grid
+    from pmnav_bt.sim.episodes import goal_door_in_world, goal_geodesic
     from pmnav_bt.sim.levels import LevelBody
     from pmnav_bt.sim.lift import SimLift
     from pmnav_bt.sim.odometry import NoisyOdometry
@@ -55,11 +56,18 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
     sim = config.sim
     t0 = time.perf_counter()
     worlds: dict[str, SimWorld] = {}
+    # Each level's grid is the robot's map of its walls where its world is built from it
+    # (``sim.walls=grid``), as in a one-level episode (``evaluation.run_episode``).
+    grids = {
+        lv.name: building_grid(lv.building, lv.path.parent if lv.path else ".")
+        if sim.walls == "grid" else None
+        for lv in site.levels
+    }  # fmt: skip
     try:
         for lv in site.levels:
             lobbies = {lift.lobbies[lv.name] for lift in site.lifts_at(lv.name)}
             worlds[lv.name] = SimWorld(
-                lv.building, base_dir=lv.path.parent if lv.path else None,
+                lv.building, walls=sim.walls, base_dir=lv.path.parent if lv.path else None,
                 scene=config.world, seed=ep.seed, lifts=lobbies,
             )  # fmt: skip
         body = LevelBody(
@@ -67,6 +75,8 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
             reading_width=sim.reading_width,
         )  # fmt: skip
         base = NoisyOdometry(body, sim.odometry_noise, seed=ep.seed) if sim.odometry_noise else body
+        # Success is judged at the goal door the goal level's world hung (on a grid wall).
+        door = goal_door_in_world(worlds[ep.goal_level], sm.maps[ep.goal_level], ep.goal)
         rng = worlds[ep.start_level].rng("lift")
         lift = SimLift(body.clock, body, rng, config.world.lift_full_p)
         for link in site.lifts:
@@ -84,15 +94,18 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
                 at = rides[i].alight.lobby
             else:
                 pm = sm.maps[leg.level]
-                geodesic = goal_geodesic(pm, ep.goal, feet, floor=w.floor_space())
+                geodesic = goal_geodesic(pm, ep.goal, feet, floor=w.floor_space(), door=door)
                 shortest += geodesic.distance(at)
         pm0 = sm.maps[ep.start_level]
         budget = action_budget(config, ep.route_length) + RIDE_ACTIONS * ep.rides
-        ctx = make_context(base, pm0, config, seed=ep.seed, budget=budget, deferred_work=True)
+        ctx = make_context(
+            base, pm0, config, seed=ep.seed, budget=budget, deferred_work=True,
+            grid=grids[ep.start_level],
+        )  # fmt: skip
         contexts = {ep.start_level: ctx}
         for name, pm in sm.maps.items():
             if name != ep.start_level:
-                contexts[name] = level_context(ctx, pm, ep.seed)
+                contexts[name] = level_context(ctx, pm, ep.seed, grid=grids[name])
         truth: list[tuple[float, str, float, float]] = []
 
         def record(tree) -> None:
@@ -117,7 +130,6 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
     finally:
         for w in worlds.values():
             w.close()
-    door = sm.maps[ep.goal_level].building.room(ep.goal).door
     stop = (final.x, final.y)
     dist = math.dist(stop, door) if level == ep.goal_level else math.inf
     ok = outcome.success and level == ep.goal_level and success(stop, door)
@@ -196,7 +208,11 @@ def _plots(sm, ep: SiteEpisode, trace, truth, result, out_dir: Path) -> dict[str
             f"{ep.goal_level}): {verdict}; SPL {result.spl:.2f}"
         )
         out = out_dir / f"{safe_filename(ep.id)}.{safe_filename(name)}.trajectory.png"
-        img = render_trajectory(sm.maps[name], planned, path_xy, nodes, None, caption)
+        lv = sm.site.level(name)
+        base_dir = lv.path.parent if lv.path else "."  # the level's floor plan is beside it
+        img = render_trajectory(
+            sm.maps[name], planned, path_xy, nodes, None, caption, base_dir=base_dir
+        )
         canvas = make_canvas(sm.maps[name])
         for d in doorways.get(name, ()):  # the cabins ridden from or to, behind the wall
             pts = np.rint(canvas.to_px(d.cabin_corners())).astype(np.int32)
