@@ -150,7 +150,8 @@ def summary(moved: list[MovedItem]) -> str:
 
 def grid_clearings(world) -> list[np.ndarray]:
     """Map-frame polygons whose grid cells the walls keep free: a strip in front of every
-    item, and each door's opening through the wall behind it."""
+    item, each door's opening through the wall behind it, and each lift's doorway and
+    cabin (``Cabin.clearings``)."""
     mounts: GridMounts = world._mounts
     out = []
     for it in (
@@ -166,6 +167,10 @@ def grid_clearings(world) -> list[np.ndarray]:
         behind = mounts.walls.thickness(c, n, DOOR_OPENING_MAX_M)
         depth = DOORWAY_DEPTH_M if behind is None else behind + mounts.walls.plan.resolution
         out.append(_strip(door, depth, 0.0, 0.0))
+    for cabin in world.cabins.values():  # a lift's doorway, and its cabin in the shaft
+        c, n = np.asarray(cabin.centre), -np.asarray(cabin.into)
+        behind = mounts.walls.thickness(c, n, DOOR_OPENING_MAX_M)
+        out.extend(cabin.clearings(0.0 if behind is None else behind))
     return out
 
 

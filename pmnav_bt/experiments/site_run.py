@@ -37,7 +37,7 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
     """Run ``ep`` (see the module); write its tree log and plots to ``out_dir``."""
     from pmnav_bt.behaviours.lift import into_cabin
     from pmnav_bt.eval.geodesic import GeodesicField
-    from pmnav_bt.sim.episodes import goal_geodesic
+    from pmnav_bt.sim.episodes import goal_door_in_world, goal_geodesic
     from pmnav_bt.sim.levels import LevelBody
     from pmnav_bt.sim.lift import SimLift
     from pmnav_bt.sim.odometry import NoisyOdometry
@@ -55,18 +55,16 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
     sim = config.sim
     t0 = time.perf_counter()
     worlds: dict[str, SimWorld] = {}
+    grids = level_grids(site, config)
     try:
-        for lv in site.levels:
-            lobbies = {lift.lobbies[lv.name] for lift in site.lifts_at(lv.name)}
-            worlds[lv.name] = SimWorld(
-                lv.building, base_dir=lv.path.parent if lv.path else None,
-                scene=config.world, seed=ep.seed, lifts=lobbies,
-            )  # fmt: skip
+        level_worlds(site, config, ep.seed, worlds)
         body = LevelBody(
             worlds, ep.start_level, ep.start_pose, width=sim.width, height=sim.height,
             reading_width=sim.reading_width,
         )  # fmt: skip
         base = NoisyOdometry(body, sim.odometry_noise, seed=ep.seed) if sim.odometry_noise else body
+        # Success is judged at the goal door the goal level's world hung (on a grid wall).
+        door = goal_door_in_world(worlds[ep.goal_level], sm.maps[ep.goal_level], ep.goal)
         rng = worlds[ep.start_level].rng("lift")
         lift = SimLift(body.clock, body, rng, config.world.lift_full_p)
         for link in site.lifts:
@@ -84,15 +82,18 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
                 at = rides[i].alight.lobby
             else:
                 pm = sm.maps[leg.level]
-                geodesic = goal_geodesic(pm, ep.goal, feet, floor=w.floor_space())
+                geodesic = goal_geodesic(pm, ep.goal, feet, floor=w.floor_space(), door=door)
                 shortest += geodesic.distance(at)
         pm0 = sm.maps[ep.start_level]
         budget = action_budget(config, ep.route_length) + RIDE_ACTIONS * ep.rides
-        ctx = make_context(base, pm0, config, seed=ep.seed, budget=budget, deferred_work=True)
+        ctx = make_context(
+            base, pm0, config, seed=ep.seed, budget=budget, deferred_work=True,
+            grid=grids[ep.start_level],
+        )  # fmt: skip
         contexts = {ep.start_level: ctx}
         for name, pm in sm.maps.items():
             if name != ep.start_level:
-                contexts[name] = level_context(ctx, pm, ep.seed)
+                contexts[name] = level_context(ctx, pm, ep.seed, grid=grids[name])
         truth: list[tuple[float, str, float, float]] = []
 
         def record(tree) -> None:
@@ -117,7 +118,6 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
     finally:
         for w in worlds.values():
             w.close()
-    door = sm.maps[ep.goal_level].building.room(ep.goal).door
     stop = (final.x, final.y)
     dist = math.dist(stop, door) if level == ep.goal_level else math.inf
     ok = outcome.success and level == ep.goal_level and success(stop, door)
@@ -148,6 +148,37 @@ def run_site_episode(ep: SiteEpisode, config: Config, out_dir: Path | None = Non
     if out_dir is not None:
         plots = _plots(sm, ep, ctx.trace, truth, result, out_dir)
     return SiteRun(result, plots, log_path)
+
+
+def level_grids(site, config: Config) -> dict:
+    """Each level's occupancy grid where its world is built from it (``sim.walls=grid``):
+    the robot's map of that level's walls, as in a one-level episode
+    (``evaluation.run_episode``); None per level otherwise."""
+    from pmnav_bt.pose.evidence.floor_model import building_grid
+
+    if config.sim.walls != "grid":
+        return {lv.name: None for lv in site.levels}
+    return {lv.name: building_grid(lv.building, _folder(lv)) for lv in site.levels}
+
+
+def level_worlds(site, config: Config, seed: int, into: dict) -> dict:
+    """A world per level of ``site`` into ``into`` (level name -> ``SimWorld``, so a
+    caller can close the ones made when a later one fails): walls as ``sim.walls`` says,
+    a cabin behind each of its lifts' lobbies."""
+    from pmnav_bt.sim.world import SimWorld
+
+    for lv in site.levels:
+        lobbies = {lift.lobbies[lv.name] for lift in site.lifts_at(lv.name)}
+        into[lv.name] = SimWorld(
+            lv.building, walls=config.sim.walls, base_dir=_folder(lv) if lv.path else None,
+            scene=config.world, seed=seed, lifts=lobbies,
+        )  # fmt: skip
+    return into
+
+
+def _folder(lv) -> Path:
+    """The folder a level's floor plan path is relative to: its building file's."""
+    return lv.path.parent if lv.path else Path(".")
 
 
 CABIN_COLOUR = (40, 40, 40)  # BGR: the lift cabin's outline on a level's plot
@@ -196,7 +227,10 @@ def _plots(sm, ep: SiteEpisode, trace, truth, result, out_dir: Path) -> dict[str
             f"{ep.goal_level}): {verdict}; SPL {result.spl:.2f}"
         )
         out = out_dir / f"{safe_filename(ep.id)}.{safe_filename(name)}.trajectory.png"
-        img = render_trajectory(sm.maps[name], planned, path_xy, nodes, None, caption)
+        img = render_trajectory(
+            sm.maps[name], planned, path_xy, nodes, None, caption,
+            base_dir=_folder(sm.site.level(name)),
+        )  # fmt: skip
         canvas = make_canvas(sm.maps[name])
         for d in doorways.get(name, ()):  # the cabins ridden from or to, behind the wall
             pts = np.rint(canvas.to_px(d.cabin_corners())).astype(np.int32)

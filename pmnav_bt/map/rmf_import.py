@@ -49,6 +49,9 @@ MAX_ID = 64  # the building format's id length
 # A lift door this far beyond its corridor's wall (half its width off the centre line) is
 # on the wall still (the corridors' widths are medians, the drawing's walls wander).
 LIFT_OFF_WALL_M = 0.1
+# A named place's plate goes on a wall at most this far from the place (a corridor's
+# half width and more: an RMF place on a hall's lane may be a few metres from any wall).
+PLATE_SEARCH_M = 5.0
 
 
 class RmfImportError(PmNavError):
@@ -98,10 +101,12 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
     seg_b = np.array([cor.pos[v] for _, v, _ in cor.edges])
     half = np.array([w / 2.0 for _, _, w in cor.edges])
 
-    def reach(pt, what: str, tail: str = "") -> bool:
+    def reach(pt, what: str, tail: str = "", quiet: bool = False) -> bool:
         j, _, d = project_points_to_segments(np.asarray(pt, float)[None], seg_a, seg_b)
         limit = half[j[0]] + DOOR_REACH_SLACK
         if d[0] > limit:
+            if quiet:
+                return False
             skipped.append(
                 f"{what}: not on a corridor ({d[0]:.2f} m from the nearest centre line; "
                 f"at most {limit:.2f} m{tail})"
@@ -127,8 +132,9 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             continue
         elif reach(lvl.xy[i], f"vertex {name!r}"):
             lid = _unique_id(name, ids)
+            pos = _plate_on_wall(lvl.xy[i], plan, free, lambda q: reach(q, "", quiet=True))
             landmarks.append(
-                {"id": lid, "kind": "sign", "name": _text(name), "pos": _r(lvl.xy[i]),
+                {"id": lid, "kind": "sign", "name": _text(name), "pos": _r(pos),
                  "sign": _words(name)}
             )
     lift_landmarks: dict[str, list[str]] = {}
@@ -347,6 +353,34 @@ def _words(name: str) -> str:
     """An RMF name as a sign reads: 'L1_left_consult_rm_3' -> 'left consult rm 3'."""
     text = re.sub(r"^L\d+_", "", name).replace("_", " ").strip()
     return _text(text or name)
+
+
+def _plate_on_wall(pt, plan: FloorPlanImage, free: np.ndarray, on_corridor) -> np.ndarray:
+    """Where the name plate of a named place at ``pt`` hangs: the nearest wall of the grid
+    (its first cell off the corridors' ``free`` space, looking all round out to
+    ``PLATE_SEARCH_M``) that is still on a corridor (``on_corridor``); ``pt`` itself where
+    no such wall is near.
+
+    An RMF place is a vertex on a lane, often on the corridor's centre line or in the
+    middle of a hall: a plate there has no wall, so neither the map (which side of the
+    corridor it faces, where it can be read from) nor the simulator (which wall it
+    hangs on, a tie on the centre line) would know where it is, and the two would
+    disagree by a corridor's width. On the wall, both have it where a person would put
+    the plate: on the wall nearest the place."""
+    p0 = np.asarray(pt, float)
+    if not plan.mask_at(free, p0[None])[0]:
+        return p0  # in a wall already
+    angles = np.radians(np.arange(0.0, 360.0, 5.0))
+    ways = np.stack([np.cos(angles), np.sin(angles)], 1)
+    t = np.arange(plan.resolution / 2.0, PLATE_SEARCH_M, plan.resolution / 2.0)
+    pts = p0[None, None, :] + t[None, :, None] * ways[:, None, :]
+    ok = plan.mask_at(free, pts.reshape(-1, 2)).reshape(len(ways), len(t))
+    hits = [(float(t[k]), pts[i, k]) for i in range(len(ways)) if not ok[i].all()
+            for k in [int(np.argmin(ok[i]))]]  # fmt: skip
+    for _, q in sorted(hits, key=lambda h: h[0]):
+        if on_corridor(q):
+            return q
+    return p0
 
 
 def _r(p) -> list[float]:

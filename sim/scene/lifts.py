@@ -116,6 +116,26 @@ class Cabin:
             across <= CABIN_WIDTH_M / 2.0
         )
 
+    def clearings(self, wall: float) -> list[np.ndarray]:
+        """Where a wall built from a grid (``sim.walls=grid``) must leave room for the
+        lift, as map-frame polygons: the doorway through the real wall (``wall`` m thick
+        there) and the cabin behind it to its walls' outer faces. The grid walls the
+        shaft round (an imported RMF lift: ``map/rmf_grid.py``), and the cabin, built with
+        walls of its own, stands in it."""
+        c, u = np.asarray(self.centre, float), np.asarray(self.into, float)
+        v = np.array([-u[1], u[0]])
+        t = DOORWAY_WALL_M
+
+        def box(near: float, far: float, half: float) -> np.ndarray:
+            return np.array([c + u * near - v * half, c + u * far - v * half,
+                             c + u * far + v * half, c + u * near + v * half])  # fmt: skip
+
+        inside = max(wall, t)
+        return [
+            box(-0.05, inside + 0.05, ELEVATOR_WIDTH_M / 2.0),
+            box(inside, t + CABIN_DEPTH_M + t, CABIN_WIDTH_M / 2.0 + t),
+        ]
+
     def set_door(self, is_open: bool) -> None:
         """Open the doors (the leaves slid away) or shut them."""
         if is_open == self.is_open:

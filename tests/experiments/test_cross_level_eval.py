@@ -132,3 +132,28 @@ def test_sim_run_takes_a_stored_site_episode(tmp_path, capsys):
     last = err.strip().splitlines()[-1]
     assert info.value.code == 2 and "(cross_level), start on L" in out  # the site's run
     assert last.startswith("pmnav: error: ") and "two.yaml" in last
+
+
+@pytest.mark.world
+def test_a_site_s_level_worlds_and_wall_maps_follow_sim_walls(rmf_maps, tmp_path):
+    """``sim.walls=grid`` builds each level's world from its grid, and the grid is that
+    level's map of the walls, as in a one-level episode (the clinic's lifts included)."""
+    from pmnav_bt.config import load_config
+    from pmnav_bt.experiments.site_run import level_grids, level_worlds
+    from pmnav_bt.map.rmf_site import import_rmf_site
+    from pmnav_bt.map.site import read_site_file
+
+    out = tmp_path / "clinic.yaml"
+    import_rmf_site(rmf_maps / "clinic" / "clinic.building.yaml", out)
+    site = read_site_file(out)
+    assert set(level_grids(site, Config()).values()) == {None}
+    cfg = load_config(None, ["sim.walls=grid"])
+    assert None not in level_grids(site, cfg).values()
+    worlds: dict = {}
+    try:
+        level_worlds(site, cfg, 0, worlds)
+        assert {w.wall_source for w in worlds.values()} == {"grid"}
+        assert all(len(w.cabins) == 3 for w in worlds.values())
+    finally:
+        for w in worlds.values():
+            w.close()

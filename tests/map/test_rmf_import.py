@@ -71,6 +71,16 @@ def test_named_door_becomes_a_room_on_its_wall_and_the_charger_the_start(example
     assert any("'desk': not on a corridor" in s for s in imp.skipped)
 
 
+def test_a_named_place_s_plate_hangs_on_the_wall_nearest_the_place(example, tmp_path):
+    """The notice board's vertex is 0.5 m north of the south wall: its plate goes on that
+    wall's face (where the map and the simulator both hang it), along the wall from it."""
+    imp = import_rmf(example, tmp_path / "out.yaml")
+    (lm,) = imp.building.landmarks
+    face = CORRIDOR["south"] + WALL_M / 2.0
+    assert lm.pos[1] == pytest.approx(face, abs=imp.grid.resolution)
+    assert lm.pos[0] == pytest.approx(400 * SCALE_M_PER_PX, abs=1e-6)
+
+
 def test_the_written_files_validate_and_the_grid_has_the_walls(example, tmp_path, capsys):
     out = tmp_path / "out.yaml"
     code, text, err = run_pmnav(capsys, "map", "import-rmf", example, "-o", out)
