@@ -113,9 +113,8 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
     for d, centre, _ in doors:
         if reach(centre, f"door {d.name!r}", "; no spur along the free space reaches it"):
             rid = _unique_id(d.name, ids)
-            rooms.append(
-                {"id": rid, "name": _text(d.name), "door": _r(centre), "sign": _words(d.name)}
-            )
+            plate = room_plate(d.name)
+            rooms.append({"id": rid, "name": plate, "door": _r(centre), "sign": plate})
     door_names = {d.name for d in lvl.doors if d.name}
     landmarks = []
     for i, name in enumerate(lvl.names):
@@ -128,7 +127,7 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
         elif reach(lvl.xy[i], f"vertex {name!r}"):
             lid = _unique_id(name, ids)
             landmarks.append(
-                {"id": lid, "kind": "sign", "name": _text(name), "pos": _r(lvl.xy[i]),
+                {"id": lid, "kind": "sign", "name": _words(name), "pos": _r(lvl.xy[i]),
                  "sign": _words(name)}
             )
     lift_landmarks: dict[str, list[str]] = {}
@@ -137,7 +136,7 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             lid = _unique_id(ld.lift, ids)
             lift_landmarks.setdefault(ld.lift, []).append(lid)
             landmarks.append(
-                {"id": lid, "kind": "elevator", "name": _text(ld.lift), "pos": _r(ld.pos),
+                {"id": lid, "kind": "elevator", "name": _words(ld.lift), "pos": _r(ld.pos),
                  "sign": _words(ld.lift)}
             )
     ros_map = Path(out).stem + "_walls.yaml"
@@ -178,7 +177,8 @@ def write_import(imp: Imported, out: str | Path) -> Path:
     save_ros_map(imp.grid, out.parent / imp.data["floor_plan"]["ros_map"])
     head = [
         f"# Imported by 'pmnav map import-rmf' from {imp.level.source} level {imp.level.name}.",
-        "# Room names are the RMF door names; check the signs and the start.",
+        "# Ids are the RMF names; names and plates their words (a room's without 'door').",
+        "# Check the signs and the start.",
     ]
     return atomic_write_text(out, "\n".join(head) + "\n" + dump_building(imp.building))
 
@@ -347,6 +347,20 @@ def _words(name: str) -> str:
     """An RMF name as a sign reads: 'L1_left_consult_rm_3' -> 'left consult rm 3'."""
     text = re.sub(r"^L\d+_", "", name).replace("_", " ").strip()
     return _text(text or name)
+
+
+def room_plate(door_name: str) -> str:
+    """What the plate by an imported door shows, and so the room's name: the RMF door's
+    name in words, less the word "door" ('coe_door' -> 'coe', 'L1_left_consult_rm_3_outer'
+    -> 'left consult rm 3 outer').
+
+    An RMF door name is an identifier for the fleet (it names the door, and most end in
+    "door"); a building prints what is behind the door. Kept, the word would be on every
+    plate, and a plate read in part ('oor') would fit every room alike. A name that is only
+    "door" keeps it. The room's id stays the RMF name (what RMF's door requests use)."""
+    words = _words(door_name).split()
+    kept = [w for w in words if w.casefold() not in ("door", "doors")]
+    return _text(" ".join(kept or words))
 
 
 def _r(p) -> list[float]:
