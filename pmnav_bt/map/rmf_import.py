@@ -9,8 +9,9 @@ What comes across, and from where (``docs/import-rmf.md`` has the details and li
 - corridors from the lanes, centred and measured in the grid (``rmf_corridors``);
 - a room per named door on a corridor (its name the door's, its door the door's centre,
   which lies in the wall the door is in);
-- a landmark per named vertex on a corridor (kind ``sign``: a name plate on the nearest
-  wall) and per lift door on this level (kind ``elevator``);
+- a landmark per named vertex on a corridor (kind ``sign``: a name plate on the real wall
+  nearest it, ``rmf_places``; none on an open floor) and per lift door on this level
+  (kind ``elevator``);
 - the start at a dead end next to a charger or a robot's spawn point, else the dead end
   nearest an outside door.
 
@@ -40,8 +41,10 @@ from pmnav_bt.map.floorplan import FloorPlanImage, load_image_plan, save_ros_map
 from pmnav_bt.map.grid import largest_component
 from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
 from pmnav_bt.map.rmf_grid import level_grid, passage_doors
+from pmnav_bt.map.rmf_places import PLACE_WALL_M, plate_on_wall
 from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
 from pmnav_bt.map.rmf_spurs import LIFT_PAST_M, PAST_M, add_spur, turn_at_door
+from pmnav_bt.map.wall_surface import RealWalls
 
 START_REACH_M = 3.0  # a dead end this near a charger or spawn point is the start
 MIN_DOOR_M = 0.3  # a door narrower than this is a drawing slip
@@ -116,6 +119,7 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             plate = room_plate(d.name)
             rooms.append({"id": rid, "name": plate, "door": _r(centre), "sign": plate})
     door_names = {d.name for d in lvl.doors if d.name}
+    walls = RealWalls(plan)
     landmarks = []
     for i, name in enumerate(lvl.names):
         if not name:
@@ -124,10 +128,12 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             skipped.append(f"vertex {name!r}: named like a door (the room is the door's)")
         elif _is_start_point(lvl.vparams[i]):
             continue
-        elif reach(lvl.xy[i], f"vertex {name!r}"):
+        elif (plate := _place_plate(walls, lvl.xy[i], name, skipped)) is not None and reach(
+            plate, f"vertex {name!r}"
+        ):
             lid = _unique_id(name, ids)
             landmarks.append(
-                {"id": lid, "kind": "sign", "name": _words(name), "pos": _r(lvl.xy[i]),
+                {"id": lid, "kind": "sign", "name": _words(name), "pos": _r(plate),
                  "sign": _words(name)}
             )
     lift_landmarks: dict[str, list[str]] = {}
@@ -214,6 +220,18 @@ def _doors(lvl: RmfLevel, passages: frozenset[int], skipped: list[str]) -> list:
             a, b = lvl.xy[d.a], lvl.xy[d.b]
             out.append((d, (a + b) / 2.0, b - a))
     return out
+
+
+def _place_plate(walls: RealWalls, place, name: str, skipped: list[str]):
+    """Where the plate of the named place at ``place`` hangs (``rmf_places``), or None,
+    listed as skipped, on an open floor."""
+    plate, _ = plate_on_wall(walls, place)
+    if plate is None:
+        skipped.append(
+            f"vertex {name!r}: on an open floor, no wall within {PLACE_WALL_M:g} m to hang "
+            "its plate on"
+        )
+    return plate
 
 
 def _entrances(lvl: RmfLevel, plan: FloorPlanImage) -> list[np.ndarray]:

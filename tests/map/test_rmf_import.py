@@ -67,6 +67,7 @@ def test_named_door_becomes_a_room_on_its_wall_and_the_charger_the_start(example
     start = imp.building.waypoint("start")
     assert start.pos[0] == pytest.approx(2.0, abs=0.1)  # the charger's end, not the other
     assert [lm.id for lm in imp.building.landmarks] == ["notice_board"]
+    assert [lm.name for lm in imp.building.landmarks] == ["notice board"]
     # The vertex inside the room is no landmark, and the list says why.
     assert any("'desk': not on a corridor" in s for s in imp.skipped)
 
@@ -83,6 +84,24 @@ def test_an_imported_rooms_name_is_its_plate_the_door_name_without_door(tmp_path
     (room,) = imp.building.rooms
     assert room.id == door  # the identifier RMF's door requests use
     assert room.name == room.sign == plate
+
+
+def test_a_named_places_plate_hangs_on_the_wall_nearest_it(tmp_path):
+    imp = import_rmf(write_example_rmf(tmp_path), tmp_path / "out.yaml")
+    (board,) = imp.building.landmarks
+    # The place is drawn 0.5 m off the south wall (its centre line at y -8, its face
+    # 0.075 m nearer): the plate is on that face, a grid cell into the wall.
+    assert board.pos[0] == pytest.approx(20.0, abs=0.05)
+    assert -8.0 < board.pos[1] < -7.9
+
+
+def test_a_named_place_on_an_open_floor_is_no_plate(tmp_path):
+    data = example_rmf()
+    v = data["levels"]["L1"]["vertices"]
+    v[4][1] = v[5][1] = 260  # the south wall 5 m further south: a hall 8 m deep
+    imp = import_rmf(write_example_rmf(tmp_path, data), tmp_path / "out.yaml")
+    assert imp.building.landmarks == ()
+    assert any("'notice_board': on an open floor" in s for s in imp.skipped)
 
 
 def test_the_written_files_validate_and_the_grid_has_the_walls(example, tmp_path, capsys):
