@@ -512,14 +512,24 @@ class CheckOpening(PmNavBehaviour):
 
 
 def floor_run(ctx: Context, position, heading: float, est) -> float:
-    """How far (m, at most ``FLOOR_RUN_MOST_M`` past ``position``) the map's floor runs
-    along ``heading`` (the plan's way out of the waypoint at ``position``), counted from
-    level with the estimated pose ``est``: the wall model the localization weighs depth
-    against (``ctx.walls``: the building's grid where it has one, else its corridors)."""
+    """How far (m) the map's floor runs along ``heading`` (the plan's way out of the
+    waypoint at ``position``) from the estimated pose ``est``: what depth should show from
+    where the robot believes it stands, in the wall model the localization weighs depth
+    against (``ctx.walls``: the building's grid where it has one, else its corridors).
+
+    From the estimate, not from the waypoint: on an open floor a lane's leg may pass a
+    room's corner, and a robot half a metre beside the lane has that corner ahead while
+    the waypoint has the whole floor (a corridor's side walls make the two alike). Where
+    the estimate is outside every corridor, from the waypoint, counted from level with
+    the estimate. At most ``FLOOR_RUN_MOST_M`` past the waypoint."""
     floor = ctx.walls.floor(ctx.pm, Visibility.of(ctx.pm))
-    run = floor.reach(np.asarray(position, float), np.array([heading]), FLOOR_RUN_MOST_M)
+    angle = np.array([heading])
     behind = (position[0] - est.x) * math.cos(heading) + (position[1] - est.y) * math.sin(heading)
-    return float(run[0]) + behind
+    loc = ctx.pm.locate(est.x, est.y)
+    if loc.offset <= loc.segment.width / 2.0:
+        most = FLOOR_RUN_MOST_M + max(0.0, behind)
+        return float(floor.reach(np.array([est.x, est.y], float), angle, most)[0])
+    return float(floor.reach(np.asarray(position, float), angle, FLOOR_RUN_MOST_M)[0]) + behind
 
 
 class Arrive(PmNavBehaviour):

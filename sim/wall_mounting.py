@@ -67,13 +67,21 @@ class GridMounts:
     def __init__(self, plan: FloorPlanImage) -> None:
         self.walls = RealWalls(plan)
         self.parent: dict[int, int] = {}  # mounted wall segment -> its annotated one
+        self.shift: dict[int, float] = {}  # mounted segment -> s there less s on its parent
         self.missed: set[int] = set()  # mounted segments where no real wall was found
 
     def real_wall(
         self, a, b, normal, s: float, half: float, at=None
-    ) -> tuple[tuple, tuple, tuple, bool]:
+    ) -> tuple[tuple, tuple, tuple, bool, float]:
         """Ends and normal of the real wall through the item at ``s`` on annotated wall
-        ``a``-``b`` (``half`` its half width), and whether a wall was found there.
+        ``a``-``b`` (``half`` its half width), whether a wall was found there, and how far
+        the real wall's start lies behind the annotated one's (the ``shift`` of ``s``).
+
+        The real wall runs as far as the annotated wall does and on where the grid's wall
+        runs on straight (``RealWalls.extent``): the annotated walls stop where corridors
+        meet and where a turn in front of a door ends, and a door on a slanted wall sits
+        on a sliver of the corridors' outline, while its plate and frame hang on the wall
+        the building has (a door's plate on a 0.28 m annotated wall went above the door).
 
         ``at``: the item's file point. Where it lies in the real wall or on its face
         (within ``IN_WALL_M``: an imported RMF door, drawn where the door is), the item
@@ -91,11 +99,14 @@ class GridMounts:
         if m is None:
             m = self.walls.mount(a + s * tan, n, half)
         if m is None:
-            return _xy(a), _xy(b), _xy(n), False
+            return _xy(a), _xy(b), _xy(n), False, 0.0
         nn = np.asarray(m.normal)
         tt = np.array([nn[1], -nn[0]])  # the real wall's direction, same sense as a -> b
-        start = np.asarray(m.point) - s * tt
-        return _xy(start), _xy(start + float(np.linalg.norm(b - a)) * tt), _xy(nn), True
+        back, forth = self.walls.extent(m.point, nn)
+        shift = max(0.0, back - s)
+        length = max(float(np.linalg.norm(b - a)), s + forth) + shift
+        start = np.asarray(m.point) - (s + shift) * tt
+        return _xy(start), _xy(start + length * tt), _xy(nn), True, shift
 
     def _face(self, pt: np.ndarray, normal: np.ndarray) -> np.ndarray | None:
         """The unit normal of the real wall face nearest ``pt`` (towards the free space),
@@ -113,8 +124,9 @@ class GridMounts:
                 return ways[free].mean(axis=0) / np.linalg.norm(ways[free].mean(axis=0))
         return None
 
-    def record(self, mounted: int, annotated: int, found: bool) -> None:
+    def record(self, mounted: int, annotated: int, found: bool, shift: float = 0.0) -> None:
         self.parent[mounted] = annotated
+        self.shift[mounted] = shift
         if not found:
             self.missed.add(mounted)
 
@@ -128,7 +140,8 @@ def moved_items(world) -> list[MovedItem]:
         if where is None or where[0] not in mounts.parent:
             continue  # a styled plate: it hangs by its door, on the door's wall
         wi, s = where
-        was, now = world.walls[mounts.parent[wi]].point(s), world.walls[wi].point(s)
+        parent = world.walls[mounts.parent[wi]]
+        was, now = parent.point(s - mounts.shift[wi]), world.walls[wi].point(s)
         found = wi not in mounts.missed
         out.append(MovedItem(item.id, item.kind, item.label, _xy(was), _xy(now), found))
     return out

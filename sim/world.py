@@ -704,22 +704,28 @@ class SimWorld:
         placed = self._placer.place(what, pt, half, at_foot=at_foot)
         for problem in placed.problems:
             log.warning("%s", problem)
-        return self._mount(placed.wall, placed.s, half, pt), placed.s
+        return self._mount(placed.wall, placed.s, half, pt)
 
-    def _mount(self, wi: int, s: float, half: float, pt: tuple[float, float]) -> int:
-        """Where the item at ``s`` on annotated wall ``wi`` (its file point ``pt``) hangs:
-        with grid walls, on a wall segment of its own through the grid's real wall there
-        (``GridMounts``), measured in the same ``s`` and sharing the annotated wall's
-        occupied stretches; else on ``wi``."""
+    def _mount(
+        self, wi: int, s: float, half: float, pt: tuple[float, float]
+    ) -> tuple[int, float]:
+        """Where the item at ``s`` on annotated wall ``wi`` (its file point ``pt``) hangs,
+        a wall and the distance along it: with grid walls, on a wall segment of its own
+        through the grid's real wall there, as long as that wall runs on straight
+        (``GridMounts``), measured in the same ``s`` (shifted where the real wall starts
+        before the annotated one) and sharing the annotated wall's occupied stretches;
+        else on ``wi`` at ``s``."""
         if self._mounts is None:
-            return wi
+            return wi, s
         w = self.walls[wi]
-        a, b, normal, found = self._mounts.real_wall(w.a, w.b, w.normal, s, half, at=pt)
+        a, b, normal, found, shift = self._mounts.real_wall(
+            w.a, w.b, w.normal, s, half, at=pt
+        )
         self.walls.append(WallSegment(a, b, normal))
         mounted = len(self.walls) - 1
-        self._placer.share(mounted, wi)
-        self._mounts.record(mounted, wi, found)
-        return mounted
+        self._placer.share(mounted, wi, shift)
+        self._mounts.record(mounted, wi, found, shift)
+        return mounted, s + shift
 
     def _wall_box(
         self,

@@ -9,8 +9,9 @@ What comes across, and from where (``docs/import-rmf.md`` has the details and li
 - corridors from the lanes, centred and measured in the grid (``rmf_corridors``);
 - a room per named door on a corridor (its name the door's, its door the door's centre,
   which lies in the wall the door is in);
-- a landmark per named vertex on a corridor (kind ``sign``: a name plate on the nearest
-  wall) and per lift door on this level (kind ``elevator``);
+- a landmark per named vertex on a corridor (kind ``sign``: a name plate on the real wall
+  nearest it, ``rmf_places``; none on an open floor) and per lift door on this level
+  (kind ``elevator``);
 - the start at a dead end next to a charger or a robot's spawn point, else the dead end
   nearest an outside door.
 
@@ -40,8 +41,10 @@ from pmnav_bt.map.floorplan import FloorPlanImage, load_image_plan, save_ros_map
 from pmnav_bt.map.grid import largest_component
 from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
 from pmnav_bt.map.rmf_grid import level_grid, passage_doors
+from pmnav_bt.map.rmf_places import PLACE_WALL_M, plate_on_wall
 from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
 from pmnav_bt.map.rmf_spurs import LIFT_PAST_M, PAST_M, add_spur, turn_at_door
+from pmnav_bt.map.wall_surface import RealWalls
 
 START_REACH_M = 3.0  # a dead end this near a charger or spawn point is the start
 MIN_DOOR_M = 0.3  # a door narrower than this is a drawing slip
@@ -49,9 +52,6 @@ MAX_ID = 64  # the building format's id length
 # A lift door this far beyond its corridor's wall (half its width off the centre line) is
 # on the wall still (the corridors' widths are medians, the drawing's walls wander).
 LIFT_OFF_WALL_M = 0.1
-# A named place's plate goes on a wall at most this far from the place (a corridor's
-# half width and more: an RMF place on a hall's lane may be a few metres from any wall).
-PLATE_SEARCH_M = 5.0
 
 
 class RmfImportError(PmNavError):
@@ -101,12 +101,10 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
     seg_b = np.array([cor.pos[v] for _, v, _ in cor.edges])
     half = np.array([w / 2.0 for _, _, w in cor.edges])
 
-    def reach(pt, what: str, tail: str = "", quiet: bool = False) -> bool:
+    def reach(pt, what: str, tail: str = "") -> bool:
         j, _, d = project_points_to_segments(np.asarray(pt, float)[None], seg_a, seg_b)
         limit = half[j[0]] + DOOR_REACH_SLACK
         if d[0] > limit:
-            if quiet:
-                return False
             skipped.append(
                 f"{what}: not on a corridor ({d[0]:.2f} m from the nearest centre line; "
                 f"at most {limit:.2f} m{tail})"
@@ -118,10 +116,10 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
     for d, centre, _ in doors:
         if reach(centre, f"door {d.name!r}", "; no spur along the free space reaches it"):
             rid = _unique_id(d.name, ids)
-            rooms.append(
-                {"id": rid, "name": _text(d.name), "door": _r(centre), "sign": _words(d.name)}
-            )
+            plate = room_plate(d.name)
+            rooms.append({"id": rid, "name": plate, "door": _r(centre), "sign": plate})
     door_names = {d.name for d in lvl.doors if d.name}
+    walls = RealWalls(plan)
     landmarks = []
     for i, name in enumerate(lvl.names):
         if not name:
@@ -130,11 +128,12 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             skipped.append(f"vertex {name!r}: named like a door (the room is the door's)")
         elif _is_start_point(lvl.vparams[i]):
             continue
-        elif reach(lvl.xy[i], f"vertex {name!r}"):
+        elif (plate := _place_plate(walls, lvl.xy[i], name, skipped)) is not None and reach(
+            plate, f"vertex {name!r}"
+        ):
             lid = _unique_id(name, ids)
-            pos = _plate_on_wall(lvl.xy[i], plan, free, lambda q: reach(q, "", quiet=True))
             landmarks.append(
-                {"id": lid, "kind": "sign", "name": _text(name), "pos": _r(pos),
+                {"id": lid, "kind": "sign", "name": _words(name), "pos": _r(plate),
                  "sign": _words(name)}
             )
     lift_landmarks: dict[str, list[str]] = {}
@@ -143,7 +142,7 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
             lid = _unique_id(ld.lift, ids)
             lift_landmarks.setdefault(ld.lift, []).append(lid)
             landmarks.append(
-                {"id": lid, "kind": "elevator", "name": _text(ld.lift), "pos": _r(ld.pos),
+                {"id": lid, "kind": "elevator", "name": _words(ld.lift), "pos": _r(ld.pos),
                  "sign": _words(ld.lift)}
             )
     ros_map = Path(out).stem + "_walls.yaml"
@@ -184,7 +183,8 @@ def write_import(imp: Imported, out: str | Path) -> Path:
     save_ros_map(imp.grid, out.parent / imp.data["floor_plan"]["ros_map"])
     head = [
         f"# Imported by 'pmnav map import-rmf' from {imp.level.source} level {imp.level.name}.",
-        "# Room names are the RMF door names; check the signs and the start.",
+        "# Ids are the RMF names; names and plates their words (a room's without 'door').",
+        "# Check the signs and the start.",
     ]
     return atomic_write_text(out, "\n".join(head) + "\n" + dump_building(imp.building))
 
@@ -220,6 +220,18 @@ def _doors(lvl: RmfLevel, passages: frozenset[int], skipped: list[str]) -> list:
             a, b = lvl.xy[d.a], lvl.xy[d.b]
             out.append((d, (a + b) / 2.0, b - a))
     return out
+
+
+def _place_plate(walls: RealWalls, place, name: str, skipped: list[str]):
+    """Where the plate of the named place at ``place`` hangs (``rmf_places``), or None,
+    listed as skipped, on an open floor."""
+    plate, _ = plate_on_wall(walls, place)
+    if plate is None:
+        skipped.append(
+            f"vertex {name!r}: on an open floor, no wall within {PLACE_WALL_M:g} m to hang "
+            "its plate on"
+        )
+    return plate
 
 
 def _entrances(lvl: RmfLevel, plan: FloorPlanImage) -> list[np.ndarray]:
@@ -355,32 +367,18 @@ def _words(name: str) -> str:
     return _text(text or name)
 
 
-def _plate_on_wall(pt, plan: FloorPlanImage, free: np.ndarray, on_corridor) -> np.ndarray:
-    """Where the name plate of a named place at ``pt`` hangs: the nearest wall of the grid
-    (its first cell off the corridors' ``free`` space, looking all round out to
-    ``PLATE_SEARCH_M``) that is still on a corridor (``on_corridor``); ``pt`` itself where
-    no such wall is near.
+def room_plate(door_name: str) -> str:
+    """What the plate by an imported door shows, and so the room's name: the RMF door's
+    name in words, less the word "door" ('coe_door' -> 'coe', 'L1_left_consult_rm_3_outer'
+    -> 'left consult rm 3 outer').
 
-    An RMF place is a vertex on a lane, often on the corridor's centre line or in the
-    middle of a hall: a plate there has no wall, so neither the map (which side of the
-    corridor it faces, where it can be read from) nor the simulator (which wall it
-    hangs on, a tie on the centre line) would know where it is, and the two would
-    disagree by a corridor's width. On the wall, both have it where a person would put
-    the plate: on the wall nearest the place."""
-    p0 = np.asarray(pt, float)
-    if not plan.mask_at(free, p0[None])[0]:
-        return p0  # in a wall already
-    angles = np.radians(np.arange(0.0, 360.0, 5.0))
-    ways = np.stack([np.cos(angles), np.sin(angles)], 1)
-    t = np.arange(plan.resolution / 2.0, PLATE_SEARCH_M, plan.resolution / 2.0)
-    pts = p0[None, None, :] + t[None, :, None] * ways[:, None, :]
-    ok = plan.mask_at(free, pts.reshape(-1, 2)).reshape(len(ways), len(t))
-    hits = [(float(t[k]), pts[i, k]) for i in range(len(ways)) if not ok[i].all()
-            for k in [int(np.argmin(ok[i]))]]  # fmt: skip
-    for _, q in sorted(hits, key=lambda h: h[0]):
-        if on_corridor(q):
-            return q
-    return p0
+    An RMF door name is an identifier for the fleet (it names the door, and most end in
+    "door"); a building prints what is behind the door. Kept, the word would be on every
+    plate, and a plate read in part ('oor') would fit every room alike. A name that is only
+    "door" keeps it. The room's id stays the RMF name (what RMF's door requests use)."""
+    words = _words(door_name).split()
+    kept = [w for w in words if w.casefold() not in ("door", "doors")]
+    return _text(" ".join(kept or words))
 
 
 def _r(p) -> list[float]:

@@ -107,6 +107,7 @@ class WallPlacer:
         self.walls = walls
         self.annotated = len(walls)
         self._taken: dict[int, list[tuple[float, float, str]]] = {}
+        self._shift: dict[int, float] = {}  # wall -> how far its s runs ahead of its like's
 
     def nearest(self, pt: Sequence[float]) -> tuple[int, float]:
         """Index of the annotated wall nearest to ``pt`` and the distance along it."""
@@ -121,7 +122,12 @@ class WallPlacer:
         return best, best_s
 
     def _clash(self, wall: int, s0: float, s1: float) -> tuple[float, float, str] | None:
-        return next((o for o in self._taken.get(wall, []) if s1 > o[0] and s0 < o[1]), None)
+        d = self._shift.get(wall, 0.0)
+        return next(
+            ((o[0] + d, o[1] + d, o[2]) for o in self._taken.get(wall, [])
+             if s1 - d > o[0] and s0 - d < o[1]),
+            None,
+        )  # fmt: skip
 
     def fits(self, wall: int, s0: float, s1: float) -> bool:
         """True when ``[s0, s1]`` lies on the wall and no item takes any of it."""
@@ -131,11 +137,15 @@ class WallPlacer:
         return self._clash(wall, s0, s1) is None
 
     def occupy(self, wall: int, s: float, half: float, what: str = "another item") -> None:
+        s -= self._shift.get(wall, 0.0)
         self._taken.setdefault(wall, []).append((s - half, s + half, what))
 
-    def share(self, wall: int, like: int) -> None:
-        """Make ``wall`` (a real wall an item on ``like`` hangs on) share its stretches."""
+    def share(self, wall: int, like: int, shift: float = 0.0) -> None:
+        """Make ``wall`` (a real wall an item on ``like`` hangs on) share its stretches; a
+        point ``s`` along ``like`` is ``s + shift`` along ``wall`` (a real wall that runs
+        on behind the annotated wall's start)."""
         self._taken[wall] = self._taken.setdefault(like, [])
+        self._shift[wall] = shift + self._shift.get(like, 0.0)
 
     def place(
         self, what: str, pt: Sequence[float], half: float, *, at_foot: bool = False

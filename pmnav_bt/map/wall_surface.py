@@ -40,6 +40,8 @@ MIN_RAYS = 8  # a wall needs this many rays (0.7 m of it) agreeing
 MAX_TILT_DEG = 25.0  # a fitted direction further off the annotation is not trusted
 MIN_FIT_SPAN_M = 0.6  # ... nor one fitted over less wall than this
 MAX_FIT_RMS_M = 0.05  # ... nor one the rays scatter about more than this
+FACE_M = 0.1  # a wall face: free floor this far in front of its line, wall this far behind
+EXTENT_M = 3.0  # how far a wall's run is followed from an item (a door and its plates)
 
 
 def grid_free_space(plan: FloorPlanImage) -> np.ndarray:
@@ -157,6 +159,25 @@ class RealWalls:
         nn = (n + b * t) / math.hypot(1.0, b)
         at = p0 - n * a
         return WallMount((float(at[0]), float(at[1])), (float(nn[0]), float(nn[1])), a, fitted)
+
+    def extent(self, point, normal, most: float = EXTENT_M) -> tuple[float, float]:
+        """How far the wall face at ``point`` (``normal`` into the free space) runs on
+        straight each way, back (against the wall's direction, ``normal`` turned right)
+        and forth, at most ``most`` metres: as long as the floor is free ``FACE_M`` in
+        front of the line and the wall stands ``FACE_M`` behind it. A corner, a gap, the
+        end of a wall or a slant away from the line ends it."""
+        p0 = np.asarray(point, float)
+        n = np.asarray(normal, float) / np.linalg.norm(normal)
+        t = np.array([n[1], -n[0]])
+        step = self.plan.resolution
+        u = np.arange(step, most + 1e-9, step)
+        out = []
+        for sign in (-1.0, 1.0):
+            line = p0 + sign * u[:, None] * t
+            face = self.free_at(line + FACE_M * n) & ~self.free_at(line - FACE_M * n)
+            run = int(np.argmin(face)) if not face.all() else len(u)  # samples on the face
+            out.append(float(u[run - 1]) if run else 0.0)
+        return out[0], out[1]
 
     def thickness(self, point, normal, most: float) -> float | None:
         """How far behind the wall surface at ``point`` map_server's free space begins again

@@ -63,22 +63,45 @@ def test_the_corridor_is_centred_between_the_walls_not_on_the_lane(example, tmp_
 def test_named_door_becomes_a_room_on_its_wall_and_the_charger_the_start(example, tmp_path):
     imp = import_rmf(example, tmp_path / "out.yaml")
     (room,) = imp.building.rooms
-    assert room.name == DOOR["name"] and room.door == pytest.approx(DOOR["centre"])
+    assert room.id == DOOR["name"] and room.door == pytest.approx(DOOR["centre"])
     start = imp.building.waypoint("start")
     assert start.pos[0] == pytest.approx(2.0, abs=0.1)  # the charger's end, not the other
-    assert [lm.name for lm in imp.building.landmarks] == ["notice_board"]
+    assert [lm.id for lm in imp.building.landmarks] == ["notice_board"]
+    assert [lm.name for lm in imp.building.landmarks] == ["notice board"]
     # The vertex inside the room is no landmark, and the list says why.
     assert any("'desk': not on a corridor" in s for s in imp.skipped)
 
 
-def test_a_named_place_s_plate_hangs_on_the_wall_nearest_the_place(example, tmp_path):
-    """The notice board's vertex is 0.5 m north of the south wall: its plate goes on that
-    wall's face (where the map and the simulator both hang it), along the wall from it."""
-    imp = import_rmf(example, tmp_path / "out.yaml")
-    (lm,) = imp.building.landmarks
-    face = CORRIDOR["south"] + WALL_M / 2.0
-    assert lm.pos[1] == pytest.approx(face, abs=imp.grid.resolution)
-    assert lm.pos[0] == pytest.approx(400 * SCALE_M_PER_PX, abs=1e-6)
+@pytest.mark.parametrize(
+    "door,plate",
+    [("coe_door", "coe"), ("L1_left_consult_rm_3_outer", "left consult rm 3 outer"),
+     ("door_2", "2"), ("Main_Door", "Main"), ("door", "door")],
+)
+def test_an_imported_rooms_name_is_its_plate_the_door_name_without_door(tmp_path, door, plate):
+    data = example_rmf()
+    data["levels"]["L1"]["doors"][0][2]["name"] = [1, door]
+    imp = import_rmf(write_example_rmf(tmp_path, data), tmp_path / "out.yaml")
+    (room,) = imp.building.rooms
+    assert room.id == door  # the identifier RMF's door requests use
+    assert room.name == room.sign == plate
+
+
+def test_a_named_places_plate_hangs_on_the_wall_nearest_it(tmp_path):
+    imp = import_rmf(write_example_rmf(tmp_path), tmp_path / "out.yaml")
+    (board,) = imp.building.landmarks
+    # The place is drawn 0.5 m off the south wall (its centre line at y -8, its face
+    # 0.075 m nearer): the plate is on that face, a grid cell into the wall.
+    assert board.pos[0] == pytest.approx(20.0, abs=0.05)
+    assert -8.0 < board.pos[1] < -7.9
+
+
+def test_a_named_place_on_an_open_floor_is_no_plate(tmp_path):
+    data = example_rmf()
+    v = data["levels"]["L1"]["vertices"]
+    v[4][1] = v[5][1] = 260  # the south wall 5 m further south: a hall 8 m deep
+    imp = import_rmf(write_example_rmf(tmp_path, data), tmp_path / "out.yaml")
+    assert imp.building.landmarks == ()
+    assert any("'notice_board': on an open floor" in s for s in imp.skipped)
 
 
 def test_the_written_files_validate_and_the_grid_has_the_walls(example, tmp_path, capsys):
@@ -118,7 +141,7 @@ def test_without_a_charger_the_start_is_the_dead_end_by_the_entrance(tmp_path):
     assert any("nearest an entrance" in s for s in imp.skipped)
     # The corridor ran into the entrance; it now turns in front of it, so the door is on
     # the last piece's side wall (half a spur width out), not at its end.
-    room = next(r for r in imp.building.rooms if r.name == "entrance")
+    room = next(r for r in imp.building.rooms if r.id == "entrance")
     b = imp.building
     last = next(e for e in b.edges if "start" in (e.a, e.b))
     a, c = (np.array(b.waypoint(w).pos) for w in (last.a, last.b))
@@ -133,7 +156,7 @@ def test_a_door_across_the_corridor_with_a_lane_through_it_is_a_passage(tmp_path
     v += [[450, 100, 0, ""], [450, 160, 0, ""]]  # a door across the whole corridor at x 22.5
     lvl["doors"].append([len(v) - 2, len(v) - 1, {"name": [1, "fire_door"]}])
     imp = import_rmf(write_example_rmf(tmp_path, data), tmp_path / "out.yaml")
-    assert "fire_door" not in {r.name for r in imp.building.rooms}
+    assert "fire_door" not in {r.id for r in imp.building.rooms}
     assert any("'fire_door': a passage" in s for s in imp.skipped)
     xs = sorted(w.pos[0] for w in imp.building.waypoints)
     assert xs[-1] > 25.0  # the corridor goes on through the open door
@@ -154,7 +177,7 @@ def test_a_door_in_a_side_bay_beyond_reach_gets_a_spur_along_its_wall(tmp_path):
     lvl["floors"].append({"vertices": [k, k + 1, k + 2, k + 5], "parameters": {}})
     imp = import_rmf(write_example_rmf(tmp_path, data), tmp_path / "out.yaml")
     assert imp.spurs == 1
-    room = next(r for r in imp.building.rooms if r.name == "bay_store")
+    room = next(r for r in imp.building.rooms if r.id == "bay_store")
     assert room.door == pytest.approx([25.0, -9.5])
 
 
@@ -174,7 +197,7 @@ def test_real_rmf_buildings_import_and_validate(rmf_maps, tmp_path, capsys, name
     raw = yaml.safe_load(rmf.read_text())["levels"][imp.level.name]["doors"]
     named = {d[2]["name"][1] for d in raw}
     passages = {s.split("'")[1] for s in imp.skipped if "a passage" in s}
-    rooms = {r.name for r in imp.building.rooms}
+    rooms = {r.id for r in imp.building.rooms}
     assert rooms <= named
     # Nearly every named door that is not a passage between corridors becomes a room.
     assert len(rooms) >= 0.9 * len(named - passages), sorted(named - passages - rooms)

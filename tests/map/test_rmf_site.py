@@ -40,7 +40,7 @@ def test_every_level_and_the_lift_come_across(tmp_path):
     assert site.level_names == ("L1", "L2")
     assert [lv.elevation for lv in site.levels] == [0.0, 4.0]
     assert site.level("L2").path == tmp_path / "site_L2.yaml"
-    assert [r.name for r in site.level("L2").building.rooms] == ["office_2"]
+    assert [r.id for r in site.level("L2").building.rooms] == ["office_2"]
     (lift,) = site.lifts
     assert lift.id == "lift_a" and set(lift.lobbies) == {"L1", "L2"}
     for level, lobby in lift.lobbies.items():
@@ -83,7 +83,7 @@ def test_cli_with_a_level_or_one_level_writes_a_building(tmp_path, capsys):
     rmf = write_example_rmf(tmp_path, example_rmf_two_levels())
     code, _, err = run(capsys, "map", "import-rmf", rmf, "--level", "L2", "-o", tmp_path / "b.yaml")
     assert code == 0, err
-    assert load_building(tmp_path / "b.yaml").rooms[0].name == "office_2"
+    assert load_building(tmp_path / "b.yaml").rooms[0].id == "office_2"
     one = tmp_path / "one"
     one.mkdir()
     code, _, err = run(

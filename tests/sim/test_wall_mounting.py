@@ -239,6 +239,38 @@ def test_a_door_point_already_in_the_real_wall_is_where_success_is_measured(narr
             assert goal_door_in_world(w, pm, room) == pytest.approx((x, REAL_HALF), abs=0.06)
 
 
+def test_a_real_walls_run_is_followed_to_its_end_and_capped():
+    walls = RealWalls(_plan())
+    # The top wall's face (y = 1.3) runs from x = -1.3 to 13.3; its direction with the
+    # corridor below is -x, so "back" is towards +x.
+    back, forth = walls.extent((12.0, REAL_HALF), (0.0, -1.0), most=3.0)
+    assert back == pytest.approx(13.3 - 12.0, abs=0.06)
+    assert forth == pytest.approx(3.0, abs=1e-9)
+    # The bottom wall stops at the alcove's mouth (x = 1 to 7): a gap ends its run.
+    back, forth = walls.extent((9.0, -REAL_HALF), (0.0, 1.0), most=3.0)
+    assert forth == pytest.approx(3.0, abs=1e-9) and back == pytest.approx(2.0, abs=0.06)
+
+
+def test_a_door_beyond_its_annotated_walls_end_gets_its_plate_on_the_real_wall(narrow):
+    """An imported door where the corridors' outline gives its wall no room (here past
+    the annotated corridor's end, its other side taken by the next door): the real wall
+    runs on, so the plate hangs beside the door at its height, not above the door."""
+    data = yaml.safe_load(narrow.read_text())
+    data["waypoints"][1]["pos"] = [6.0, 0.0]  # the annotated corridor ends at x = 6.8
+    data["rooms"][1]["door"] = [6.3, REAL_HALF]  # in the real wall, 1.3 m from room1's
+    data["landmarks"] = []
+    short = narrow.with_name("short_annotated_wall.yaml")
+    short.write_text(yaml.safe_dump(data))
+    with SimWorld(short, walls="grid", ceiling=False) as w:
+        door, sign = w.doors["room2"], w.signs["room2"]
+        assert door.centre == pytest.approx((6.3, REAL_HALF), abs=0.06)
+        assert sum(sign.z) / 2.0 == pytest.approx(SIGN_CENTRE_Z)
+        assert sign.centre[1] == pytest.approx(REAL_HALF, abs=0.06)
+        assert sign.centre[0] - door.centre[0] > door.width / 2.0  # beside it, past the end
+        hit = _hit(w, sign.centre[0], 3.0, SIGN_CENTRE_Z)
+        assert hit.label == "sign:room2"
+
+
 def test_sim_show_says_what_moved_and_draws_the_grid_walls(narrow, tmp_path):
     args = ["show", str(narrow), "--out", str(tmp_path), "--width", "64", "--height", "48"]
     res = CliRunner().invoke(app, [*args, "--set", "sim.walls=grid"])
