@@ -933,10 +933,12 @@ class SimWorld:
         for lid in sorted(self.lift_lobbies):
             wi, s = self._where[landmark_label(lid)]
             near, s_near = self._placer.nearest(self.building.landmark(lid).pos)
-            on = self._mounts.parent.get(wi, wi) if self._mounts else wi  # grid: the real wall's
-            if (on, round(s, 3)) != (near, round(s_near, 3)):
+            on, s_on = wi, s
+            if self._mounts:  # grid: the annotated wall of the real one, in its measure
+                on, s_on = self._mounts.parent.get(wi, wi), s - self._mounts.shift.get(wi, 0.0)
+            if (on, round(s_on, 3)) != (near, round(s_near, 3)):
                 raise SimError(
-                    f"{self.building.name}: lift {lid} hangs {abs(s - s_near):.2f} m from its "
+                    f"{self.building.name}: lift {lid} hangs {abs(s_on - s_near):.2f} m from its "
                     "point (no room on the wall there), so its cabin has no doorway; move it"
                 )
             w = self.walls[wi]
