@@ -367,15 +367,22 @@ class StartLevel(PmNavBehaviour):
 
 
 class OnNewLevel(PmNavBehaviour):
-    """The robot stands in the cabin on the ride's far level, facing the doors. Everything
+    """The robot stands in the cabin on the ride's far level, turned round. Everything
     of the level left (``OLD_LEVEL_KEYS``: the plan, what was found blocked, the belief) is
-    dropped, and the estimate restarts on the new level's map at the cabin's middle facing
-    out (``map_T_odom``, with ``ARRIVAL_SIGMA_M`` in ``pose_tracker``): the lift's word,
+    dropped, and the estimate restarts on the new level's map in the cabin
+    (``map_T_odom``, with ``ARRIVAL_SIGMA_M`` in ``pose_tracker``): the lift's word,
     which the re-localization then checks against the signs. ``ctx`` is the new level's.
 
-    Writes ``level``, ``map_T_odom``, ``pose_tracker``, ``recent_sightings``,
-    ``lift_full_seen`` and every key of ``OLD_LEVEL_KEYS`` (cleared)."""
+    The lift carries the cabin and the robot in it together: the robot's heading in the
+    cabin is the one it had there on the level left (``arrival_pose``), not the doors'
+    (it drove in along the way depth found, up to 27 degrees aside, and turned round on
+    odometry); its place is the cabin's middle, where it drove to.
 
+    Reads ``map_T_odom`` (the old level's, before it is replaced). Writes ``level``,
+    ``map_T_odom``, ``pose_tracker``, ``recent_sightings``, ``lift_full_seen`` and every
+    key of ``OLD_LEVEL_KEYS`` (cleared)."""
+
+    READS = ("map_T_odom",)
     WRITES = (
         "level", "map_T_odom", "pose_tracker", "recent_sightings", "lift_full_seen",
         *OLD_LEVEL_KEYS,
@@ -386,11 +393,11 @@ class OnNewLevel(PmNavBehaviour):
         self.ride = ride
 
     def update(self) -> Status:
+        odom = self.ctx.base.pose()
+        cabin = arrival_pose(self.ride, self.get("map_T_odom"), odom)
         for key in OLD_LEVEL_KEYS:
             self.bb.set(key, None)
         forget_stale_sightings(self)
-        odom = self.ctx.base.pose()
-        cabin = self.ride.alight.cabin_pose()
         tf = se2_compose(
             (cabin.x, cabin.y, cabin.yaw), se2_inverse((odom.x, odom.y, odom.yaw))
         )
@@ -406,6 +413,18 @@ class OnNewLevel(PmNavBehaviour):
         self.ctx.log("level", self.ride.to_level, lift=self.ride.lift, map_pose=[cabin.x, cabin.y])
         self.feedback_message = f"level {self.ride.to_level}, in {self.ride.name}"
         return Status.SUCCESS
+
+
+def arrival_pose(ride: Ride, old_map_T_odom, odom: Pose2D) -> Pose2D:
+    """The robot's map pose on the ride's far level: the middle of the cabin there, heading
+    as it was in the cabin on the level left (its estimate there, ``old_map_T_odom`` of
+    the odometry pose ``odom``, turned from the first level's cabin to the second's);
+    facing the doors when there was no estimate."""
+    out = ride.alight.cabin_pose()
+    if old_map_T_odom is None:
+        return out
+    was = wrap_angle(old_map_T_odom[2] + odom.yaw)
+    return Pose2D(out.x, out.y, wrap_angle(was - ride.board.cabin_pose().yaw + out.yaw))
 
 
 def sign_key(text: str) -> str:

@@ -106,7 +106,7 @@ def lift_subtree(
         children=[
             sequence(
                 f"{name}FixFromArrival",
-                UpdateBelief(f"{name}ArrivalBelief", ctx_to),
+                UpdateBelief(f"{name}ArrivalBelief", ctx_to, anchored=True),
                 FixFromBelief(f"{name}ArrivalFix", ctx_to),
             ),
             active_localize_subtree(ctx_to, f"{name}Localize"),
