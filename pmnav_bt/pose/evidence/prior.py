@@ -9,7 +9,9 @@ An estimate that cannot be grossly wrong has no floor (``floor=None``): after a 
 ride the robot stands at that lift's doors on the level it asked for (the lift stops
 nowhere else; a wrong floor is told by the signs, ``behaviours/lift.py``), so a place
 far from them is as unlikely as the Gaussian says, and one misread plate across the
-building cannot outweigh the lift's word.
+building cannot outweigh the lift's word. Its heading is a Gaussian too
+(``ANCHORED_HEADING_SIGMA``): the robot turned round in the cabin on odometry, and a
+hypothesis facing the other way along the corridor is ruled out, not a quarter as likely.
 """
 
 from __future__ import annotations
@@ -26,6 +28,10 @@ P_FAR = 0.005  # a place far from the estimate (the floor of the Gaussian)
 P_TURNED = 0.25  # a heading more than TURNED off the estimate's
 TURNED = math.radians(60.0)
 MIN_SIGMA_M = 0.5  # the estimate is no surer of the place than a lattice step
+# The heading of an estimate that cannot be grossly wrong: half of TURNED, so that the
+# widest way into a lift's cabin (27.5 deg aside, not known to the estimate had it been
+# lost) is about one sigma, and facing the other way along the corridor six.
+ANCHORED_HEADING_SIGMA = TURNED / 2.0
 
 
 def weigh_prior(
@@ -45,5 +51,8 @@ def weigh_prior(
     turn = np.abs(np.angle(np.exp(1j * (hyps.yaw - yaw))))
     s = max(sigma, MIN_SIGMA_M)
     near = -0.5 * (d / s) ** 2
-    logw += near if floor is None else np.maximum(near, math.log(floor))
+    if floor is None:
+        logw += near - 0.5 * (turn / ANCHORED_HEADING_SIGMA) ** 2
+        return
+    logw += np.maximum(near, math.log(floor))
     logw += np.where(turn > TURNED, math.log(P_TURNED), 0.0)
