@@ -66,6 +66,13 @@ CABIN_MARGIN_M = 0.1
 # The way into the cabin is looked for over these bearings of the 60-degree camera.
 SCAN_HALF = math.radians(27.5)
 SCAN_STEP = math.radians(2.5)
+# An open lift whose doorway is not in view is looked at again this many times, this
+# many seconds apart, before the robot says it is not at the doors: someone walking past
+# (1 m/s) clears the 1.6 m doorway in two seconds, someone waiting steps in or aside,
+# and the lift holds its doors open for the robot's session meanwhile. Waiting costs no
+# action; walking off to look elsewhere would.
+CABIN_LOOKS = 4
+CABIN_LOOK_AGAIN_S = 4.0
 # The estimate on arrival: the cabin on the new level's map, as sure as the ride put the
 # robot there (it drove in on the old level's estimate, a few tenths of a metre off).
 ARRIVAL_SIGMA_M = 0.5
@@ -234,9 +241,10 @@ class CabinHasRoom(PmNavBehaviour):
     """Look into the open cabin (``look_into_cabin``): SUCCESS with a way in, written to
     ``cabin_way``; FAILURE (LIFT_FULL) when depth sees into the cabin but no way to its
     middle, counting the full cabins of this ride in ``lift_full_seen`` and saying how many
-    of ``tries`` are spent; FAILURE (TARGET_NOT_FOUND) when no open doorway is in view
-    (the robot is not in front of the doors: its estimate is off). The frame is taken and
-    judged in the worker.
+    of ``tries`` are spent. When no open doorway is in view, someone may stand between the
+    robot and the doors: it waits ``CABIN_LOOK_AGAIN_S`` and looks again, ``CABIN_LOOKS``
+    looks in all, before FAILURE (TARGET_NOT_FOUND: the robot is not in front of the
+    doors, its estimate is off). Each frame is taken and judged in the worker.
 
     Reads and writes ``lift_full_seen``; reads ``map_T_odom``; writes ``cabin_way``."""
 
@@ -249,29 +257,47 @@ class CabinHasRoom(PmNavBehaviour):
         self.ride, self.tries = ride, tries
 
     def initialise(self) -> None:
+        self._looks = 0
+        self._look()
+
+    def _look(self) -> None:
         base, tf, d = self.ctx.base, self.get("map_T_odom"), self.ride.board
 
         def look(cancelled):
             obs = base.observe()
             return look_into_cabin(obs, map_pose(tf, obs.pose), d)
 
+        self._looks += 1
+        self._again_at = None
         self._job = self.ctx.worker.submit(look)
 
     def update(self) -> Status:
+        r = self.ride
+        if self._again_at is not None:
+            if self.ctx.now() < self._again_at:
+                return Status.RUNNING
+            self._look()
         status, look = self.poll(self._job, "looking into the lift")
         if status is not None:
             return status
-        r = self.ride
         if look.way is not None:
             self.bb.set("cabin_way", look.way)
             b, m = look.way
             self.feedback_message = f"room in {r.name}: {m:.1f} m in at {math.degrees(b):+.0f} deg"
             return Status.SUCCESS
+        if not look.beyond and self._looks < CABIN_LOOKS:
+            self._job, self._again_at = None, self.ctx.now() + CABIN_LOOK_AGAIN_S
+            self.ctx.log("lift_door_hidden", r.lift, looks=self._looks)
+            self.feedback_message = (
+                f"no open door of {r.name} in view ({self._looks} of {CABIN_LOOKS} looks): "
+                "someone in the way? looking again"
+            )
+            return Status.RUNNING
         if not look.beyond:
             return self.fail(
                 FailureCode.TARGET_NOT_FOUND,
-                f"no open door of {r.name} in view at its lobby on level {r.from_level}, "
-                "though the lift says it is open",
+                f"no open door of {r.name} in view at its lobby on level {r.from_level} in "
+                f"{CABIN_LOOKS} looks, though the lift says it is open",
             )
         seen = (self.get("lift_full_seen") or 0) + 1
         self.bb.set("lift_full_seen", seen)

@@ -15,8 +15,8 @@ from pmnav_bt.failures import FailureCode
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.lift_doorway import doorway
 from pmnav_bt.map.priori_map import parse_building
-from pmnav_bt.seams import Pose2D
-from pmnav_bt.testing.doubles import ScriptedGrounder
+from pmnav_bt.seams import LiftDoor, Pose2D
+from pmnav_bt.testing.doubles import FakeObstacle, ScriptedGrounder
 from pmnav_bt.testing.fake_lift import FakeLift
 from pmnav_bt.trees.lift import lift_subtree
 
@@ -116,3 +116,31 @@ def test_signs_of_another_level_on_arrival_fail_wrong_level(make_rig, levels):
     assert f.code == FailureCode.WRONG_LEVEL, f
     assert "level L5's" in f.message and "not level L4's" in f.message and '"5' in f.message
     assert lift.true_level == "L5"
+
+
+def test_people_before_the_doors_are_waited_for_not_taken_for_a_lost_lift(make_rig, levels):
+    """Two people stand talking between the lobby and the open doors, then walk off:
+    the robot looks again while the lift holds its doors, and rides."""
+    rig, tree, lift, ride = ride_rig(make_rig, levels)
+    d = ride.board
+    (cx, cy), (ux, uy) = d.lobby, d.into
+    group = [
+        FakeObstacle.standing(cx + 0.75 * ux - uy * a, cy + 0.75 * uy + ux * a, 0.3)
+        for a in (-0.3, 0.3)
+    ]  # fmt: skip
+    rig.body.obstacles.extend(group)
+    opened: list[float] = []
+
+    def walk_off(dt: float) -> None:
+        now = rig.base.clock.now()
+        if not opened and lift.state(lift.name).door == LiftDoor.OPEN:
+            opened.append(now)
+        if opened and now >= opened[0] + 6.0:
+            for person in group:
+                if person in rig.body.obstacles:
+                    rig.body.obstacles.remove(person)
+
+    rig.base.clock.on_wait(walk_off)
+    rig.expect(rig.run(tree, MAX_TICKS), Status.SUCCESS)
+    kinds = [e.kind for e in rig.ctx.trace]
+    assert "lift_door_hidden" in kinds and rig.get("level") == "L4"
