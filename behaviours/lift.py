@@ -41,11 +41,12 @@ from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import heading, se2_compose, se2_inverse, wrap_angle
+from pmnav_bt.geometry import heading, se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.lift_doorway import CABIN_DEPTH_M, DOORWAY_WALL_M, Doorway
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.hypotheses import FIX_MASS
 from pmnav_bt.seams import (
     CREATE3_RADIUS_M,
     Lift,
@@ -76,6 +77,10 @@ CABIN_LOOK_AGAIN_S = 4.0
 # The estimate on arrival: the cabin on the new level's map, as sure as the ride put the
 # robot there (it drove in on the old level's estimate, a few tenths of a metre off).
 ARRIVAL_SIGMA_M = 0.5
+# The lift's word stands when the arrival belief's likeliest place is this many of the
+# estimate's sigmas from it (and at least STANDS_MIN_M: a lattice step and a half).
+STANDS_SIGMAS = 2.0
+STANDS_MIN_M = 0.75
 # Signs of another level read on arrival: this many, and more than of the level asked,
 # say the lift stopped at the wrong floor (one could be a misread).
 WRONG_LEVEL_SIGNS = 2
@@ -451,6 +456,46 @@ def arrival_pose(ride: Ride, old_map_T_odom, odom: Pose2D) -> Pose2D:
         return out
     was = wrap_angle(old_map_T_odom[2] + odom.yaw)
     return Pose2D(out.x, out.y, wrap_angle(was - ride.board.cabin_pose().yaw + out.yaw))
+
+
+class LiftWordStands(PmNavBehaviour):
+    """After the arrival look, when the belief cannot sharpen the estimate (one plate
+    read, a lift's own plate a metre or two from its point, is too loose for a fix) but
+    agrees with it: ``FIX_MASS`` of the belief lies where the lift's word puts the robot,
+    within ``STANDS_SIGMAS`` of the estimate's uncertainty. Then the estimate stands as the
+    ride gave it (``OnNewLevel``) and the belief is dropped: looking round again and
+    driving to read more, as a robot lost must, spends actions on what the lift already
+    told. FAILURE when the belief does not agree (something is odd: the localization
+    subtree then looks further).
+
+    Reads ``belief``, ``map_T_odom``, ``pose_tracker``; writes ``belief``."""
+
+    READS = ("belief", "map_T_odom", "pose_tracker")
+    WRITES = ("belief",)
+
+    def update(self) -> Status:
+        belief, tf = self.get("belief"), self.get("map_T_odom")
+        tracker = self.get("pose_tracker")
+        if belief is None or belief.ref is None or tf is None or tracker is None:
+            return Status.FAILURE
+        est = se2_apply(tf, (belief.ref.x, belief.ref.y))  # both at the belief's reference
+        off = np.linalg.norm(belief.xy - est, axis=1)
+        allowed = max(STANDS_SIGMAS * tracker.sigma(self.ctx.odometer.distance), STANDS_MIN_M)
+        share = float(belief.weights()[off <= allowed].sum())
+        if share < FIX_MASS:
+            self.feedback_message = (
+                f"{share:.0%} of the belief within {allowed:.1f} m of the lift's word"
+            )
+            return Status.FAILURE
+        self.bb.set("belief", None)
+        est_x, est_y = (float(v) for v in se2_apply(tf, _xy(self.ctx.base.pose())))
+        self.ctx.log("fix", "the lift's word", map_pose=[est_x, est_y], share=share)
+        self.feedback_message = f"at ({est_x:.1f}, {est_y:.1f}): the lift's word stands"
+        return Status.SUCCESS
+
+
+def _xy(p: Pose2D) -> tuple[float, float]:
+    return p.x, p.y
 
 
 def sign_key(text: str) -> str:
