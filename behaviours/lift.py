@@ -17,8 +17,11 @@ leaves, in the order ``trees/lift.py`` strings them:
 - ``StartLevel``: the mission's first leaf: the level it starts on;
 - ``OnNewLevel``: in the cabin on the far level: the old level's estimate, plan and what
   was found blocked are dropped; the estimate restarts at the cabin on the new level's
-  map, with the lift's word as its only evidence (a prior, ``ARRIVAL_SIGMA_M``), for
-  the re-localization to confirm;
+  map, heading as the robot stood in the cabin (``arrival_pose``), with the lift's word
+  as its only evidence (a prior, ``ARRIVAL_SIGMA_M``), for the re-localization to
+  confirm;
+- ``LiftWordStands``: the arrival look agrees with the lift's word but cannot sharpen it
+  (the lift's own plate alone): the estimate stands;
 - ``CheckLevel``: the signs read on arrival name places of the level asked, not of
   another (WRONG_LEVEL).
 
@@ -77,8 +80,8 @@ CABIN_LOOK_AGAIN_S = 4.0
 # The estimate on arrival: the cabin on the new level's map, as sure as the ride put the
 # robot there (it drove in on the old level's estimate, a few tenths of a metre off).
 ARRIVAL_SIGMA_M = 0.5
-# The lift's word stands when the arrival belief's likeliest place is this many of the
-# estimate's sigmas from it (and at least STANDS_MIN_M: a lattice step and a half).
+# The lift's word stands when FIX_MASS of the arrival belief lies within this many of the
+# estimate's sigmas of it (and at least STANDS_MIN_M: a lattice step and a half).
 STANDS_SIGMAS = 2.0
 STANDS_MIN_M = 0.75
 # Signs of another level read on arrival: this many, and more than of the level asked,
