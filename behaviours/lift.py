@@ -49,7 +49,7 @@ from pmnav_bt.map.building import Building
 from pmnav_bt.map.lift_doorway import CABIN_DEPTH_M, DOORWAY_WALL_M, Doorway
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.pose.correction import PoseTracker
-from pmnav_bt.pose.hypotheses import FIX_MASS
+from pmnav_bt.pose.hypotheses import CLUSTER_M, FIX_MASS
 from pmnav_bt.seams import (
     CREATE3_RADIUS_M,
     Lift,
@@ -80,10 +80,6 @@ CABIN_LOOK_AGAIN_S = 4.0
 # The estimate on arrival: the cabin on the new level's map, as sure as the ride put the
 # robot there (it drove in on the old level's estimate, a few tenths of a metre off).
 ARRIVAL_SIGMA_M = 0.5
-# The lift's word stands when FIX_MASS of the arrival belief lies within this many of the
-# estimate's sigmas of it (and at least STANDS_MIN_M: a lattice step and a half).
-STANDS_SIGMAS = 2.0
-STANDS_MIN_M = 0.75
 # Signs of another level read on arrival: this many, and more than of the level asked,
 # say the lift stopped at the wrong floor (one could be a misread).
 WRONG_LEVEL_SIGNS = 2
@@ -464,30 +460,29 @@ def arrival_pose(ride: Ride, old_map_T_odom, odom: Pose2D) -> Pose2D:
 class LiftWordStands(PmNavBehaviour):
     """After the arrival look, when the belief cannot sharpen the estimate (one plate
     read, a lift's own plate a metre or two from its point, is too loose for a fix) but
-    agrees with it: ``FIX_MASS`` of the belief lies where the lift's word puts the robot,
-    within ``STANDS_SIGMAS`` of the estimate's uncertainty. Then the estimate stands as the
-    ride gave it (``OnNewLevel``) and the belief is dropped: looking round again and
-    driving to read more, as a robot lost must, spends actions on what the lift already
-    told. FAILURE when the belief does not agree (something is odd: the localization
-    subtree then looks further).
+    agrees with it: ``FIX_MASS`` of the belief lies in one place (a cluster,
+    ``CLUSTER_M``) about where the lift's word puts the robot. What was read places the
+    robot no better than that; the ride (the cabin's middle, a drive out on odometry)
+    places it to a few tenths. So the estimate stands as the ride gave it (``OnNewLevel``)
+    and the belief is dropped: looking round again and driving to read more, as a robot
+    lost must, spends actions on what the lift already told. FAILURE when the belief does
+    not agree (something is odd: the localization subtree then looks further).
 
-    Reads ``belief``, ``map_T_odom``, ``pose_tracker``; writes ``belief``."""
+    Reads ``belief``, ``map_T_odom``; writes ``belief``."""
 
-    READS = ("belief", "map_T_odom", "pose_tracker")
+    READS = ("belief", "map_T_odom")
     WRITES = ("belief",)
 
     def update(self) -> Status:
         belief, tf = self.get("belief"), self.get("map_T_odom")
-        tracker = self.get("pose_tracker")
-        if belief is None or belief.ref is None or tf is None or tracker is None:
+        if belief is None or belief.ref is None or tf is None:
             return Status.FAILURE
         est = se2_apply(tf, (belief.ref.x, belief.ref.y))  # both at the belief's reference
         off = np.linalg.norm(belief.xy - est, axis=1)
-        allowed = max(STANDS_SIGMAS * tracker.sigma(self.ctx.odometer.distance), STANDS_MIN_M)
-        share = float(belief.weights()[off <= allowed].sum())
+        share = float(belief.weights()[off <= CLUSTER_M].sum())
         if share < FIX_MASS:
             self.feedback_message = (
-                f"{share:.0%} of the belief within {allowed:.1f} m of the lift's word"
+                f"{share:.0%} of the belief within {CLUSTER_M:.0f} m of the lift's word"
             )
             return Status.FAILURE
         self.bb.set("belief", None)
