@@ -25,6 +25,7 @@ from pmnav_bt.perception.read_range import sign_lead_range, sign_recall, sign_vi
 from pmnav_bt.planning.resolve import resolve_room
 from pmnav_bt.pose.belief import CorridorBelief
 from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.evidence.prior import P_FAR
 from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.landmark_fix import Sighting, fix_pose, sighting
 from pmnav_bt.pose.odometry import CalibratedBase, rotation_scale_error
@@ -160,12 +161,20 @@ class UpdateBelief(PmNavBehaviour):
     worker, on a fork of the belief (``CorridorBelief.fork``) that replaces it when done:
     a look halted half-way leaves the belief as it was.
 
+    ``anchored``: the estimate a new belief starts from cannot be grossly wrong (the lift's
+    word on arrival, ``behaviours/lift.py``): a place far from it is ruled out as the
+    Gaussian rules it out, not kept possible (``evidence.prior``).
+
     Reads ``views``, ``belief``, ``map_T_odom``, ``pose_tracker``, ``goal``; writes ``belief``.
     """
 
     READS = ("views", "belief", "map_T_odom", "pose_tracker", "goal")
     WRITES = ("belief",)
     JOBS = ("_job",)
+
+    def __init__(self, name: str, ctx: Context, anchored: bool = False):
+        super().__init__(name, ctx)
+        self.anchored = anchored
 
     def initialise(self) -> None:
         ctx, views, belief = self.ctx, self.get("views") or [], self.get("belief")
@@ -177,7 +186,8 @@ class UpdateBelief(PmNavBehaviour):
 
         def job(cancelled):
             read = read_panorama(ctx, views)
-            b = _new_belief(ctx, goal, prior) if belief is None else belief.fork()
+            floor = None if self.anchored else P_FAR
+            b = _new_belief(ctx, goal, prior, floor) if belief is None else belief.fork()
             _rescale(b, ctx.base)  # a new gain weighs every hypothesis again
             seen: dict[Entity, tuple[float, float]] = {}
             for s in read.sightings:
@@ -212,9 +222,10 @@ class UpdateBelief(PmNavBehaviour):
         return Status.SUCCESS
 
 
-def _new_belief(ctx, goal, prior) -> CorridorBelief:
+def _new_belief(ctx, goal, prior, floor: float | None = P_FAR) -> CorridorBelief:
     """A belief with no glimpse yet, for ``goal`` (its door is where to look first), with
-    ``prior`` ((map_T_odom, sigma m) of the estimate so far; None: none)."""
+    ``prior`` ((map_T_odom, sigma m) of the estimate so far; None: none) and ``floor``
+    (how likely that estimate is grossly wrong; None: it cannot be)."""
     cfg, pm = ctx.config, ctx.pm
     belief = CorridorBelief(
         pm,
@@ -225,6 +236,7 @@ def _new_belief(ctx, goal, prior) -> CorridorBelief:
         walls=ctx.walls,
     )
     belief.prior = prior
+    belief.prior_floor = floor
     return belief
 
 

@@ -17,8 +17,11 @@ leaves, in the order ``trees/lift.py`` strings them:
 - ``StartLevel``: the mission's first leaf: the level it starts on;
 - ``OnNewLevel``: in the cabin on the far level: the old level's estimate, plan and what
   was found blocked are dropped; the estimate restarts at the cabin on the new level's
-  map, with the lift's word as its only evidence (a prior, ``ARRIVAL_SIGMA_M``), for
-  the re-localization to confirm;
+  map, heading as the robot stood in the cabin (``arrival_pose``), with the lift's word
+  as its only evidence (a prior, ``ARRIVAL_SIGMA_M``), for the re-localization to
+  confirm;
+- ``LiftWordStands``: the arrival look agrees with the lift's word but cannot sharpen it
+  (the lift's own plate alone): the estimate stands;
 - ``CheckLevel``: the signs read on arrival name places of the level asked, not of
   another (WRONG_LEVEL).
 
@@ -41,11 +44,12 @@ from pmnav_bt.behaviours.context import Context, map_pose
 from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.control import goto_command
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import heading, se2_compose, se2_inverse, wrap_angle
+from pmnav_bt.geometry import heading, se2_apply, se2_compose, se2_inverse, wrap_angle
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.lift_doorway import CABIN_DEPTH_M, DOORWAY_WALL_M, Doorway
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.hypotheses import CLUSTER_M, FIX_MASS
 from pmnav_bt.seams import (
     CREATE3_RADIUS_M,
     Lift,
@@ -66,6 +70,13 @@ CABIN_MARGIN_M = 0.1
 # The way into the cabin is looked for over these bearings of the 60-degree camera.
 SCAN_HALF = math.radians(27.5)
 SCAN_STEP = math.radians(2.5)
+# An open lift whose doorway is not in view is looked at again this many times, this
+# many seconds apart, before the robot says it is not at the doors: someone walking past
+# (1 m/s) clears the 1.6 m doorway in two seconds, someone waiting steps in or aside,
+# and the lift holds its doors open for the robot's session meanwhile. Waiting costs no
+# action; walking off to look elsewhere would.
+CABIN_LOOKS = 4
+CABIN_LOOK_AGAIN_S = 4.0
 # The estimate on arrival: the cabin on the new level's map, as sure as the ride put the
 # robot there (it drove in on the old level's estimate, a few tenths of a metre off).
 ARRIVAL_SIGMA_M = 0.5
@@ -234,9 +245,10 @@ class CabinHasRoom(PmNavBehaviour):
     """Look into the open cabin (``look_into_cabin``): SUCCESS with a way in, written to
     ``cabin_way``; FAILURE (LIFT_FULL) when depth sees into the cabin but no way to its
     middle, counting the full cabins of this ride in ``lift_full_seen`` and saying how many
-    of ``tries`` are spent; FAILURE (TARGET_NOT_FOUND) when no open doorway is in view
-    (the robot is not in front of the doors: its estimate is off). The frame is taken and
-    judged in the worker.
+    of ``tries`` are spent. When no open doorway is in view, someone may stand between the
+    robot and the doors: it waits ``CABIN_LOOK_AGAIN_S`` and looks again, ``CABIN_LOOKS``
+    looks in all, before FAILURE (TARGET_NOT_FOUND: the robot is not in front of the
+    doors, its estimate is off). Each frame is taken and judged in the worker.
 
     Reads and writes ``lift_full_seen``; reads ``map_T_odom``; writes ``cabin_way``."""
 
@@ -249,29 +261,47 @@ class CabinHasRoom(PmNavBehaviour):
         self.ride, self.tries = ride, tries
 
     def initialise(self) -> None:
+        self._looks = 0
+        self._look()
+
+    def _look(self) -> None:
         base, tf, d = self.ctx.base, self.get("map_T_odom"), self.ride.board
 
         def look(cancelled):
             obs = base.observe()
             return look_into_cabin(obs, map_pose(tf, obs.pose), d)
 
+        self._looks += 1
+        self._again_at = None
         self._job = self.ctx.worker.submit(look)
 
     def update(self) -> Status:
+        r = self.ride
+        if self._again_at is not None:
+            if self.ctx.now() < self._again_at:
+                return Status.RUNNING
+            self._look()
         status, look = self.poll(self._job, "looking into the lift")
         if status is not None:
             return status
-        r = self.ride
         if look.way is not None:
             self.bb.set("cabin_way", look.way)
             b, m = look.way
             self.feedback_message = f"room in {r.name}: {m:.1f} m in at {math.degrees(b):+.0f} deg"
             return Status.SUCCESS
+        if not look.beyond and self._looks < CABIN_LOOKS:
+            self._job, self._again_at = None, self.ctx.now() + CABIN_LOOK_AGAIN_S
+            self.ctx.log("lift_door_hidden", r.lift, looks=self._looks)
+            self.feedback_message = (
+                f"no open door of {r.name} in view ({self._looks} of {CABIN_LOOKS} looks): "
+                "someone in the way? looking again"
+            )
+            return Status.RUNNING
         if not look.beyond:
             return self.fail(
                 FailureCode.TARGET_NOT_FOUND,
-                f"no open door of {r.name} in view at its lobby on level {r.from_level}, "
-                "though the lift says it is open",
+                f"no open door of {r.name} in view at its lobby on level {r.from_level} in "
+                f"{CABIN_LOOKS} looks, though the lift says it is open",
             )
         seen = (self.get("lift_full_seen") or 0) + 1
         self.bb.set("lift_full_seen", seen)
@@ -367,15 +397,22 @@ class StartLevel(PmNavBehaviour):
 
 
 class OnNewLevel(PmNavBehaviour):
-    """The robot stands in the cabin on the ride's far level, facing the doors. Everything
+    """The robot stands in the cabin on the ride's far level, turned round. Everything
     of the level left (``OLD_LEVEL_KEYS``: the plan, what was found blocked, the belief) is
-    dropped, and the estimate restarts on the new level's map at the cabin's middle facing
-    out (``map_T_odom``, with ``ARRIVAL_SIGMA_M`` in ``pose_tracker``): the lift's word,
+    dropped, and the estimate restarts on the new level's map in the cabin
+    (``map_T_odom``, with ``ARRIVAL_SIGMA_M`` in ``pose_tracker``): the lift's word,
     which the re-localization then checks against the signs. ``ctx`` is the new level's.
 
-    Writes ``level``, ``map_T_odom``, ``pose_tracker``, ``recent_sightings``,
-    ``lift_full_seen`` and every key of ``OLD_LEVEL_KEYS`` (cleared)."""
+    The lift carries the cabin and the robot in it together: the robot's heading in the
+    cabin is the one it had there on the level left (``arrival_pose``), not the doors'
+    (it drove in along the way depth found, up to 27 degrees aside, and turned round on
+    odometry); its place is the cabin's middle, where it drove to.
 
+    Reads ``map_T_odom`` (the old level's, before it is replaced). Writes ``level``,
+    ``map_T_odom``, ``pose_tracker``, ``recent_sightings``, ``lift_full_seen`` and every
+    key of ``OLD_LEVEL_KEYS`` (cleared)."""
+
+    READS = ("map_T_odom",)
     WRITES = (
         "level", "map_T_odom", "pose_tracker", "recent_sightings", "lift_full_seen",
         *OLD_LEVEL_KEYS,
@@ -386,11 +423,11 @@ class OnNewLevel(PmNavBehaviour):
         self.ride = ride
 
     def update(self) -> Status:
+        odom = self.ctx.base.pose()
+        cabin = arrival_pose(self.ride, self.get("map_T_odom"), odom)
         for key in OLD_LEVEL_KEYS:
             self.bb.set(key, None)
         forget_stale_sightings(self)
-        odom = self.ctx.base.pose()
-        cabin = self.ride.alight.cabin_pose()
         tf = se2_compose(
             (cabin.x, cabin.y, cabin.yaw), se2_inverse((odom.x, odom.y, odom.yaw))
         )
@@ -406,6 +443,57 @@ class OnNewLevel(PmNavBehaviour):
         self.ctx.log("level", self.ride.to_level, lift=self.ride.lift, map_pose=[cabin.x, cabin.y])
         self.feedback_message = f"level {self.ride.to_level}, in {self.ride.name}"
         return Status.SUCCESS
+
+
+def arrival_pose(ride: Ride, old_map_T_odom, odom: Pose2D) -> Pose2D:
+    """The robot's map pose on the ride's far level: the middle of the cabin there, heading
+    as it was in the cabin on the level left (its estimate there, ``old_map_T_odom`` of
+    the odometry pose ``odom``, turned from the first level's cabin to the second's);
+    facing the doors when there was no estimate."""
+    out = ride.alight.cabin_pose()
+    if old_map_T_odom is None:
+        return out
+    was = wrap_angle(old_map_T_odom[2] + odom.yaw)
+    return Pose2D(out.x, out.y, wrap_angle(was - ride.board.cabin_pose().yaw + out.yaw))
+
+
+class LiftWordStands(PmNavBehaviour):
+    """After the arrival look, when the belief cannot sharpen the estimate (one plate
+    read, a lift's own plate a metre or two from its point, is too loose for a fix) but
+    agrees with it: ``FIX_MASS`` of the belief lies in one place (a cluster,
+    ``CLUSTER_M``) about where the lift's word puts the robot. What was read places the
+    robot no better than that; the ride (the cabin's middle, a drive out on odometry)
+    places it to a few tenths. So the estimate stands as the ride gave it (``OnNewLevel``)
+    and the belief is dropped: looking round again and driving to read more, as a robot
+    lost must, spends actions on what the lift already told. FAILURE when the belief does
+    not agree (something is odd: the localization subtree then looks further).
+
+    Reads ``belief``, ``map_T_odom``; writes ``belief``."""
+
+    READS = ("belief", "map_T_odom")
+    WRITES = ("belief",)
+
+    def update(self) -> Status:
+        belief, tf = self.get("belief"), self.get("map_T_odom")
+        if belief is None or belief.ref is None or tf is None:
+            return Status.FAILURE
+        est = se2_apply(tf, (belief.ref.x, belief.ref.y))  # both at the belief's reference
+        off = np.linalg.norm(belief.xy - est, axis=1)
+        share = float(belief.weights()[off <= CLUSTER_M].sum())
+        if share < FIX_MASS:
+            self.feedback_message = (
+                f"{share:.0%} of the belief within {CLUSTER_M:.0f} m of the lift's word"
+            )
+            return Status.FAILURE
+        self.bb.set("belief", None)
+        est_x, est_y = (float(v) for v in se2_apply(tf, _xy(self.ctx.base.pose())))
+        self.ctx.log("fix", "the lift's word", map_pose=[est_x, est_y], share=share)
+        self.feedback_message = f"at ({est_x:.1f}, {est_y:.1f}): the lift's word stands"
+        return Status.SUCCESS
+
+
+def _xy(p: Pose2D) -> tuple[float, float]:
+    return p.x, p.y
 
 
 def sign_key(text: str) -> str:

@@ -13,7 +13,8 @@ where the robot is on the new level (issue 40)::
         OnNewLevel                   drop the old level's estimate; the lift's word as prior
         OutOfCabin, LeaveLift        out to the lobby facing the corridor; end the session
         ArrivalLook, CheckLevel      the panorama; its signs are the level's (WRONG_LEVEL)
-        FixOnLevel: weigh that panorama and fix | the localization subtree
+        FixOnLevel: weigh that panorama and fix, or the lift's word stands when the
+                    belief agrees with it but cannot sharpen it | the localization subtree
       GiveUpLift                     any failure: end the session, keep the failure
 
 The leaves before the ride work on the level left (``ctx_from``: its map and grounder),
@@ -42,6 +43,7 @@ from pmnav_bt.behaviours.lift import (
     CallLift,
     CheckLevel,
     DriveThrough,
+    LiftWordStands,
     OnNewLevel,
     ReleaseLift,
     Ride,
@@ -106,8 +108,15 @@ def lift_subtree(
         children=[
             sequence(
                 f"{name}FixFromArrival",
-                UpdateBelief(f"{name}ArrivalBelief", ctx_to),
-                FixFromBelief(f"{name}ArrivalFix", ctx_to),
+                UpdateBelief(f"{name}ArrivalBelief", ctx_to, anchored=True),
+                Selector(
+                    f"{name}FixOrWordStands",
+                    memory=True,
+                    children=[
+                        FixFromBelief(f"{name}ArrivalFix", ctx_to),
+                        LiftWordStands(f"{name}WordStands", ctx_to),
+                    ],
+                ),
             ),
             active_localize_subtree(ctx_to, f"{name}Localize"),
         ],

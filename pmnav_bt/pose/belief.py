@@ -35,7 +35,7 @@ from pmnav_bt.pose import lead as leads
 from pmnav_bt.pose import telling
 from pmnav_bt.pose.evidence import Evidence
 from pmnav_bt.pose.evidence.floor_model import CORRIDORS, WallSource
-from pmnav_bt.pose.evidence.prior import weigh_prior
+from pmnav_bt.pose.evidence.prior import P_FAR, weigh_prior
 from pmnav_bt.pose.evidence.signs import PLACE_SIGMA_M, SIGHT_SIGMA_M
 from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.hypotheses import FIX_MASS, Hypotheses, Straightened, apply_many
@@ -65,6 +65,9 @@ class CorridorBelief:
     axis_offset: float = 0.0  # robot yaw minus corridor axis at the reference (rad)
     # A prior from an earlier estimate: map_T_odom and its position uncertainty (m).
     prior: tuple[tuple[float, float, float], float] | None = None
+    # How likely that estimate is grossly wrong (``evidence.prior``); None: it cannot be
+    # (the lift's word on arrival).
+    prior_floor: float | None = P_FAR
     pending_blocked: float | None = None  # a drive was blocked heading this way (odometry)
     # The free floor seen straight ahead while driving between glimpses (straightened
     # odometry): depth only, no look round, so no sign is missed in them.
@@ -169,7 +172,7 @@ class CorridorBelief:
         if self.ref is None:
             return
         if self.prior is not None:
-            weigh_prior(self.logw, self.hyps, self.ref, *self.prior)
+            weigh_prior(self.logw, self.hyps, self.ref, *self.prior, floor=self.prior_floor)
         tfs = self.map_T_odoms()  # the hypotheses and the reference are fixed from here
         for g in self.glimpses:
             self.evidence.look(self.logw, g, tfs, self.ref)

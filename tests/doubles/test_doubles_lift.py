@@ -15,8 +15,8 @@ from pmnav_bt.failures import FailureCode
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.lift_doorway import doorway
 from pmnav_bt.map.priori_map import parse_building
-from pmnav_bt.seams import Pose2D
-from pmnav_bt.testing.doubles import ScriptedGrounder
+from pmnav_bt.seams import LiftDoor, Pose2D
+from pmnav_bt.testing.doubles import FakeObstacle, ScriptedGrounder
 from pmnav_bt.testing.fake_lift import FakeLift
 from pmnav_bt.trees.lift import lift_subtree
 
@@ -34,14 +34,17 @@ def levels(building):
     return {"L3": building, "L4": as_floor(building, 4), "L5": as_floor(building, 5)}
 
 
-def ride_rig(make_rig, levels, *, arrive_reads: str = "L4", overrides=(), **lift):
+def ride_rig(
+    make_rig, levels, *, arrive_reads: str = "L4", hidden=frozenset(), overrides=(), **lift
+):
     """A rig localized at Lift A's lobby on L3, the lift subtree to L4, and its FakeLift
     (``lift``: its script). ``arrive_reads``: the level whose signs the robot reads on
-    arriving (another than L4: the lift stopped at the wrong floor)."""
+    arriving (another than L4: the lift stopped at the wrong floor); ``hidden``: the
+    rooms and landmarks whose signs it does not read there."""
     rig = make_rig(START, overrides=overrides)
     rig.set(map_T_odom=(0.0, 0.0, 0.0), goal="room5")
     pm_to = parse_building(levels["L4"])
-    grounder_to = ScriptedGrounder(parse_building(levels[arrive_reads]))
+    grounder_to = ScriptedGrounder(parse_building(levels[arrive_reads]), hidden=hidden)
     ctx_to = dataclasses.replace(rig.ctx, pm=pm_to, grounder=grounder_to)
     board, alight = doorway(rig.pm, "elevator1"), doorway(pm_to, "elevator1")
     ride = Ride("lift_a", "Lift A", "L3", "L4", board, alight, session="test")
@@ -116,3 +119,44 @@ def test_signs_of_another_level_on_arrival_fail_wrong_level(make_rig, levels):
     assert f.code == FailureCode.WRONG_LEVEL, f
     assert "level L5's" in f.message and "not level L4's" in f.message and '"5' in f.message
     assert lift.true_level == "L5"
+
+
+def test_people_before_the_doors_are_waited_for_not_taken_for_a_lost_lift(make_rig, levels):
+    """Two people stand talking between the lobby and the open doors, then walk off:
+    the robot looks again while the lift holds its doors, and rides."""
+    rig, tree, lift, ride = ride_rig(make_rig, levels)
+    d = ride.board
+    (cx, cy), (ux, uy) = d.lobby, d.into
+    group = [
+        FakeObstacle.standing(cx + 0.75 * ux - uy * a, cy + 0.75 * uy + ux * a, 0.3)
+        for a in (-0.3, 0.3)
+    ]  # fmt: skip
+    rig.body.obstacles.extend(group)
+    opened: list[float] = []
+
+    def walk_off(dt: float) -> None:
+        now = rig.base.clock.now()
+        if not opened and lift.state(lift.name).door == LiftDoor.OPEN:
+            opened.append(now)
+        if opened and now >= opened[0] + 6.0:
+            for person in group:
+                if person in rig.body.obstacles:
+                    rig.body.obstacles.remove(person)
+
+    rig.base.clock.on_wait(walk_off)
+    rig.expect(rig.run(tree, MAX_TICKS), Status.SUCCESS)
+    kinds = [e.kind for e in rig.ctx.trace]
+    assert "lift_door_hidden" in kinds and rig.get("level") == "L4"
+
+
+def test_the_lift_plate_alone_on_arrival_confirms_the_lift_s_word(make_rig, levels):
+    """On arrival only the lift's own plate is read (every door sign hidden): too loose
+    for a fix, but where the lift put the robot; the estimate stands, no looking further."""
+    b = levels["L4"]
+    others = {r.id for r in b.rooms} | {lm.id for lm in b.landmarks if lm.id != "elevator1"}
+    rig, tree, lift, ride = ride_rig(make_rig, levels, hidden=frozenset(others))
+    rig.expect(rig.run(tree, MAX_TICKS), Status.SUCCESS)
+    assert [e.label for e in rig.ctx.trace if e.kind == "fix"] == ["the lift's word"]
+    p, est = rig.true_pose(), rig.estimate()
+    assert math.dist((est.x, est.y), (p.x, p.y)) < 0.6
+    assert rig.get("belief") is None

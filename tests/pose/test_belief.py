@@ -21,7 +21,7 @@ from pmnav_bt.pose.belief import CorridorBelief
 from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.landmark_fix import Sighting, fix_pose
 from pmnav_bt.pose.visibility import Visibility, entity_xy
-from pmnav_bt.seams import EntityKind, Pose2D
+from pmnav_bt.seams import Entity, EntityKind, Pose2D
 
 
 @pytest.mark.parametrize("n", [1, 2, 3])
@@ -214,3 +214,30 @@ def test_a_lone_elevator_plate_does_not_fix_the_place_along_the_corridor():
     if fix is not None:
         here = se2_apply(fix[0], se2_apply(ODOM_T_MAP, truth[:2]))
         assert math.dist(here, truth[:2]) < 1.0
+
+
+@pytest.mark.parametrize("floor", [None, pytest.param("default", id="floored")])
+def test_a_misread_plate_far_off_cannot_outweigh_an_estimate_that_cannot_be_wrong(floor):
+    """Out of Lift B on the hospital's level 1, a plate read as "112" beside the robot
+    (112's door is 20 m away, in the main corridor): after a lift ride the estimate is
+    the lift's word (no floor), and the belief stays at the lift's lobby; an ordinary
+    estimate (floored) may be grossly wrong, and the plate moves the belief to 112."""
+    from pmnav_bt.map.site import load_site
+
+    site = load_site("hospital_2l")
+    pm = parse_building(next(lv.building for lv in site.levels if lv.name == "L1"))
+    true = (30.0, 12.0, -math.pi / 2)  # in the north wing at Lift B, facing south
+    odom = se2_compose(ODOM_T_MAP, true)
+    misread = se2_apply(ODOM_T_MAP, (31.2, 10.4))  # "112" on the wing's wall, 1.6 m off
+    free = tuple((true[2] + a + ODOM_T_MAP[2], free_along(pm, true, true[2] + a)) for a in
+                 np.radians(np.arange(0.0, 360.0, 20.0)))  # fmt: skip
+    g = Glimpse(Pose2D(*odom), {Entity.room("room112"): tuple(misread)}, None, free)
+    b = CorridorBelief(pm, prior=(se2_inverse(ODOM_T_MAP), 0.6))
+    if floor is None:
+        b.prior_floor = None
+    b.observe(g, axis_odom=g.odom.yaw)
+    i = int(np.argmax(b.weights()))
+    near = math.dist(b.xy[i], true[:2]) < 1.5
+    assert near == (floor is None), b.xy[i]
+    if floor is None:  # and facing the way it turned to in the cabin, not the other
+        assert abs(wrap_angle(b.yaw[i] - true[2])) < math.radians(60.0), b.yaw[i]
