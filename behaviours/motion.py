@@ -487,12 +487,13 @@ class CheckOpening(PmNavBehaviour):
         base, grounder = self.ctx.base, self.ctx.grounder
         t = self.get("target")
         est = map_pose(self.get("map_T_odom"), base.pose())
-        self._run = floor_run(self.ctx, t.position, out_heading(self.get("plan"), t), est)
+        ctx, heading = self.ctx, out_heading(self.get("plan"), t)
 
         def look(cancelled):
             obs = base.observe()
             free = None if obs.depth is None else free_distance(obs, 0.0)
-            return mask_ratios(obs, grounder), free, band_reach(obs)
+            run = floor_run(ctx, t.position, heading, est)  # the map's floor: not in a tick
+            return mask_ratios(obs, grounder), free, band_reach(obs), run
 
         self._job = self.ctx.worker.submit(look)
 
@@ -500,10 +501,10 @@ class CheckOpening(PmNavBehaviour):
         status, seen = self.poll(self._job, "checking the way ahead")
         if status is not None:
             return status
-        ratios, free, reach = seen
+        ratios, free, reach, run = seen
         t = self.get("target")
-        depth = "" if free is None else f"; depth {free:.1f} m free, the map {self._run:.1f} m"
-        if not is_open_way(ratios, free, self._run, reach):
+        depth = "" if free is None else f"; depth {free:.1f} m free, the map {run:.1f} m"
+        if not is_open_way(ratios, free, run, reach):
             return self.fail(
                 FailureCode.TARGET_NOT_FOUND,
                 f"no corridor to take at {t.landmark} (floor {ratios.floor:.2f}, "
