@@ -35,8 +35,8 @@ def test_a_mission_tree_ticks_as_py_trees_does():
     for tree in (ours, theirs):
         tree.visitors += [Seen(full=False), Seen(full=True)]
         handled = []
-        tree.add_pre_tick_handler(lambda t: handled.append("pre"))
-        tree.add_post_tick_handler(lambda t: handled.append("post"))
+        tree.add_pre_tick_handler(lambda t, h=handled: h.append("pre"))
+        tree.add_post_tick_handler(lambda t, h=handled: h.append("post"))
         tree.tick()
         tree.tick()
         assert handled == ["pre", "post", "pre", "post"]
