@@ -202,6 +202,7 @@ class UpdateBelief(PmNavBehaviour):
                 door_views=read.door_views,
             )
             b.observe(glimpse, axis_odom=read.axis)
+            b.settle()  # the fix FixFromBelief asks for next, worked out here
             return read, b, len(seen), b.best_cluster()[1]
 
         self._job = ctx.worker.submit(job)
@@ -341,7 +342,14 @@ class LookTellsNothing(PmNavBehaviour):
         self._job = None
         if belief is not None and end in SKIPPABLE_ENDS:
             pose = self.ctx.base.pose()
-            self._job = self.ctx.worker.submit(lambda c: belief.look_tells(pose))
+
+            def job(cancelled) -> bool:
+                tells = belief.look_tells(pose)
+                if not tells:
+                    belief.settle()  # no look: FixFromBelief asks this belief next
+                return tells
+
+            self._job = self.ctx.worker.submit(job)
             self.feedback_message = "weighing a look round"  # not the last decision's reason
         self._end = end
 

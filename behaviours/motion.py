@@ -20,7 +20,7 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
-from pmnav_bt.behaviours.pose import keep_on_axis, measure_walls
+from pmnav_bt.behaviours.pose import axis_correction, keep_on_axis, measure_walls
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
 from pmnav_bt.hazards import body_hazards
@@ -184,7 +184,9 @@ class DriveTo(PmNavBehaviour):
                     steer.feel(body_hazards(base, since=felt_since), obs.pose, now)
                     est = map_pose(tf, obs.pose)
                     found = self.inspect(obs, est, target)
-                    found["walls"] = measure_walls(self.ctx.grounder, obs)
+                    found["walls"] = line = measure_walls(self.ctx.grounder, obs)
+                    if line is not None and tf is not None:
+                        found["axis"] = axis_correction(self.ctx.pm, tf, obs.pose, line)
                     found["ahead"] = ahead = _toward_goal(obs, est, goal)
                     blocked = _closer_than_goal(ahead, est, goal)
                     if blocked is not None and before is not None and steer.movers(before, obs):
@@ -208,7 +210,7 @@ class DriveTo(PmNavBehaviour):
         obs, free, found = watched
         self._last_frame = obs
         if found.get("walls") is not None:
-            keep_on_axis(self, obs.pose, found["walls"])
+            keep_on_axis(self, obs.pose, found["walls"], found.get("axis"))
         self.on_watch(found, obs)
         ahead = found.get("ahead")
         if ahead is not None and self.arrived_at_wall(ahead):
@@ -485,12 +487,13 @@ class CheckOpening(PmNavBehaviour):
         base, grounder = self.ctx.base, self.ctx.grounder
         t = self.get("target")
         est = map_pose(self.get("map_T_odom"), base.pose())
-        self._run = floor_run(self.ctx, t.position, out_heading(self.get("plan"), t), est)
+        ctx, heading = self.ctx, out_heading(self.get("plan"), t)
 
         def look(cancelled):
             obs = base.observe()
             free = None if obs.depth is None else free_distance(obs, 0.0)
-            return mask_ratios(obs, grounder), free, band_reach(obs)
+            run = floor_run(ctx, t.position, heading, est)  # the map's floor: not in a tick
+            return mask_ratios(obs, grounder), free, band_reach(obs), run
 
         self._job = self.ctx.worker.submit(look)
 
@@ -498,10 +501,10 @@ class CheckOpening(PmNavBehaviour):
         status, seen = self.poll(self._job, "checking the way ahead")
         if status is not None:
             return status
-        ratios, free, reach = seen
+        ratios, free, reach, run = seen
         t = self.get("target")
-        depth = "" if free is None else f"; depth {free:.1f} m free, the map {self._run:.1f} m"
-        if not is_open_way(ratios, free, self._run, reach):
+        depth = "" if free is None else f"; depth {free:.1f} m free, the map {run:.1f} m"
+        if not is_open_way(ratios, free, run, reach):
             return self.fail(
                 FailureCode.TARGET_NOT_FOUND,
                 f"no corridor to take at {t.landmark} (floor {ratios.floor:.2f}, "

@@ -4,6 +4,7 @@ and line its heading up with the corridor walls seen in depth."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from py_trees.common import Status
 
@@ -11,7 +12,7 @@ from pmnav_bt.behaviours.belief import wall_mask
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import map_pose
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.pose.correction import PoseTracker
+from pmnav_bt.pose.correction import PoseTracker, rotated
 from pmnav_bt.pose.snap import OffMapError, snap_to_corridor
 from pmnav_bt.pose.walls import (
     WallLine,
@@ -134,22 +135,31 @@ def measure_walls(grounder, obs) -> WallLine | None:
     return line if line is not None and line.length >= MIN_WALL_LENGTH_M else None
 
 
-def keep_on_axis(b: PmNavBehaviour, odom: Pose2D, line: WallLine) -> str | None:
-    """Correct ``map_T_odom`` with a corridor wall seen while driving (from odometry pose
-    ``odom``): its direction gives the heading relative to the corridor axis, its distance
-    the position across the corridor. Writes ``map_T_odom`` and ``pose_tracker``; returns
-    what it did (None: the wall is not the corridor's, nothing changed)."""
-    if b.get("map_T_odom") is None:
-        return None
-    tracker = tracker_of(b)
-    est = map_pose(tracker.map_T_odom, odom)
-    seg = b.ctx.pm.locate(est.x, est.y).segment
-    turn = heading_correction(odom.yaw + line.angle, tracker.map_T_odom[2], seg.heading)
+@dataclass(frozen=True)
+class AxisCorrection:
+    """What a corridor wall seen while driving does to ``map_T_odom``: the estimate it was
+    worked out on (``before``), the corrected one (None: the wall is not the corridor's,
+    nothing changes) and what it did, in words."""
+
+    before: tuple[float, float, float]
+    after: tuple[float, float, float] | None
+    words: str | None
+
+
+def axis_correction(pm, map_T_odom, odom: Pose2D, line: WallLine) -> AxisCorrection:
+    """The correction a corridor wall ``line`` seen from odometry pose ``odom`` makes to
+    ``map_T_odom``: its direction gives the heading relative to the corridor axis, its
+    distance the position across the corridor (``AXIS_GAIN`` of each). Worked out in the
+    worker beside the wall's measurement (``measure_walls``): finding the corridor on the
+    map is most of a drive's slowest ticks (issue 37)."""
+    est = map_pose(map_T_odom, odom)
+    seg = pm.locate(est.x, est.y).segment
+    turn = heading_correction(odom.yaw + line.angle, map_T_odom[2], seg.heading)
     if abs(turn) > AXIS_MAX_TURN or not 0.1 < abs(line.offset) < seg.width:
-        return None
-    tracker.rotate(AXIS_GAIN * turn, (odom.x, odom.y))
-    est = map_pose(tracker.map_T_odom, odom)
-    a = b.ctx.pm.node_xy(seg.a)
+        return AxisCorrection(map_T_odom, None, None)
+    turned = rotated(map_T_odom, AXIS_GAIN * turn, (odom.x, odom.y))
+    est = map_pose(turned, odom)
+    a = pm.node_xy(seg.a)
     u = (math.cos(seg.heading), math.sin(seg.heading))
     n = (-u[1], u[0])  # the corridor's left
     lateral = n[0] * (est.x - a[0]) + n[1] * (est.y - a[1])
@@ -158,8 +168,31 @@ def keep_on_axis(b: PmNavBehaviour, odom: Pose2D, line: WallLine) -> str | None:
     wall = side * line.offset  # the wall relative to the robot, across the corridor
     true_lateral = (seg.width / 2.0 if wall > 0.0 else -seg.width / 2.0) - wall
     shift = max(-MAX_SHIFT_M, min(MAX_SHIFT_M, AXIS_GAIN * (true_lateral - lateral)))
-    x, y, yaw = tracker.map_T_odom
-    tracker.map_T_odom = (x + shift * n[0], y + shift * n[1], yaw)
+    x, y, yaw = turned
+    return AxisCorrection(
+        map_T_odom,
+        (x + shift * n[0], y + shift * n[1], yaw),
+        f"walls: heading {math.degrees(AXIS_GAIN * turn):+.1f} deg, across {shift:+.2f} m",
+    )
+
+
+def keep_on_axis(
+    b: PmNavBehaviour, odom: Pose2D, line: WallLine, worked: AxisCorrection | None = None
+) -> str | None:
+    """Correct ``map_T_odom`` with a corridor wall seen while driving (from odometry pose
+    ``odom``; ``axis_correction``), taking the correction ``worked`` out in the worker when
+    it was worked out on the estimate as it is now. Writes ``map_T_odom`` and
+    ``pose_tracker``; returns what it did (None: the wall is not the corridor's, nothing
+    changed)."""
+    if b.get("map_T_odom") is None:
+        return None
+    tracker = tracker_of(b)
+    fix = worked
+    if fix is None or fix.before != tracker.map_T_odom:
+        fix = axis_correction(b.ctx.pm, tracker.map_T_odom, odom, line)
+    if fix.after is None:
+        return None
+    tracker.map_T_odom = fix.after
     b.bb.set("map_T_odom", tracker.map_T_odom)
     b.bb.set("pose_tracker", tracker)
-    return f"walls: heading {math.degrees(AXIS_GAIN * turn):+.1f} deg, across {shift:+.2f} m"
+    return fix.words

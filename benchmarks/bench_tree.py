@@ -1,7 +1,11 @@
 """Tick latency and episode wall time of the PM-Nav tree in the simulator.
 
-Target (docs/architecture.md, a tick never blocks): p99 tick duration < 5 ms while workers are
-busy. Two worker modes are measured:
+Target (docs/architecture.md, a tick never blocks; issue 37): p99 tick under 1 ms on every
+case while workers are busy. Each tick is timed twice: its wall time, and the CPU time of
+the ticking thread (``time.thread_time``). On a shared machine the wall time carries the
+machine's load (and, in the immediate mode, the worker holding the interpreter lock); the
+CPU time is what the tree's own code costs a tick, and the target is judged on both.
+Two worker modes are measured:
 
 - deferred (the simulator's mode): background jobs run between ticks;
 - immediate (the robot's mode): jobs run in a worker thread *during* ticks. Here the
@@ -12,7 +16,10 @@ The sign_sparse_2 case starts with no sign in reach: the corridor belief is buil
 weighed with each look (``UpdateBelief``) and with the depth along each drive
 (``behaviours/follow_lead.py``), and asked whether a sign is in reach
 (``NoSignInReach``), all in the worker; the drive's rays weighed in the tick were the
-slowest ticks (10 ms of CPU each, p99 7 ms of CPU, before they moved).
+slowest ticks (10 ms of CPU each, p99 7 ms of CPU, before they moved), then the fix
+from the belief (up to 45 ms, now worked out in the worker: ``CorridorBelief.settle``).
+What is left in a tick is py_trees' own walk (about 0.1 ms) and the leaves' reading of
+what the worker sent.
 
 ``--log`` says where the tree log goes: nowhere (``none``, the default), a file
 (``file``), or the live web view (``view``: a ``pmnav view`` server fed through its
@@ -36,6 +43,8 @@ import time
 
 from pmnav_bt.config import load_config
 from pmnav_bt.experiments.evaluation import custom_episode
+
+TARGET_P99_MS = 1.0  # issue 37: the tick stays far inside the 100 ms period, even at its tail
 
 
 @contextlib.contextmanager
@@ -83,19 +92,17 @@ def attach_page(address, stop: threading.Event) -> None:
             conn.close()
 
 
-def run(
-    ep, deferred: bool, overrides=(), log: str = "none"
-) -> tuple[list[float], float, bool, int]:
+def run(ep, deferred: bool, overrides=(), log: str = "none") -> tuple[list, float, bool, int]:
     from pmnav_bt.map.catalogue import load_building
     from pmnav_bt.map.priori_map import parse_building
     from pmnav_bt.sim.odometry import simulated_robot
     from pmnav_bt.sim.world import SimWorld
-    from pmnav_bt.trees.runner import make_context, run_tree
+    from pmnav_bt.trees.runner import TickTime, make_context, run_tree
 
     cfg = load_config(None, list(overrides))
     b = load_building(ep.building)
     pm = parse_building(b)
-    durations: list[float] = []
+    times: list[TickTime] = []
     t0 = time.perf_counter()
     with SimWorld(b) as world:
         _, base = simulated_robot(world, cfg.sim, ep.start_pose, ep.seed)
@@ -103,8 +110,8 @@ def run(
             base, pm, cfg, seed=ep.seed, budget=ep.step_budget * 2, deferred_work=deferred
         )
         with tree_log(log) as sink:
-            out = run_tree(ctx, ep.goal, log=sink, tick_durations=durations)
-    return durations, time.perf_counter() - t0, out.success, out.ticks
+            out = run_tree(ctx, ep.goal, log=sink, tick_times=times)
+    return times, time.perf_counter() - t0, out.success, out.ticks
 
 
 def pct(xs: list[float], q: float) -> float:
@@ -135,21 +142,33 @@ def main() -> None:
     if args.case:
         cases = [c for c in cases if c[0] == args.case]
     print(
-        f"{'episode':<34} {'mode':<9} {'ticks':>6} {'median ms':>9} {'p99 ms':>7} "
-        f"{'max ms':>7} {'wall s':>7} {'sim s/wall s':>12} ok"
+        f"{'episode':<34} {'mode':<9} {'ticks':>6} "
+        f"{'wall: median':>12} {'p99':>6} {'max':>6}  {'cpu: median':>11} {'p99':>6} {'max':>6} "
+        f"{'wall s':>7} {'sim s/wall s':>12} ok   (tick times in ms)"
     )
+    worst = {"wall": 0.0, "cpu": 0.0}
     for building, goal, start in cases:
         ep = custom_episode(building, goal, start)
         for deferred in (True, False):
-            d, wall, ok, ticks = run(ep, deferred, args.set, args.log)
-            ms = [1e3 * x for x in d]
+            times, wall, ok, ticks = run(ep, deferred, args.set, args.log)
             name = f"{building}:{goal} from {start or 'start'}"
+            row = {}
+            for kind in ("wall", "cpu"):
+                ms = [1e3 * getattr(t, kind) for t in times]
+                row[kind] = (statistics.median(ms), pct(ms, 0.99), max(ms))
+                worst[kind] = max(worst[kind], row[kind][1])
+            w, c = row["wall"], row["cpu"]
             print(
                 f"{name:<34} {'deferred' if deferred else 'immediate':<9} {ticks:>6} "
-                f"{statistics.median(ms):>9.3f} {pct(ms, 0.99):>7.2f} {max(ms):>7.1f} "
+                f"{w[0]:>12.3f} {w[1]:>6.2f} {w[2]:>6.1f}  {c[0]:>11.3f} {c[1]:>6.2f} {c[2]:>6.1f} "
                 f"{wall:>7.1f} {ticks * 0.1 / wall:>12.1f} {ok}"
             )
-    print("target: p99 tick < 5 ms")
+    for kind in ("wall", "cpu"):
+        verdict = "met" if worst[kind] < TARGET_P99_MS else "NOT met"
+        print(
+            f"target p99 tick < {TARGET_P99_MS:g} ms on every case, {kind} time: {verdict} "
+            f"(worst p99 {worst[kind]:.2f} ms)"
+        )
 
 
 if __name__ == "__main__":

@@ -84,24 +84,41 @@ def project_points_to_segments(
 
     points (N,2), seg_a/seg_b (M,2). Returns (index of nearest segment (N,),
     parameter t in [0,1] along it (N,), distance (N,)). Uses an STR-tree, so large
-    maps cost O(N log M).
+    maps cost O(N log M); to ask about the same segments again and again, keep a
+    ``SegmentIndex``.
     """
-    points = np.asarray(points, dtype=float).reshape(-1, 2)
-    seg_a = np.asarray(seg_a, dtype=float).reshape(-1, 2)
-    seg_b = np.asarray(seg_b, dtype=float).reshape(-1, 2)
-    n = len(points)
-    if n == 0 or len(seg_a) == 0:
-        return np.zeros(n, dtype=int), np.zeros(n), np.full(n, np.inf)
-    lines = shapely.linestrings(np.stack([seg_a, seg_b], axis=1))
-    tree = shapely.STRtree(lines)
-    pairs = tree.query_nearest(shapely.points(points), all_matches=False)
-    idx = np.empty(n, dtype=int)
-    idx[pairs[0]] = pairs[1]
-    a, d = seg_a[idx], seg_b[idx] - seg_a[idx]
-    len2 = np.maximum((d * d).sum(axis=1), 1e-12)
-    t = np.clip(((points - a) * d).sum(axis=1) / len2, 0.0, 1.0)
-    dist = np.linalg.norm(points - (a + t[:, None] * d), axis=1)
-    return idx, t, dist
+    return SegmentIndex(seg_a, seg_b).project(points)
+
+
+class SegmentIndex:
+    """Segments (seg_a/seg_b (M,2)) with their STR-tree built once: ``project`` answers
+    as ``project_points_to_segments`` does. Building the tree is most of the cost of
+    asking about one point (80 of 90 us on a 27-segment map), which a tick that asks
+    where the robot is along its corridor cannot spend (issue 37: tick p99 under 1 ms)."""
+
+    def __init__(self, seg_a: np.ndarray, seg_b: np.ndarray):
+        self.seg_a = np.asarray(seg_a, dtype=float).reshape(-1, 2)
+        self.seg_b = np.asarray(seg_b, dtype=float).reshape(-1, 2)
+        self._tree = None
+        if len(self.seg_a):
+            self._tree = shapely.STRtree(
+                shapely.linestrings(np.stack([self.seg_a, self.seg_b], axis=1))
+            )
+
+    def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(index of the nearest segment, t in [0,1] along it, distance) for each point."""
+        points = np.asarray(points, dtype=float).reshape(-1, 2)
+        n = len(points)
+        if n == 0 or self._tree is None:
+            return np.zeros(n, dtype=int), np.zeros(n), np.full(n, np.inf)
+        pairs = self._tree.query_nearest(shapely.points(points), all_matches=False)
+        idx = np.empty(n, dtype=int)
+        idx[pairs[0]] = pairs[1]
+        a, d = self.seg_a[idx], self.seg_b[idx] - self.seg_a[idx]
+        len2 = np.maximum((d * d).sum(axis=1), 1e-12)
+        t = np.clip(((points - a) * d).sum(axis=1) / len2, 0.0, 1.0)
+        dist = np.linalg.norm(points - (a + t[:, None] * d), axis=1)
+        return idx, t, dist
 
 
 # -- planar rigid transforms, as (x, y, yaw) triples ------------------------------------

@@ -1,6 +1,7 @@
 """What every tree variant's tree is made of at the top: its mission beside the Monitor
-(action budget, body faults), the goal on the blackboard; and the one composite the
-missions are strung from, a sequence that remembers where it is."""
+(action budget, body faults), the goal on the blackboard; the one composite the missions
+are strung from, a sequence that remembers where it is; and the tree that ticks them
+(``MissionTree``)."""
 
 from __future__ import annotations
 
@@ -19,6 +20,44 @@ def sequence(name: str, *children: py_trees.behaviour.Behaviour) -> Sequence:
     return Sequence(name, memory=True, children=list(children))
 
 
+class MissionTree(py_trees.trees.BehaviourTree):
+    """py_trees' ``BehaviourTree``, ticked the same way, but walking the whole tree after a
+    tick only when a visitor asks to see every node (``visitor.full``).
+
+    py_trees walks all the nodes after every tick, with or without such a visitor. For
+    PM-Nav's 128 nodes, 16 deep, that walk (about a thousand generator steps) is a fifth
+    of a tick's median CPU time (0.1 ms), spent on nothing: the tree's own visitors (the
+    tree log's ``SnapshotVisitor``, the live display's) see only the nodes ticked, which
+    the tick itself hands them (issue 37: tick p99 under 1 ms)."""
+
+    def tick(self, pre_tick_handler=None, post_tick_handler=None) -> None:
+        """One tick: the handlers before, the tick (each ticked node shown to the visitors
+        that see only those), the whole tree shown to the visitors that see every node,
+        the handlers after; as ``BehaviourTree.tick``."""
+        if pre_tick_handler is not None:
+            pre_tick_handler(self)
+        for handler in self.pre_tick_handlers:
+            handler(self)
+        for visitor in self.visitors:
+            visitor.initialise()
+        ticked = [v for v in self.visitors if not v.full]
+        for node in self.root.tick():
+            for visitor in ticked:
+                node.visit(visitor)
+        full = [v for v in self.visitors if v.full]
+        if full:
+            for node in self.root.iterate():
+                for visitor in full:
+                    node.visit(visitor)
+        for visitor in self.visitors:
+            visitor.finalise()
+        for handler in self.post_tick_handlers:
+            handler(self)
+        if post_tick_handler is not None:
+            post_tick_handler(self)
+        self.count += 1
+
+
 def monitored_mission(
     ctx: Context, name: str, mission: py_trees.behaviour.Behaviour, goal: str
 ) -> py_trees.trees.BehaviourTree:
@@ -33,4 +72,4 @@ def monitored_mission(
     bb = py_trees.blackboard.Client(name="setup", namespace=NAMESPACE)
     bb.register_key(key="goal", access=Access.WRITE)
     bb.goal = goal
-    return py_trees.trees.BehaviourTree(root)
+    return MissionTree(root)

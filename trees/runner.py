@@ -34,6 +34,16 @@ if TYPE_CHECKING:
     from pmnav_bt.map.floorplan import FloorPlanImage
 
 
+@dataclass(frozen=True)
+class TickTime:
+    """What one tick took, in seconds: ``wall`` on the clock, ``cpu`` of the ticking
+    thread's own CPU time (``time.thread_time``), which other processes' load and the
+    worker's threads do not inflate: what the tree's code costs."""
+
+    wall: float
+    cpu: float
+
+
 @dataclass
 class RunOutcome:
     """How a run ended."""
@@ -132,7 +142,7 @@ def run_tree(
     log: TextIO | None = None,
     on_tick: Callable[[py_trees.trees.BehaviourTree], None] | None = None,
     sync_workers: bool = True,
-    tick_durations: list[float] | None = None,
+    tick_times: list[TickTime] | None = None,
     view: ViewRecorder | None = None,
     build: Callable[[Context, str], py_trees.trees.BehaviourTree] | None = None,
     ended_on: Callable[[], Context] | None = None,
@@ -144,7 +154,7 @@ def run_tree(
     ``ended_on``: the context of the level the run ended on, whose map explains a failure
     (default ``ctx``).
 
-    ``tick_durations`` (optional) collects the wall time of every tick, in seconds.
+    ``tick_times`` (optional) collects what every tick took (wall and CPU time).
     ``log``: write the tree log here, each tick's ``view`` entry made by ``view`` (default
     a ViewRecorder that knows the building by the map's name and no true pose).
     """
@@ -160,15 +170,15 @@ def run_tree(
     try:
         tree.setup()
         while tree.count < max_ticks:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.thread_time()
             try:
                 tree.tick()
             except Exception as err:  # noqa: BLE001 - a bug in a leaf ends the run, reported
                 crash = failure_from(err, "tick")
                 status = py_trees.common.Status.FAILURE
                 break
-            if tick_durations is not None:
-                tick_durations.append(time.perf_counter() - t0)
+            if tick_times is not None:
+                tick_times.append(TickTime(time.perf_counter() - t0, time.thread_time() - c0))
             if on_tick is not None:
                 on_tick(tree)  # outside the guard: a handler may end the run (cancel)
             status = tree.root.status

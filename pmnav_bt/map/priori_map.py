@@ -21,7 +21,13 @@ import networkx as nx
 import numpy as np
 
 from pmnav_bt.errors import UnknownNameError
-from pmnav_bt.geometry import compass, heading, project_points_to_segments, side_of
+from pmnav_bt.geometry import (
+    SegmentIndex,
+    compass,
+    heading,
+    project_points_to_segments,
+    side_of,
+)
 from pmnav_bt.map.building import Building
 
 # Room waypoints closer than this (metres, along one corridor) share one map node,
@@ -173,10 +179,14 @@ class PrioriMap:
             names[:5],
         )
 
+    @cached_property
+    def _segment_index(self) -> SegmentIndex:
+        return SegmentIndex(*self._segment_arrays)
+
     def locate(self, x: float, y: float) -> SegmentPosition:
-        """Project a map position onto the nearest segment."""
-        a, b = self._segment_arrays
-        j, t, d = project_points_to_segments(np.array([[x, y]]), a, b)
+        """Project a map position onto the nearest segment (the segments' index is built
+        once: a tick may ask)."""
+        j, t, d = self._segment_index.project(np.array([[x, y]]))
         return SegmentPosition(self.segments[int(j[0])], float(t[0]), float(d[0]))
 
     def segments_at(self, node_id: str) -> list[Segment]:

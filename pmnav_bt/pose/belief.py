@@ -94,6 +94,11 @@ class CorridorBelief:
     # walls' axis in it at the last glimpse (None: not measured, or not taken).
     _odo: Straightened | None = field(default=None, init=False, repr=False)
     _last_axis: float | None = field(default=None, init=False, repr=False)
+    # What ``fix`` and ``best_cluster`` answer for the belief as it is (None: not worked
+    # out since it last changed). ``settle`` works them out in the worker, so that the
+    # tick that asks (``FixFromBelief``) reads them: on a sign-sparse building's belief a
+    # fix weighs every depth ray held against the walls (tens of ms).
+    _answers: dict | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm, self.read_range)
@@ -167,6 +172,7 @@ class CorridorBelief:
 
     def _build(self) -> None:
         """The hypotheses afresh, weighed by everything held."""
+        self._answers = None
         self.hyps = Hypotheses.on_lattice(self.vis, self.pm.segments, self.axis_offset)
         self.logw = np.zeros(len(self.hyps))
         if self.ref is None:
@@ -188,6 +194,7 @@ class CorridorBelief:
         glimpse (the reference) it sets the hypotheses' headings; later, how far it has
         turned (mod pi/2) is the odometry's heading drift, taken out of the glimpse (the
         belief works in odometry straightened by the walls)."""
+        self._answers = None
         if self.pending_blocked is not None and glimpse.blocked is None:
             glimpse = replace(glimpse, blocked=self.pending_blocked)
         self.pending_blocked = None
@@ -239,6 +246,7 @@ class CorridorBelief:
         ``doors``: the doors seen in that view (odometry xy; None: not looked for)."""
         if self.ref is None:
             return
+        self._answers = None
         self._odo, _ = self._odo.advanced(odom, axis_odom)
         p = self.straighten((odom.x, odom.y))
         yaw = wrap_angle(odom.yaw - self.drift)
@@ -294,8 +302,26 @@ class CorridorBelief:
 
     def best_cluster(self) -> tuple[np.ndarray, float]:
         """Indices of the hypotheses around the best one and the weight they hold."""
+        return self._answer("best_cluster", self._best_cluster)
+
+    def _best_cluster(self) -> tuple[np.ndarray, float]:
         w = self.weights()
         return self.hyps.cluster_around(w, int(np.argmax(w)))
+
+    def settle(self) -> None:
+        """Work out now what ``fix`` and ``best_cluster`` answer for the belief as it is,
+        to be read (not worked out) when asked: the worker calls it on a belief it hands
+        to the tree, whose ``FixFromBelief`` then asks in a tick. Each is worked out once
+        per change (``observe``, ``observe_ray``, ``rescale``), the same answer either way."""
+        self.fix()
+
+    def _answer(self, question: str, work_out: Callable[[], object]):
+        """``work_out()``'s answer, kept until the belief changes."""
+        answers = self._answers or {}
+        if question not in answers:
+            # a new dict: a fork shares the one it was copied with until either changes
+            answers = self._answers = {**answers, question: work_out()}
+        return answers[question]
 
     def sightings(self) -> list[tuple[Entity, tuple[float, float]]]:
         """Every sign read so far and where (odometry), oldest first."""
@@ -331,7 +357,10 @@ class CorridorBelief:
         after a blocked corner, the estimate and the walls seen can be enough) or
         ``MIN_BLIND_GLIMPSES`` glimpses were taken (the corridors' shape alone, the ends
         met and the turns taken, can tell where the robot is); refined on the signs read
-        under that hypothesis."""
+        under that hypothesis. Kept until the belief changes (``settle``)."""
+        return self._answer("fix", self._fix)
+
+    def _fix(self) -> tuple[tuple[float, float, float], float] | None:
         if not self.glimpses:
             return None
         blind = not any(g.seen for g in self.glimpses)

@@ -40,6 +40,19 @@ class Verified:
     odometer: float  # odometry distance driven when it was seen (m)
 
 
+def rotated(
+    map_T_odom: tuple[float, float, float], dyaw: float, about_odom: tuple[float, float]
+) -> tuple[float, float, float]:
+    """``map_T_odom`` turned by ``dyaw`` about the map point of ``about_odom`` (the robot),
+    that point keeping its map position."""
+    before = se2_apply(map_T_odom, about_odom)
+    yaw = wrap_angle(map_T_odom[2] + dyaw)
+    c, s = math.cos(yaw), math.sin(yaw)
+    x = before[0] - (c * about_odom[0] - s * about_odom[1])
+    y = before[1] - (s * about_odom[0] + c * about_odom[1])
+    return (float(x), float(y), yaw)
+
+
 @dataclass
 class PoseTracker:
     """``map_T_odom`` and its uncertainty, corrected by verified landmarks."""
@@ -98,12 +111,7 @@ class PoseTracker:
     def rotate(self, dyaw: float, about_odom: tuple[float, float]) -> None:
         """Turn ``map_T_odom`` by ``dyaw`` about the map point of ``about_odom`` (the robot),
         keeping that point's map position (a heading correction from the walls)."""
-        before = se2_apply(self.map_T_odom, about_odom)
-        yaw = wrap_angle(self.map_T_odom[2] + dyaw)
-        c, s = math.cos(yaw), math.sin(yaw)
-        x = before[0] - (c * about_odom[0] - s * about_odom[1])
-        y = before[1] - (s * about_odom[0] + c * about_odom[1])
-        self.map_T_odom = (float(x), float(y), yaw)
+        self.map_T_odom = rotated(self.map_T_odom, dyaw, about_odom)
 
     def _refit(self) -> tuple[float, float, float] | None:
         if len(self.recent) < 2:

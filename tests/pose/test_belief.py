@@ -241,3 +241,23 @@ def test_a_misread_plate_far_off_cannot_outweigh_an_estimate_that_cannot_be_wron
     assert near == (floor is None), b.xy[i]
     if floor is None:  # and facing the way it turned to in the cabin, not the other
         assert abs(wrap_angle(b.yaw[i] - true[2])) < math.radians(60.0), b.yaw[i]
+
+
+def test_a_settled_belief_answers_its_fix_until_it_changes(fig2_map, monkeypatch):
+    """``settle`` (in the worker) works the fix out once; the tick that asks reads it.
+    A glimpse added to the belief, or to a fork of it, is answered afresh."""
+    worked = []
+    work_out = CorridorBelief._fix
+    monkeypatch.setattr(CorridorBelief, "_fix", lambda self: worked.append(1) or work_out(self))
+    p = points_reading(fig2_map, 2)[0]
+    true = (*p.xy, fig2_map.segments[p.segment - 1].heading)
+    b = CorridorBelief(fig2_map)
+    b.observe(glimpse(fig2_map, true, ()))
+    b.settle()
+    assert b.fix() is None and b.fix() is None and len(worked) == 1
+    fork = b.fork()
+    fork.observe(glimpse(fig2_map, true, p.readable))
+    assert fork.fix() is not None and len(worked) == 2
+    assert b.fix() is None and len(worked) == 2  # the fork's glimpse is not the belief's
+    b.observe(glimpse(fig2_map, true, p.readable))
+    assert b.fix() == fork.fix() and len(worked) == 3
