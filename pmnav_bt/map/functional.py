@@ -210,11 +210,16 @@ def fill_rooms(
     scheme: str,
     odd_even: bool,
     floor: int,
+    courtyard: bool | None = None,
 ) -> list[dict]:
     """One floor's rooms on what its landmarks left of ``walls``, numbered in ``scheme``
-    for ``floor``, as file data."""
+    for ``floor``, as file data. ``courtyard``: whether a school ring's inner walls face a
+    courtyard (no doors there), which a building of several floors decides once for all
+    of them; None: drawn here, for this floor alone."""
     split_p = 0.0 if scheme in PER_WING else SPLIT_P  # "3BA" is no code anyone uses
-    rooms = _fill(rng, shell.prog, shell.layout, shell.ends, walls, shell.order, states, split_p)
+    rooms = _fill(
+        rng, shell.prog, shell.layout, shell.ends, walls, shell.order, states, split_p, courtyard
+    )
     _number(rooms, shell.order, shell.layout, scheme, odd_even)
     return _room_data(rooms, shell.layout, scheme, floor)
 
@@ -422,12 +427,21 @@ def departments(rng: random.Random, shell: Shell, floor: int) -> dict[int, _Dept
 
 
 def _fill(
-    rng, prog: Programme, layout: Layout, ends, walls, order, states, split_p: float
+    rng,
+    prog: Programme,
+    layout: Layout,
+    ends,
+    walls,
+    order,
+    states,
+    split_p: float,
+    courtyard: bool | None,
 ) -> list[_Room]:
     """Rooms along every free stretch of wall, from the core outward; a small repeated
     room is divided in two with chance ``split_p``."""
     core = _DeptState(prog.core, "", rng)
-    courtyard = prog.kind == "school" and rng.random() < COURTYARD_P
+    if courtyard is None:
+        courtyard = has_courtyard(rng, prog)
     rooms: list[_Room] = []
     for i in order:
         c = layout.corridors[i]
@@ -461,6 +475,11 @@ def _fill(
                         rooms.append(room)
                         s += width
     return rooms
+
+
+def has_courtyard(rng: random.Random, prog: Programme) -> bool:
+    """Whether a ring's inner walls face a courtyard (a school's, with ``COURTYARD_P``)."""
+    return prog.kind == "school" and rng.random() < COURTYARD_P
 
 
 def _faces_centre(layout: Layout, c: int, ends, side: int) -> bool:

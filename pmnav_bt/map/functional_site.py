@@ -45,6 +45,7 @@ from pmnav_bt.map.functional import (
     draw_shell,
     fill_rooms,
     floor_data,
+    has_courtyard,
 )
 from pmnav_bt.map.numbering import SCHEMES
 from pmnav_bt.map.site import SITE_VERSION
@@ -108,6 +109,7 @@ def generate_functional_site(kind: str, seed: int) -> GeneratedSite:
     core = draw_core(rng, shell, shell.walls())
     scheme = rng.choice(FLOOR_SCHEMES)
     odd_even = rng.random() < 0.5
+    courtyard = has_courtyard(rng, shell.prog)  # a courtyard is open the building's height
     levels: dict[str, dict] = {}
     for floor in range(1, n_levels + 1):
         level = f"L{floor}"
@@ -116,11 +118,12 @@ def generate_functional_site(kind: str, seed: int) -> GeneratedSite:
         states = departments(lrng, shell, floor)
         landmarks = core_landmarks(shell, walls, core, reception=floor == 1)
         landmarks += department_signs(lrng, shell, walls, states)
-        rooms = fill_rooms(lrng, shell, walls, states, scheme, odd_even, floor)
+        rooms = fill_rooms(lrng, shell, walls, states, scheme, odd_even, floor, courtyard)
         wings = ", ".join(s.title for _, s in sorted(states.items()) if s.title) or "no wings"
-        entry = "the entrance and reception" if floor == 1 else "the lift lobby"
+        entry = "the entrance lobby with reception, " if floor == 1 else ""
         description = (
-            f"Level {floor} of {name}: {shell.layout.describe()}; {entry} at the core; "
+            f"Level {floor} of {name}: {shell.layout.describe()}; {entry}the lift lobby "
+            "and stairs at the core; "
             f"{wings}; {len(rooms)} rooms numbered like "
             f"{rooms[0]['sign'].split()[0] if rooms else scheme}."
         )
