@@ -51,6 +51,7 @@ PLATE_ROOM_M = 1.0  # a sign plate and its gap, kept free beside a landmark
 DESK_SLOT_M = 2.4  # the reception desk (1.9 m) and its margins
 STAIRS_SLOT_M = 2.4  # the stairs (1.8 m) and their margins
 SIGN_SLOT_M = 1.2  # a department sign plate
+LIFT_SLOT_M = 3.2  # a lift's doors, frame and call panel (2.14 m) and its name plate
 
 
 
@@ -340,11 +341,19 @@ def draw_core(rng: random.Random, shell: Shell, walls) -> Core:
     return Core(desk_side, desk_at, tuple(rng.sample((1, -1), 2)))
 
 
-def core_landmarks(shell: Shell, walls, core: Core, reception: bool) -> list[dict]:
+def core_landmarks(
+    shell: Shell, walls, core: Core, reception: bool, shaft: bool = False
+) -> list[dict]:
     """Reception (where ``reception``: the entrance floor), the main stairs and the lift at
     the core, escape stairs far away; their places taken out of ``walls``. Nothing here
     draws: every floor of a shell with the same ``core`` gets its stairs and lift at the
-    same points."""
+    same points.
+
+    ``shaft``: the lift is one the robot rides (a site's), whose doorway and cabin the
+    map (``lift_doorway``) and the simulator put behind the corridor wall its point is
+    on: it stands on a main corridor's wall beside the lift lobby (``_shaft_spot``). A
+    floor of its own (``shaft`` False) keeps its lift on the lift lobby's back wall facing
+    the entrance, its point in front of it (the world mounts it on the nearest wall)."""
     prog, layout, ends, lobby = shell.prog, shell.layout, shell.ends, shell.lobby
     out: list[dict] = []
     _, (ux, uy), _, _ = _frame(layout, ends[lobby])
@@ -372,6 +381,8 @@ def core_landmarks(shell: Shell, walls, core: Core, reception: bool) -> list[dic
     half = min(layout.lobby_width, main_w + 2.0 * DOOR_REACH_SLACK) / 2.0 - 0.05
     lift = f"{prog.lift} {wing_letter(0)}"
     pos = (round(cx + ux * half, 3), round(cy + uy * half, 3))
+    if shaft:
+        pos = _shaft_spot(shell, walls)
     out.append(_lm("lift1", "elevator", lift, lift, pos))
     # Escape stairs near the far end of the corridor farthest from the core.
     g = nx.Graph()
@@ -389,6 +400,28 @@ def core_landmarks(shell: Shell, walls, core: Core, reception: bool) -> list[dic
                            _on_wall(layout, far, ends[far], side, s)))
             break
     return out
+
+
+def _shaft_spot(shell: Shell, walls) -> tuple[float, float]:
+    """A ridden lift's point: on the wall of a corridor leaving the core, on the side the
+    entrance lobby faces (past the main corridor, where the lift lobby is), at the first
+    free stretch from the core; its place taken out of that wall. The lift lobby's back
+    wall will not do for it: the point must be on the wall of the corridor whose centre
+    line is nearest it, and there the main corridor's and the lobby's are equally near.
+    ValueError where no such wall has room (no layout of ``layouts`` leaves none)."""
+    layout, ends = shell.layout, shell.ends
+    _, (ux, uy), _, _ = _frame(layout, ends[shell.lobby])
+    for i in shell.order:
+        if ends[i][0] != layout.core or layout.corridors[i].role == "lobby":
+            continue
+        _, _, (nx_, ny_), _ = _frame(layout, ends[i])
+        side = 1 if nx_ * ux + ny_ * uy > 0 else -1
+        wall = walls[(i, side)]
+        if wall.free and wall.free[0][1] - wall.free[0][0] >= LIFT_SLOT_M:
+            s = round(wall.free[0][0] + LIFT_SLOT_M / 2.0, 2)
+            _reserve(wall, s, LIFT_SLOT_M)
+            return _on_wall(layout, i, ends[i], side, s)
+    raise ValueError("no corridor wall at the core has room for a lift")
 
 
 def department_signs(rng: random.Random, shell: Shell, walls, states) -> list[dict]:

@@ -20,10 +20,14 @@ generated site is built that way from the seed, with the one-floor family's part
    ``1G`` scheme has no floor in its codes, so its floors would repeat each other's plates
    and a robot off the lift could not tell by a door's number that it is on the wrong
    floor: no site uses it;
-4. the site: the lift ``lift1`` with its lobby on every level (each level reaches it from
-   its corridors: it stands in the lift lobby at the end of the entrance lobby), the
-   stairs ``stairs1`` (and ``stairs2``, where the far corridor had room for them) joining
-   every level, never driven.
+4. the site: the lift ``lift1`` with its lobby on every level, the stairs ``stairs1``
+   (and ``stairs2``, where the far corridor had room for them) joining every level, never
+   driven. The robot rides this lift, so the map (``lift_doorway``) and the simulator cut
+   its doorway through the wall its point is on, and the point must be on a corridor's
+   wall: the lift stands on the main corridor's wall beside the lift lobby, the first
+   stretch past its mouth (``functional.core_landmarks(shaft=True)``), not on the lobby's
+   back wall where the one-floor family hangs it (its point in front of that wall, which
+   the map's doorway and the world's nearest wall would disagree about).
 
 Members are named like the one-floor families with ``_site`` after the type:
 ``hospital_site_3``; the catalogue (``map/catalogue.py``) writes one once to its cache
@@ -116,7 +120,7 @@ def generate_functional_site(kind: str, seed: int) -> GeneratedSite:
         lrng = random.Random(f"{kind}{SITE_SUFFIX}:{seed}:{level}")
         walls = shell.walls()
         states = departments(lrng, shell, floor)
-        landmarks = core_landmarks(shell, walls, core, reception=floor == 1)
+        landmarks = core_landmarks(shell, walls, core, reception=floor == 1, shaft=True)
         landmarks += department_signs(lrng, shell, walls, states)
         rooms = fill_rooms(lrng, shell, walls, states, scheme, odd_even, floor, courtyard)
         wings = ", ".join(s.title for _, s in sorted(states.items()) if s.title) or "no wings"

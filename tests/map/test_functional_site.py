@@ -5,6 +5,7 @@ their floor, and the sites are named, written and found like the one-floor famil
 
 from __future__ import annotations
 
+import math
 import random
 
 import pytest
@@ -19,8 +20,9 @@ from pmnav_bt.map.catalogue import (
     is_generated_site_name,
 )
 from pmnav_bt.map.functional import BUILDING_KINDS
-from pmnav_bt.map.functional_site import LEVELS, generate_functional_site
-from pmnav_bt.map.landmark_kinds import ELEVATOR, landmark_shape
+from pmnav_bt.map.functional_site import LEVELS, LIFT_ID, generate_functional_site
+from pmnav_bt.map.landmark_kinds import ELEVATOR, ELEVATOR_PANEL_M, landmark_shape
+from pmnav_bt.map.lift_doorway import doorway
 from pmnav_bt.map.site import Site, load_site, site_from_data
 from pmnav_bt.map.site_map import parse_site
 from pmnav_bt.planning.resolve import resolve_start
@@ -75,6 +77,18 @@ def test_every_lift_serves_every_level_and_only_the_ground_floor_has_reception(s
             if any(lm.kind == "reception_desk" for lm in lv.building.landmarks)
         ]  # fmt: skip
         assert receptions == [site.levels[0].name], case
+
+
+def test_the_lift_stands_on_the_wall_its_doorway_is_cut_through(sites):
+    # the map puts a lift's doorway on the wall of the corridor nearest its point, and the
+    # simulator cuts it through the wall nearest its point: the point must be on that wall
+    # (the doors half a call panel beside it), not out in a lobby in front of a wall
+    for case, site in sites.items():
+        sm = parse_site(site)
+        for lv in site.levels:
+            lift = lv.building.landmark(LIFT_ID)
+            gap = math.dist(lift.pos, doorway(sm.maps[lv.name], LIFT_ID).centre)
+            assert gap == pytest.approx(ELEVATOR_PANEL_M / 2.0, abs=0.01), (case, lv.name)
 
 
 def test_every_level_reaches_a_room_on_every_other_level_by_one_ride(sites):
