@@ -151,6 +151,10 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
             text,
             [Problem("", f"names {len(members)} buildings; give one, such as {members[0]}")],
         )
+    if is_generated_site_name(text):
+        raise BuildingFileError(
+            text, [Problem("", "a generated site of several levels, not one building")]
+        )
     stem, _, seed = text.rpartition("_")
     if stem in _RANGED and seed.isdigit():
         raise BuildingFileError(

@@ -18,6 +18,7 @@ from pmnav_bt.map.catalogue import (
     family_members,
     generated_site_path,
     is_generated_site_name,
+    load_building,
 )
 from pmnav_bt.map.functional import BUILDING_KINDS
 from pmnav_bt.map.functional_site import LEVELS, LIFT_ID, generate_functional_site
@@ -174,3 +175,5 @@ def test_a_site_seed_outside_the_ranges_is_refused_in_one_line(tmp_path, monkeyp
     assert "\n" not in str(err.value)
     with pytest.raises(BuildingFileError, match="names 2 buildings; give one"):
         load_site("functional_site:2")
+    with pytest.raises(BuildingFileError, match="a generated site of several levels"):
+        load_building("hospital_site_3")
