@@ -59,6 +59,8 @@ def buildings() -> None:
         FAMILIES,
         HELDOUT_SEEDS,
         MIXED_FAMILY,
+        MIXED_SITE_FAMILY,
+        SITE_FAMILIES,
         builtin_buildings,
         load_building,
     )
@@ -77,6 +79,11 @@ def buildings() -> None:
         f"school, office and {MIXED_FAMILY} have development seeds {DEV_SEEDS.start}-"
         f"{DEV_SEEDS.stop - 1} and held-out seeds {HELDOUT_SEEDS.start}-{HELDOUT_SEEDS.stop - 1} "
         "(FAMILY_heldout:N; for evaluation only, never tuned on). See docs/scale.md."
+    )
+    typer.echo(
+        f"Generated sites of 2-4 levels ({', '.join(SITE_FAMILIES)}; {MIXED_SITE_FAMILY}:N "
+        "takes the three in turn), seeded and ranged alike: hospital_site_3, "
+        f"{MIXED_SITE_FAMILY}:N, {MIXED_SITE_FAMILY}_heldout:N. See docs/lifts.md."
     )
 
 

@@ -1,9 +1,9 @@
 """Episodes across levels (issue 40): a start on one level of a site, a goal room on
 another, reached by lift (the tier ``cross_level``).
 
-A ``SiteEpisode`` names its site (a built-in site by its name, so that an episode file
-travels to another machine as the one-level episodes of built-ins do; any other by its
-file's absolute path: ``site_ref``), the start level and
+A ``SiteEpisode`` names its site (a built-in or generated site by its name, so that an
+episode file travels to another machine as the one-level episodes of built-ins do; any
+other by its file's absolute path: ``site_ref``), the start level and
 pose (that level's map frame, on a corridor centre line, along the corridor), the goal
 room and its level. Its route is the ``SitePlan`` from the start (``planning/site_plan.py``):
 ``route_length`` is the corridor metres of its legs together, the rides not counted.
@@ -25,6 +25,7 @@ from pmnav_bt.errors import PmNavError, Problem
 from pmnav_bt.eval.task import action_budget
 from pmnav_bt.eval.tiers import CROSS_LEVEL, start_candidates
 from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.map.catalogue import generated_site_path, is_generated_site_name
 from pmnav_bt.map.site import BUILTIN_SITES_DIR, Site, load_site
 from pmnav_bt.map.site_map import SiteMap, parse_site
 from pmnav_bt.planning.resolve import resolve_site_room, resolve_start
@@ -86,11 +87,14 @@ def site_map(site: str | Site) -> SiteMap:
 
 
 def site_ref(s: Site) -> str:
-    """How an episode names its site: a built-in by its name, any other by its file."""
+    """How an episode names its site: a built-in or a generated site (``hospital_site_3``)
+    by its name, any other by its file."""
     if s.path is None:
         raise SiteEpisodeError(f"site {s.name} has no file: its episodes cannot name it")
     path = s.path.resolve()
     if path == (BUILTIN_SITES_DIR / f"{path.stem}.yaml").resolve():
+        return path.stem
+    if is_generated_site_name(path.stem) and path == generated_site_path(path.stem).resolve():
         return path.stem
     return str(path)
 

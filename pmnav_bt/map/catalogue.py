@@ -8,8 +8,12 @@ written once to a cache folder so that it has a path and a hash like any other. 
 name several members at once: ``FAMILY:N`` (the first N development members) and
 ``FAMILY_heldout:N`` (the first N held-out members; see ``HELDOUT_SEEDS``). This module
 turns such a name into a file, a hash and a ``Building``. It sits above ``building`` (the
-file format) and the seeded generators (``generate``, ``functional``), so those need not
-know each other.
+file format) and the seeded generators (``generate``, ``functional``,
+``functional_site``), so those need not know each other.
+
+Generated sites of several levels (``hospital_site_3``; ``functional_site:N`` takes the
+three types in turn) are named the same way; ``generated_site_file`` writes one as a site
+file and a building file per level, which ``site.resolve_site_path`` finds by its name.
 """
 
 from __future__ import annotations
@@ -19,9 +23,12 @@ import os
 from functools import partial
 from pathlib import Path
 
+import yaml
+
 from pmnav_bt.errors import BuildingFileError, Problem
 from pmnav_bt.map.building import Building, dump_building, read_building_file
 from pmnav_bt.map.functional import BUILDING_KINDS, generate_functional
+from pmnav_bt.map.functional_site import SITE_KINDS, SITE_SUFFIX, generate_functional_site
 from pmnav_bt.map.generate import (
     SIGN_SPARSE_FAMILY,
     SMALL_FAMILY,
@@ -56,6 +63,18 @@ MIXED_FAMILY = "functional"
 """Not a family of its own: ``functional:N`` names the realistic families' members in
 turn, hospital, school, office, hospital ... (``functional:4`` is hospital_0, school_0,
 office_0, hospital_1), so that one spec spans every building type."""
+
+# The generated sites of several levels by name: "hospital_site_3" is
+# generate_functional_site("hospital", 3). Their seeds are ranged as the floors' are.
+SITE_FAMILIES = {
+    family: partial(generate_functional_site, family.removesuffix(SITE_SUFFIX))
+    for family in SITE_KINDS
+}
+MIXED_SITE_FAMILY = MIXED_FAMILY + SITE_SUFFIX
+"""``functional_site:N``: the site families' members in turn (hospital_site_0,
+school_site_0, office_site_0, hospital_site_1 ...), as ``functional:N`` for floors."""
+_MIXED = {MIXED_FAMILY: RANGED_FAMILIES, MIXED_SITE_FAMILY: SITE_KINDS}
+_RANGED = (*RANGED_FAMILIES, *SITE_KINDS)
 
 
 def load_building(name_or_path: str | Path) -> Building:
@@ -132,8 +151,12 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
             text,
             [Problem("", f"names {len(members)} buildings; give one, such as {members[0]}")],
         )
+    if is_generated_site_name(text):
+        raise BuildingFileError(
+            text, [Problem("", "a generated site of several levels, not one building")]
+        )
     stem, _, seed = text.rpartition("_")
-    if stem in RANGED_FAMILIES and seed.isdigit():
+    if stem in _RANGED and seed.isdigit():
         raise BuildingFileError(
             text,
             [
@@ -174,16 +197,17 @@ def family_members(spec: str) -> list[str] | None:
     """ "FAMILY:N" -> the family's first N development members ("gen_small:3" ->
     gen_small_0, gen_small_1, gen_small_2); "FAMILY_heldout:N" -> its first N held-out
     members; "functional:N" / "functional_heldout:N" -> the realistic families' members
-    in turn. None when ``spec`` is not of that form; ValueError (one line) for an
+    in turn; the site families alike ("functional_site:2" -> hospital_site_0,
+    school_site_0). None when ``spec`` is not of that form; ValueError (one line) for an
     unknown family or a bad N."""
     family, sep, count = spec.partition(":")
     if not sep:
         return None
     base = family.removesuffix(HELDOUT_SUFFIX)
     heldout = base != family
-    ranged = (*RANGED_FAMILIES, MIXED_FAMILY)
-    if base not in FAMILIES and base != MIXED_FAMILY:
-        known = [*FAMILIES, MIXED_FAMILY, *(f + HELDOUT_SUFFIX for f in ranged)]
+    ranged = (*_RANGED, *_MIXED)
+    if base not in FAMILIES and base not in SITE_FAMILIES and base not in _MIXED:
+        known = [*FAMILIES, *SITE_FAMILIES, *_MIXED, *(f + HELDOUT_SUFFIX for f in ranged)]
         raise ValueError(f"{spec!r}: unknown building family {family!r}; choose {', '.join(known)}")
     if heldout and base not in ranged:
         raise ValueError(
@@ -191,7 +215,7 @@ def family_members(spec: str) -> list[str] | None:
             + ", ".join(f + HELDOUT_SUFFIX for f in ranged)
         )
     seeds = HELDOUT_SEEDS if heldout else DEV_SEEDS
-    kinds = RANGED_FAMILIES if base == MIXED_FAMILY else (base,)
+    kinds = _MIXED.get(base, (base,))
     most = len(seeds) * len(kinds) if base in ranged else 100_000
     if not count.isdigit() or not 1 <= int(count) <= most:
         raise ValueError(f"{spec!r}: expected {family}:N with N from 1 to {most}")
@@ -215,14 +239,54 @@ def generated_file(name: str) -> Path | None:
     b = generated_family(name)
     if b is None:
         return None
-    root = os.environ.get("PMNAV_CACHE") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "pmnav"
+    path = _cache_root() / "buildings" / f"{name}.yaml"
+    _write_once(path, dump_building(b))
+    return path
+
+
+def is_generated_site_name(name: str) -> bool:
+    """True for a generated site's name, such as "hospital_site_3" or "office_site_1004"
+    (its seed in the development or the held-out range)."""
+    stem, _, seed = name.rpartition("_")
+    if stem not in SITE_FAMILIES or not seed.isdigit() or len(seed) >= 10:
+        return False
+    return int(seed) in DEV_SEEDS or int(seed) in HELDOUT_SEEDS
+
+
+def generated_site_path(name: str) -> Path:
+    """Where the cache folder keeps the site file of a generated site's name (its levels'
+    building files in the folder of that name beside it)."""
+    return _cache_root() / "sites" / f"{name}.yaml"
+
+
+def generated_site_file(name: str) -> Path | None:
+    """The site file of a generated site's name ("hospital_site_3"), written once to the
+    cache folder with its levels' building files (``generated_site_path``), or None for
+    any other name. A site travels by its name: a Ray node writes its own copy."""
+    if not is_generated_site_name(name):
+        return None
+    stem, _, seed = name.rpartition("_")
+    gen = SITE_FAMILIES[stem](int(seed))
+    path = generated_site_path(name)
+    refs = {}
+    for level, text in gen.level_texts().items():
+        refs[level] = f"{name}/{level}.yaml"
+        _write_once(path.parent / refs[level], text)
+    _write_once(path, yaml.safe_dump(gen.site_data(refs), sort_keys=False, width=100))
+    return path
+
+
+def _cache_root() -> Path:
+    return Path(
+        os.environ.get("PMNAV_CACHE")
+        or os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "pmnav")
     )
-    path = Path(root) / "buildings" / f"{name}.yaml"
-    text = dump_building(b)
+
+
+def _write_once(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` unless it holds it already."""
     if not path.is_file() or path.read_text(encoding="utf-8") != text:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
         tmp.write_text(text, encoding="utf-8")
         tmp.replace(path)  # atomic: parallel runs never read half a file
-    return path

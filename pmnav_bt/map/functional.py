@@ -51,6 +51,7 @@ PLATE_ROOM_M = 1.0  # a sign plate and its gap, kept free beside a landmark
 DESK_SLOT_M = 2.4  # the reception desk (1.9 m) and its margins
 STAIRS_SLOT_M = 2.4  # the stairs (1.8 m) and their margins
 SIGN_SLOT_M = 1.2  # a department sign plate
+LIFT_SLOT_M = 3.2  # a lift's doors, frame and call panel (2.14 m) and its name plate
 
 
 
@@ -119,10 +120,67 @@ class _DeptState:
 
 def generate_functional(kind: str, seed: int) -> Building:
     """A valid ``kind`` floor (hospital, school or office); the same seed, the same file."""
+    rng = random.Random(f"{kind}:{seed}")  # a str seed is hashed stably (sha512)
+    shell = draw_shell(rng, kind)
+    walls = shell.walls()
+    floor = rng.randint(1, 5)
+    states = departments(rng, shell, floor)
+    core = draw_core(rng, shell, walls)
+    landmarks = core_landmarks(shell, walls, core, reception=True)
+    landmarks += department_signs(rng, shell, walls, states)
+    scheme = rng.choice(list(SCHEMES))
+    odd_even = rng.random() < 0.5
+    room_data = fill_rooms(rng, shell, walls, states, scheme, odd_even, floor)
+    label = f"{kind}_{seed}"  # the family member's name
+    description = (
+        f"Generated {kind} floor {floor} (seed {seed}): {shell.layout.describe()}; corridors "
+        f"{shell.main_w:g} m wide, an entrance lobby {shell.lobby_w:g} m wide with reception, "
+        f"the main stairs and a lift lobby at its far end; {len(room_data)} rooms numbered "
+        f"like {room_data[0]['sign'].split()[0] if room_data else scheme} "
+        f"({'odd and even sides' if odd_even else 'in passing order'})."
+    )
+    return building_from_data(
+        floor_data(shell, label, description, room_data, landmarks), source=label
+    )
+
+
+@dataclass(frozen=True)
+class Shell:
+    """What every floor of one building shares: the type's programme, the corridor widths
+    and layout, and the layout's corridors oriented away from the core (``ends``: from its
+    nearer node to its farther one; the lobby from the entrance in), visited from the core
+    outward (``order``). A multi-level site (``functional_site``) stacks floors on one
+    shell, so their corridors lie over each other and its lifts and stairs line up."""
+
+    kind: str
+    prog: Programme
+    main_w: float
+    wing_w: float
+    lobby_w: float
+    layout: Layout
+    graph: nx.Graph
+    order: tuple[int, ...]
+    ends: dict[int, tuple[int, int]]
+
+    @property
+    def lobby(self) -> int:
+        """The entrance lobby's corridor."""
+        return next(i for i, c in enumerate(self.layout.corridors) if c.role == "lobby")
+
+    def walls(self) -> dict[tuple[int, int], _Wall]:
+        """Every corridor side's wall, free for a floor's landmarks and rooms."""
+        return {
+            (i, side): _wall(self.layout, self.graph, i, self.ends[i])
+            for i in self.order
+            for side in (1, -1)
+        }
+
+
+def draw_shell(rng: random.Random, kind: str) -> Shell:
+    """A ``kind`` building's corridor widths and layout, drawn from ``rng``."""
     if kind not in PROGRAMMES:
         raise ValueError(f"unknown building kind {kind!r}; choose {', '.join(PROGRAMMES)}")
     prog = PROGRAMMES[kind]
-    rng = random.Random(f"{kind}:{seed}")  # a str seed is hashed stably (sha512)
     main_w = round(rng.uniform(*prog.corridor), 1)
     wing_w = round(rng.uniform(max(prog.corridor[0], main_w - 0.4), main_w), 1)
     lobby_w = round(rng.uniform(*prog.lobby), 1)
@@ -142,42 +200,51 @@ def generate_functional(kind: str, seed: int) -> Building:
         ends[i] = (c.a, c.b) if depth[c.a] <= depth[c.b] else (c.b, c.a)
         if c.role == "lobby":  # the lobby runs from the entrance in
             ends[i] = (layout.entrance, layout.core)
+    return Shell(kind, prog, main_w, wing_w, lobby_w, layout, g, tuple(order), ends)
 
-    walls = {(i, side): _wall(layout, g, i, ends[i]) for i in order for side in (1, -1)}
-    floor = rng.randint(1, 5)
-    states = _departments(rng, prog, layout, floor)
-    landmarks = _landmarks(rng, prog, layout, ends, walls, states)
-    scheme = rng.choice(list(SCHEMES))
-    odd_even = rng.random() < 0.5
+
+def fill_rooms(
+    rng: random.Random,
+    shell: Shell,
+    walls,
+    states,
+    scheme: str,
+    odd_even: bool,
+    floor: int,
+    courtyard: bool | None = None,
+) -> list[dict]:
+    """One floor's rooms on what its landmarks left of ``walls``, numbered in ``scheme``
+    for ``floor``, as file data. ``courtyard``: whether a school ring's inner walls face a
+    courtyard (no doors there), which a building of several floors decides once for all
+    of them; None: drawn here, for this floor alone."""
     split_p = 0.0 if scheme in PER_WING else SPLIT_P  # "3BA" is no code anyone uses
-    rooms = _fill(rng, prog, layout, ends, walls, order, states, split_p)
-    _number(rooms, order, layout, scheme, odd_even)
-    room_data = _room_data(rooms, layout, scheme, floor)
-    waypoints, wp_ids = _waypoints(layout, g)
+    rooms = _fill(
+        rng, shell.prog, shell.layout, shell.ends, walls, shell.order, states, split_p, courtyard
+    )
+    _number(rooms, shell.order, shell.layout, scheme, odd_even)
+    return _room_data(rooms, shell.layout, scheme, floor)
+
+
+def floor_data(shell: Shell, label: str, description: str, rooms, landmarks) -> dict:
+    """A floor's building file data: the shell's waypoints and corridors, its rooms and
+    landmarks."""
+    waypoints, wp_ids = _waypoints(shell.layout, shell.graph)
     edges = []
-    for c in layout.corridors:
+    for c in shell.layout.corridors:
         pair = [wp_ids[c.a], wp_ids[c.b]]
         wide = {"from": pair[0], "to": pair[1], "width": c.width}
-        edges.append(pair if c.width == main_w else wide)
-    label = f"{kind}_{seed}"  # the family member's name
-    data = {
+        edges.append(pair if c.width == shell.main_w else wide)
+    return {
         "schema_version": SCHEMA_VERSION,
         "name": label,
-        "kind": kind,
-        "description": (
-            f"Generated {kind} floor {floor} (seed {seed}): {layout.describe()}; corridors "
-            f"{main_w:g} m wide, an entrance lobby {lobby_w:g} m wide with reception, the "
-            f"main stairs and a lift lobby at its far end; {len(room_data)} rooms numbered "
-            f"like {room_data[0]['sign'].split()[0] if room_data else scheme} "
-            f"({'odd and even sides' if odd_even else 'in passing order'})."
-        ),
-        "corridor_width": main_w,
+        "kind": shell.kind,
+        "description": description,
+        "corridor_width": shell.main_w,
         "waypoints": waypoints,
         "edges": edges,
-        "rooms": room_data,
+        "rooms": rooms,
         "landmarks": landmarks,
     }
-    return building_from_data(data, source=label)
 
 
 def _layout(rng, kind: str, prog: Programme, main_w, wing_w, lobby_w) -> Layout:
@@ -255,25 +322,54 @@ def _reserve(wall: _Wall, s: float, width: float) -> bool:
     return False
 
 
-def _landmarks(rng, prog: Programme, layout: Layout, ends, walls, states) -> list[dict]:
-    """Reception, stairs and lift at the core, escape stairs far away, department signs."""
-    out: list[dict] = []
-    lobby = next(i for i, c in enumerate(layout.corridors) if c.role == "lobby")
-    _, (ux, uy), _, _ = _frame(layout, ends[lobby])
+@dataclass(frozen=True)
+class Core:
+    """Where a building's core landmarks go, the same on every floor: the side of the
+    lobby the reception desk stands on (the main stairs face it), how far along its free
+    wall the desk stands (0-1; None where that wall has no room), and the escape stairs'
+    wall sides in the order tried."""
+
+    desk_side: int
+    desk_at: float | None
+    escape_sides: tuple[int, int]
+
+
+def draw_core(rng: random.Random, shell: Shell, walls) -> Core:
+    """The core's places, drawn from ``rng``."""
     desk_side = rng.choice((1, -1))
-    wall = walls[(lobby, desk_side)]
-    if wall.free:
+    desk_at = rng.uniform(0.0, 1.0) if walls[(shell.lobby, desk_side)].free else None
+    return Core(desk_side, desk_at, tuple(rng.sample((1, -1), 2)))
+
+
+def core_landmarks(
+    shell: Shell, walls, core: Core, reception: bool, shaft: bool = False
+) -> list[dict]:
+    """Reception (where ``reception``: the entrance floor), the main stairs and the lift at
+    the core, escape stairs far away; their places taken out of ``walls``. Nothing here
+    draws: every floor of a shell with the same ``core`` gets its stairs and lift at the
+    same points.
+
+    ``shaft``: the lift is one the robot rides (a site's), whose doorway and cabin the
+    map (``lift_doorway``) and the simulator put behind the corridor wall its point is
+    on: it stands on a main corridor's wall beside the lift lobby (``_shaft_spot``). A
+    floor of its own (``shaft`` False) keeps its lift on the lift lobby's back wall facing
+    the entrance, its point in front of it (the world mounts it on the nearest wall)."""
+    prog, layout, ends, lobby = shell.prog, shell.layout, shell.ends, shell.lobby
+    out: list[dict] = []
+    _, (ux, uy), _, _ = _frame(layout, ends[lobby])
+    wall = walls[(lobby, core.desk_side)]
+    if reception and core.desk_at is not None:
         lo, hi = wall.free[0]
-        s = round(lo + DESK_SLOT_M / 2.0 + rng.uniform(0.0, 1.0) * (hi - lo - DESK_SLOT_M), 2)
+        s = round(lo + DESK_SLOT_M / 2.0 + core.desk_at * (hi - lo - DESK_SLOT_M), 2)
         if _reserve(wall, s, DESK_SLOT_M):
             out.append(_lm("reception", "reception_desk", prog.reception, "Reception",
-                           _on_wall(layout, lobby, ends[lobby], desk_side, s)))
-    wall = walls[(lobby, -desk_side)]
+                           _on_wall(layout, lobby, ends[lobby], core.desk_side, s)))
+    wall = walls[(lobby, -core.desk_side)]
     if wall.free:
         s = round(wall.free[-1][1] - STAIRS_SLOT_M / 2.0, 2)
         if _reserve(wall, s, STAIRS_SLOT_M):
             out.append(_lm("stairs1", "stairs", f"Stairs {wing_letter(0)}", "Stairs",
-                           _on_wall(layout, lobby, ends[lobby], -desk_side, s)))
+                           _on_wall(layout, lobby, ends[lobby], -core.desk_side, s)))
     # The lift faces the entrance, on the back wall of the lift lobby past the main corridor
     # (the world mounts it on the nearest wall). Its position in the file stands in front
     # of it, within reach of the main corridor: the file's rule measures reach from the
@@ -285,6 +381,8 @@ def _landmarks(rng, prog: Programme, layout: Layout, ends, walls, states) -> lis
     half = min(layout.lobby_width, main_w + 2.0 * DOOR_REACH_SLACK) / 2.0 - 0.05
     lift = f"{prog.lift} {wing_letter(0)}"
     pos = (round(cx + ux * half, 3), round(cy + uy * half, 3))
+    if shaft:
+        pos = _shaft_spot(shell, walls)
     out.append(_lm("lift1", "elevator", lift, lift, pos))
     # Escape stairs near the far end of the corridor farthest from the core.
     g = nx.Graph()
@@ -293,7 +391,7 @@ def _landmarks(rng, prog: Programme, layout: Layout, ends, walls, states) -> lis
     dist = nx.single_source_dijkstra_path_length(g, layout.core, weight="w")
     inner = [i for i in ends if layout.corridors[i].role != "lobby"]
     far = max(inner, key=lambda i: dist[ends[i][1]])
-    for side in rng.sample((1, -1), 2):
+    for side in core.escape_sides:
         wall = walls[(far, side)]
         if wall.free and wall.free[-1][1] - wall.free[-1][0] >= STAIRS_SLOT_M:
             s = round(wall.free[-1][1] - STAIRS_SLOT_M / 2.0, 2)
@@ -301,7 +399,35 @@ def _landmarks(rng, prog: Programme, layout: Layout, ends, walls, states) -> lis
             out.append(_lm("stairs2", "stairs", f"Stairs {wing_letter(1)}", "Stairs",
                            _on_wall(layout, far, ends[far], side, s)))
             break
-    # A department's name where its wing leaves the main corridor.
+    return out
+
+
+def _shaft_spot(shell: Shell, walls) -> tuple[float, float]:
+    """A ridden lift's point: on the wall of a corridor leaving the core, on the side the
+    entrance lobby faces (past the main corridor, where the lift lobby is), at the first
+    free stretch from the core; its place taken out of that wall. The lift lobby's back
+    wall will not do for it: the point must be on the wall of the corridor whose centre
+    line is nearest it, and there the main corridor's and the lobby's are equally near.
+    ValueError where no such wall has room (no layout of ``layouts`` leaves none)."""
+    layout, ends = shell.layout, shell.ends
+    _, (ux, uy), _, _ = _frame(layout, ends[shell.lobby])
+    for i in shell.order:
+        if ends[i][0] != layout.core or layout.corridors[i].role == "lobby":
+            continue
+        _, _, (nx_, ny_), _ = _frame(layout, ends[i])
+        side = 1 if nx_ * ux + ny_ * uy > 0 else -1
+        wall = walls[(i, side)]
+        if wall.free and wall.free[0][1] - wall.free[0][0] >= LIFT_SLOT_M:
+            s = round(wall.free[0][0] + LIFT_SLOT_M / 2.0, 2)
+            _reserve(wall, s, LIFT_SLOT_M)
+            return _on_wall(layout, i, ends[i], side, s)
+    raise ValueError("no corridor wall at the core has room for a lift")
+
+
+def department_signs(rng: random.Random, shell: Shell, walls, states) -> list[dict]:
+    """A department's name where its wing leaves the main corridor."""
+    layout, ends = shell.layout, shell.ends
+    out: list[dict] = []
     for k, state in sorted(states.items()):
         first = next((i for i in ends if layout.corridors[i].wing == k), None)
         if not state.title or first is None:
@@ -320,8 +446,9 @@ def _lm(ident: str, kind: str, name: str, sign: str, pos) -> dict:
     return {"id": ident, "kind": kind, "name": name, "pos": list(pos), "sign": sign}
 
 
-def _departments(rng, prog: Programme, layout: Layout, floor: int) -> dict[int, _DeptState]:
-    """The department of every wing (0: the main corridor and lobby)."""
+def departments(rng: random.Random, shell: Shell, floor: int) -> dict[int, _DeptState]:
+    """The department of every wing (0: the main corridor and lobby) on ``floor``."""
+    prog, layout = shell.prog, shell.layout
     pool = list(prog.wings)
     rng.shuffle(pool)
     states = {0: _DeptState(prog.main, "", rng)}
@@ -333,12 +460,21 @@ def _departments(rng, prog: Programme, layout: Layout, floor: int) -> dict[int, 
 
 
 def _fill(
-    rng, prog: Programme, layout: Layout, ends, walls, order, states, split_p: float
+    rng,
+    prog: Programme,
+    layout: Layout,
+    ends,
+    walls,
+    order,
+    states,
+    split_p: float,
+    courtyard: bool | None,
 ) -> list[_Room]:
     """Rooms along every free stretch of wall, from the core outward; a small repeated
     room is divided in two with chance ``split_p``."""
     core = _DeptState(prog.core, "", rng)
-    courtyard = prog.kind == "school" and rng.random() < COURTYARD_P
+    if courtyard is None:
+        courtyard = has_courtyard(rng, prog)
     rooms: list[_Room] = []
     for i in order:
         c = layout.corridors[i]
@@ -372,6 +508,11 @@ def _fill(
                         rooms.append(room)
                         s += width
     return rooms
+
+
+def has_courtyard(rng: random.Random, prog: Programme) -> bool:
+    """Whether a ring's inner walls face a courtyard (a school's, with ``COURTYARD_P``)."""
+    return prog.kind == "school" and rng.random() < COURTYARD_P
 
 
 def _faces_centre(layout: Layout, c: int, ends, side: int) -> bool:

@@ -439,14 +439,22 @@ def builtin_sites() -> list[str]:
 
 
 def resolve_site_path(name_or_path: str | Path) -> Path:
-    """A path as given, a built-in site's file, or a building's (``catalogue``)."""
+    """A path as given, a built-in site's file, a generated site's (``hospital_site_3``,
+    written to the cache folder), or a building's (``catalogue``)."""
+    from pmnav_bt.map.catalogue import (  # above this module
+        generated_site_file,
+        resolve_building_path,
+    )
+
     text = str(name_or_path)
     p = Path(name_or_path)
     if p.suffix not in SITE_SUFFIXES and len(p.parts) == 1 and not os.path.lexists(p):
         builtin = BUILTIN_SITES_DIR / f"{text}.yaml"
         if len(text) <= 255 and "\0" not in text and builtin.is_file():
             return builtin
-    from pmnav_bt.map.catalogue import resolve_building_path  # above this module
+        generated = generated_site_file(text)
+        if generated is not None:
+            return generated
 
     try:
         return resolve_building_path(name_or_path)
