@@ -34,6 +34,7 @@ from pmnav_bt.loading import (
 from pmnav_bt.map.signage import Signage, signage_problems
 
 SCHEMA_VERSION = 1
+SITE_VERSION = 1  # a site file's (map/site.py): here, below the site's readers and writers
 
 # What a building can plausibly be (docs/building-format.md, "Limits"): beyond these a
 # file is a mistake or an attack, and rendering or simulating it would exhaust memory.

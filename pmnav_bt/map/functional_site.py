@@ -39,7 +39,7 @@ from __future__ import annotations
 import random
 from dataclasses import dataclass
 
-from pmnav_bt.map.building import building_from_data, dump_building
+from pmnav_bt.map.building import SITE_VERSION, building_from_data, dump_building
 from pmnav_bt.map.functional import (
     BUILDING_KINDS,
     core_landmarks,
@@ -52,7 +52,6 @@ from pmnav_bt.map.functional import (
     has_courtyard,
 )
 from pmnav_bt.map.numbering import SCHEMES
-from pmnav_bt.map.site import SITE_VERSION
 
 SITE_SUFFIX = "_site"
 SITE_KINDS = tuple(f"{kind}{SITE_SUFFIX}" for kind in BUILDING_KINDS)  # hospital_site ...

@@ -39,6 +39,7 @@ from pmnav_bt.map.building import (
     MAX_COORD_M,
     MAX_DESCRIPTION_CHARS,
     MAX_TEXT_CHARS,
+    SITE_VERSION,
     Building,
     Finite,
     Ident,
@@ -48,8 +49,6 @@ from pmnav_bt.map.building import (
     read_building_file,
 )
 from pmnav_bt.map.landmark_kinds import ELEVATOR, STAIRS, landmark_shape
-
-SITE_VERSION = 1
 
 ONE_LEVEL = "L1"
 """The level name of a one-floor building opened as a site (``load_site``)."""
