@@ -25,7 +25,6 @@ Run: python benchmarks/bench_door_from_sign.py [--seeds 4] [--views 12] [--world
 from __future__ import annotations
 
 import argparse
-import math
 import time
 from collections import defaultdict
 
@@ -36,31 +35,16 @@ from pmnav_bt.map.catalogue import builtin_buildings
 from pmnav_bt.perception.depth import plate_pose
 from pmnav_bt.perception.door_scene import door_for_plate
 from pmnav_bt.perception.doors import DoorLayout, door_from_sign
-from pmnav_bt.seams import EntityKind, sign_label
-from pmnav_bt.sim.sign_views import built_mounting, sample_views
+from pmnav_bt.seams import EntityKind
+from pmnav_bt.sim.sign_views import (
+    body_to_map,
+    built_mounting,
+    labelled_plate_box,
+    sample_views,
+)
 from pmnav_bt.sim.world import SimWorld
 
 FOUND_M = 0.5
-MIN_PLATE_PX = 15
-
-
-def plate_box(obs, rid: str):
-    """The sign's box from the simulator's labels (None: too little of it in view)."""
-    ids = [i for i, name in obs.labels.items() if name == sign_label(rid)]
-    m = np.isin(obs.segmentation, ids)
-    if m.sum() < MIN_PLATE_PX:
-        return None
-    ys, xs = np.nonzero(m)
-    return (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
-
-
-def to_map(obs, centre) -> np.ndarray:
-    p = obs.pose
-    c, s = math.cos(p.yaw), math.sin(p.yaw)
-    x, y = float(centre[0]), float(centre[1])
-    return np.array([p.x + c * x - s * y, p.y + s * x + c * y])
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=4, help="worlds per building")
@@ -99,7 +83,7 @@ def main() -> None:
                         continue
                     rid = v.entity.id
                     obs = v.observation
-                    box = plate_box(obs, rid)
+                    box = labelled_plate_box(obs, rid)
                     plate = None if box is None else plate_pose(obs, box)
                     if plate is None:
                         skipped += 1
@@ -113,7 +97,7 @@ def main() -> None:
                         t0 = time.process_time()
                         est = fn(obs, plate, box)
                         ms[meth].append((time.process_time() - t0) * 1000.0)
-                        e = float(np.linalg.norm(to_map(obs, est.centre) - truth))
+                        e = float(np.linalg.norm(body_to_map(obs, est.centre) - truth))
                         errs[(meth, kind)].append(e)
                         states[(meth, state)].append(e)
             print(f"{name} seed {seed}: done", flush=True)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from shapely.geometry import Point
 
-from pmnav_bt.seams import CameraIntrinsics, Entity, Observation, Pose2D
+from pmnav_bt.seams import CameraIntrinsics, Entity, Observation, Pose2D, sign_label
 from pmnav_bt.sim.render import render_camera
 from pmnav_bt.sim.robot import CAMERA_HEIGHT, HFOV, RADIUS
 from pmnav_bt.sim.world import SimWorld, WallItem
@@ -125,3 +125,25 @@ def observe(
         labels=labels,
         camera_height=CAMERA_HEIGHT,
     )
+
+
+MIN_PLATE_PX = 15  # labelled pixels of a plate for its box to count as in view
+
+
+def labelled_plate_box(obs: Observation, rid: str) -> tuple[float, float, float, float] | None:
+    """Room ``rid``'s sign's box (x0, y0, x1, y1) from the simulator's labels; None with
+    too little of it in view. Measures the door placement alone, not the reading."""
+    ids = [i for i, name in obs.labels.items() if name == sign_label(rid)]
+    m = np.isin(obs.segmentation, ids)
+    if m.sum() < MIN_PLATE_PX:
+        return None
+    ys, xs = np.nonzero(m)
+    return (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
+
+
+def body_to_map(obs: Observation, centre) -> np.ndarray:
+    """A point in the camera body frame of ``obs`` (x ahead, y left) in the map frame."""
+    p = obs.pose
+    c, s = math.cos(p.yaw), math.sin(p.yaw)
+    x, y = float(centre[0]), float(centre[1])
+    return np.array([p.x + c * x - s * y, p.y + s * x + c * y])

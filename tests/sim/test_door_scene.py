@@ -21,30 +21,22 @@ from pmnav_bt.map.signage import Signage, SignStyleSpec
 from pmnav_bt.perception.depth import plate_pose
 from pmnav_bt.perception.door_scene import door_for_plate, mounting_prior
 from pmnav_bt.perception.doors import DoorLayout, door_from_sign
-from pmnav_bt.seams import CameraIntrinsics, EntityKind, sign_label
+from pmnav_bt.seams import CameraIntrinsics, EntityKind
 from pmnav_bt.sim.robot import HFOV, RADIUS
-from pmnav_bt.sim.sign_views import built_mounting, observe, sample_views, view_pose
+from pmnav_bt.sim.sign_views import (
+    body_to_map,
+    built_mounting,
+    labelled_plate_box,
+    observe,
+    sample_views,
+    view_pose,
+)
 from pmnav_bt.sim.world import SimWorld
 
 K = CameraIntrinsics.from_hfov(320, 240, HFOV)
 LAYOUT = DoorLayout()
 VIEWS = ((2.0, 40.0), (2.8, 60.0))  # m from the plate, deg off its normal: in the corridor
 REALISTIC = WorldConfig(preset="realistic", people_per_100m=0.0, clutter_per_10m=0.0)
-
-
-def _box(obs, rid: str):
-    ids = [i for i, name in obs.labels.items() if name == sign_label(rid)]
-    m = np.isin(obs.segmentation, ids)
-    if m.sum() < 15:
-        return None
-    ys, xs = np.nonzero(m)
-    return (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
-
-
-def _in_map(obs, centre) -> np.ndarray:
-    p = obs.pose
-    c, s = math.cos(p.yaw), math.sin(p.yaw)
-    return np.array([p.x + c * centre[0] - s * centre[1], p.y + s * centre[0] + c * centre[1]])
 
 
 def _errors(world: SimWorld, mounting: str, rooms: int = 4) -> tuple[list[float], list[float]]:
@@ -58,15 +50,15 @@ def _errors(world: SimWorld, mounting: str, rooms: int = 4) -> tuple[list[float]
             if not world.free_space.contains(Point(pose.x, pose.y).buffer(RADIUS)):
                 continue
             obs = observe(world, pose, K)
-            box = _box(obs, rid)
+            box = labelled_plate_box(obs, rid)
             plate = None if box is None else plate_pose(obs, box)
             if plate is None:
                 continue
             truth = np.asarray(world.doors[rid].centre, float)
             est = door_for_plate(obs, plate, box, LAYOUT)
-            scene.append(float(np.linalg.norm(_in_map(obs, est.centre) - truth)))
+            scene.append(float(np.linalg.norm(body_to_map(obs, est.centre) - truth)))
             old = door_from_sign(obs, plate, LAYOUT)
-            convention.append(float(np.linalg.norm(_in_map(obs, old.centre) - truth)))
+            convention.append(float(np.linalg.norm(body_to_map(obs, old.centre) - truth)))
     return scene, convention
 
 
@@ -138,7 +130,7 @@ def test_the_clean_world_places_its_doors_as_before(building):
             if v.entity.kind != EntityKind.ROOM:
                 continue
             obs = v.observation
-            box = _box(obs, v.entity.id)
+            box = labelled_plate_box(obs, v.entity.id)
             plate = None if box is None else plate_pose(obs, box)
             if plate is None:
                 continue
