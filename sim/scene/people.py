@@ -17,7 +17,10 @@ move first in every tick and the robot then collides with them where they now st
 
 People never walk into the robot: a person whose way ahead holds the robot within
 ``YIELD_AHEAD_M`` stops (and after ``TURN_BACK_S`` turns back), and no step ever brings
-a person closer than ``KEEP_OFF_M`` to it. They are solid for the robot (the world's
+a person closer than ``KEEP_OFF_M`` to it, nor from outside into the floor a moving
+robot will cover in the next ``ROBOT_REACH_S`` (its way: people see it move and do not
+step in front of it; crossing at a junction, one waits beside its way; one already in
+it walks on). They are solid for the robot (the world's
 ``clearance`` asks ``Crowd.clearance``: a person is an upright cylinder of
 ``PERSON_RADIUS_M``) but not part of the building: they are not in
 ``obstacle_footprints``, and SPL's shortest path ignores them. Where the robot drives
@@ -51,6 +54,10 @@ OBSTACLE_CLEAR_M = 0.05  # a person keeps this off clutter and landmarks beside 
 YIELD_AHEAD_M = 0.8  # a person stops when the robot is this close ahead (gap)
 YIELD_SIDE_M = 0.1  # ... and within this of their path's edge, sideways
 KEEP_OFF_M = 0.05  # no step ever brings a person closer than this to the robot (gap)
+# ... nor to where a moving robot will be within this: pedestrians judge a mover by its time
+# to reach them, and keep out of the way of one due within 2-3 s (time-to-collision
+# models of walking); 2 s also spans the robot's look at its way (a depth frame a second).
+ROBOT_REACH_S = 2.0
 TURN_BACK_S = 2.0  # a person held up this long by the robot turns back
 START_CLEAR_M = 2.0  # people start at least this far from a robot put in the world
 WALK_S = (8.0, 25.0)  # a pausing person walks this long between pauses (s)
@@ -173,6 +180,8 @@ class Crowd:
         self.corridors = {c.index: c for c in ways}
         self.contacts = 0  # times a robot came into contact with a person
         self._robots: list[Walker] = []
+        self._moves: dict[int, tuple[float, float]] = {}  # robot -> metres ahead it will go
+        self._last: dict[int, Pose2D] = {}  # robot -> its pose a tick ago
         self._clock: SimClock | None = None
         self._touching: set[tuple[int, int]] = set()
         self._shown = False  # bodies where the people are
@@ -257,6 +266,8 @@ class Crowd:
         """Stop watching ``robot``; leave its clock when no robot is left."""
         if robot in self._robots:
             self._robots.remove(robot)
+            self._moves.pop(id(robot), None)
+            self._last.pop(id(robot), None)
         if not self._robots and self._clock is not None:
             self._clock.remove_listener(self.advance)
             self._clock = None
@@ -264,9 +275,23 @@ class Crowd:
     def advance(self, h: float) -> None:
         """Clock listener: ``h`` seconds of walking, pausing and yielding."""
         with self.world.lock:  # a camera may be rendering them from a worker thread
+            self._watch_robots(h)
             for q in self.people:
                 self._advance_one(q, h)
             self._count_contacts()
+
+    def _watch_robots(self, h: float) -> None:
+        """How far along its heading each robot will go in ``ROBOT_REACH_S`` at the speed
+        it moved in the last tick (people see it move; backwards: negative)."""
+        for robot in self._robots:
+            r, k = robot.pose(), id(robot)
+            last = self._last.get(k)
+            self._last[k] = r
+            if last is None or h <= 0.0:
+                self._moves[k] = (0.0, 0.0)
+                continue
+            along = (r.x - last.x) * math.cos(r.yaw) + (r.y - last.y) * math.sin(r.yaw)
+            self._moves[k] = (0.0, along / h * ROBOT_REACH_S)
 
     # -- walking --------------------------------------------------------------------------------
 
@@ -274,6 +299,15 @@ class Crowd:
     def _gap(x: float, y: float, robot: Walker) -> float:
         r = robot.pose()
         return math.hypot(x - r.x, y - r.y) - PERSON_RADIUS_M - robot.radius
+
+    def _way_gap(self, x: float, y: float, robot: Walker) -> float:
+        """The gap from a person at (x, y) to the floor ``robot`` covers from where it is
+        to where it will be in ``ROBOT_REACH_S`` (its body swept along its heading)."""
+        r = robot.pose()
+        lo, hi = sorted(self._moves.get(id(robot), (0.0, 0.0)))
+        c, s = math.cos(r.yaw), math.sin(r.yaw)
+        t = max(lo, min(hi, (x - r.x) * c + (y - r.y) * s))
+        return math.hypot(x - r.x - t * c, y - r.y - t * s) - PERSON_RADIUS_M - robot.radius
 
     def _advance_one(self, q: Person, h: float) -> None:
         if q.pause_left > 0.0:
@@ -316,6 +350,10 @@ class Crowd:
                 return True
             gap = self._gap(q.x, q.y, robot)
             if gap < KEEP_OFF_M and gap < self._gap(x0, y0, robot):
+                return True
+            # Into its way from outside (one already in it walks on: freezing there, in
+            # front of it, is what must not happen).
+            if self._way_gap(q.x, q.y, robot) < KEEP_OFF_M <= self._way_gap(x0, y0, robot):
                 return True
         return False
 

@@ -1,6 +1,8 @@
 """Walking people: they walk with the clock at their speed, some pause, they keep off the
-robot (stopping, then turning back), the robot that drives into one is stopped and the
-contact counted, the camera sees them where they are, and a seed replays the crowd."""
+robot (stopping, then turning back) and do not step into the way ahead of a moving one
+(crossing at a junction) nor freeze in it (walking ahead of it), the robot that drives
+into one is stopped and the contact counted, the camera sees them where they are, and a
+seed replays the crowd."""
 
 from __future__ import annotations
 
@@ -136,6 +138,60 @@ def test_a_person_stops_before_the_robot_then_turns_back_and_never_walks_into_it
         assert gap_q[-1] > held + 2.0  # ... and walked away
         assert min(lows) >= KEEP_OFF_M - 1e-9
         assert w.people.contacts == 0 and body.stats.collisions == 0
+        body.close()
+
+
+def _one_person(w: SimWorld):
+    """The crowd's first person alone in the world (the others moved out of it)."""
+    from pmnav_bt.sim._pybullet import p
+
+    crowd = w.people
+    for o in crowd.people[1:]:
+        p.resetBasePositionAndOrientation(
+            o.body, (500.0, 500.0, -10.0), (0.0, 0.0, 0.0, 1.0), physicsClientId=w.client
+        )
+    crowd.people = crowd.people[:1]
+    return crowd.people[0]
+
+
+@pytest.mark.parametrize("start_s", [10.0, 10.5])
+def test_a_person_crossing_waits_beside_the_way_of_a_moving_robot(start_s):
+    # t_school: the stem (x = 0, y from -20 to 0) meets the bar (y = 0) at branch1 (0, 0).
+    # The robot drives up the stem across the bar at full speed, never stopping; a person
+    # walks along the bar towards the crossing, timed to reach it as the robot does. Seen
+    # only where they stand, they would walk on into the robot's way and stop in front of
+    # it (the robot then runs into them); seeing it move, they wait beside its way (and
+    # turn back after a while, as for a robot standing in their way).
+    with SimWorld("t_school", scene=crowd_config(people_pausing=0.0), seed=1) as w:
+        q = _one_person(w)
+        body = SimBase(w, SimClock(), pose=Pose2D(0.0, -3.0, math.pi / 2), width=16, height=12)
+        q.corridor, q.forward, q.s, q.speed = 3, False, start_s, 1.2  # walking -x to (0, 0)
+        q.lateral = w.people.lane(q)
+        w.people._locate(q)
+        lows: list[float] = []
+        body.clock.add_listener(lambda h: lows.append(min(_gaps(w, body))))
+        body.set_velocity(0.306, 0.0)
+        body.clock.wait(12.0)  # 3.7 m: across the bar and up to its far wall
+        assert w.people.contacts == 0 and body.stats.collisions == 0
+        assert KEEP_OFF_M - 1e-9 <= min(lows) < 0.5  # they met, and the person kept off
+        body.close()
+
+
+def test_a_person_walking_ahead_of_a_moving_robot_walks_on_where_their_lane_narrows():
+    # t_school's bar, towards branch2 (24, 0): the keep-right lane tapers to the centre line
+    # there. A person just ahead of the robot, beside its way, steps towards its way as
+    # they walk; stopping there (in front of it, out of its camera's view) would have it
+    # run into them from behind. They walk on.
+    with SimWorld("t_school", scene=crowd_config(people_pausing=0.0), seed=1) as w:
+        q = _one_person(w)
+        body = SimBase(w, SimClock(), pose=Pose2D(22.3, 0.0, 0.0), width=16, height=12)
+        q.corridor, q.forward, q.s, q.speed = 3, True, 22.8, 1.2  # walking +x to (24, 0)
+        q.lateral = w.people.lane(q)
+        w.people._locate(q)
+        body.set_velocity(0.306, 0.0)
+        body.clock.wait(4.0)
+        assert w.people.contacts == 0 and body.stats.collisions == 0
+        assert q.walked > 3.0  # on their way, not held up
         body.close()
 
 
