@@ -83,7 +83,8 @@ def encode_frame(rgb: np.ndarray, stamp: float) -> TappedFrame:
 
 
 class FrameTap:
-    """A ``Grounder`` that keeps the last frame it grounded (see the module docstring)."""
+    """A ``Grounder`` that keeps the last frame it grounded (see the module docstring); any
+    other attribute is the wrapped grounder's."""
 
     def __init__(self, inner: Grounder) -> None:
         self.inner = inner
@@ -106,6 +107,15 @@ class FrameTap:
 
     def surfaces(self, obs: Observation) -> SurfaceMasks:
         return self.inner.surfaces(obs)
+
+    def __getattr__(self, name: str):
+        """Whatever else the wrapped grounder offers (its optional capabilities, such as
+        ``unread_plates`` for active reading or ``watch_reads``), as its own: a tapped
+        grounder must do all that the untapped one does, or turning the view on would
+        change what the robot does. Only called for names the tap does not have."""
+        if name == "inner":  # not set yet (copying, unpickling): no recursion
+            raise AttributeError(name)
+        return getattr(self.inner, name)
 
     def _keep(self, obs: Observation, what: str, dets: list[Detection]) -> None:
         with self._lock:

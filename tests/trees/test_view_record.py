@@ -5,6 +5,7 @@ after it, and the frames perception grounded with what they showed."""
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import pytest
 
@@ -55,3 +56,34 @@ def test_a_mission_logs_what_the_view_draws(make_rig, pm, tmp_path):
     seen = {e for v in views for e in v.get("seen", [])}
     assert {d["entity"] for d in found if d["entity"]} <= seen
     assert f"room {hidden}" not in seen
+
+
+class _PlateReader(ScriptedGrounder):
+    """A grounder with the optional capabilities of the real stack (remembered unread
+    plates, watched reads), as the OCR grounder has them."""
+
+    def unread_plates(self, since: float) -> list:
+        return [f"unread since {since}"]
+
+    def watch_reads(self, observer) -> None:
+        self.observer = observer
+
+
+def test_the_view_s_tap_keeps_what_the_grounder_can_do(make_rig, pm):
+    """Turning the view on wraps the grounder in a FrameTap: the tree must find the same
+    capabilities behind it (active reading asks for SeesUnreadPlates), or a run with the
+    view would do other things than the same run without it."""
+    from pmnav_bt.perception.frame_tap import FrameTap
+    from pmnav_bt.perception.map_check import WatchesReads
+    from pmnav_bt.perception.unread_plates import SeesUnreadPlates
+
+    rig = make_rig(START, grounder=_PlateReader(pm))
+    ViewRecorder(rig.ctx, building="straight_office", truth=rig.true_pose)
+    tap = rig.ctx.grounder
+    assert isinstance(tap, FrameTap)
+    assert isinstance(tap, SeesUnreadPlates) and isinstance(tap, WatchesReads)
+    assert tap.unread_plates(2.0) == ["unread since 2.0"]
+    tap.watch_reads(print)
+    assert tap.inner.observer is print
+    plain = FrameTap(SimpleNamespace(needs_sim_labels=False))  # one without them
+    assert not isinstance(plain, SeesUnreadPlates) and not isinstance(plain, WatchesReads)
