@@ -52,7 +52,9 @@ class ActionClient:
         fut = self.client.send_goal_async(
             goal, feedback_callback=lambda m: feedback.append((time.monotonic(), m.feedback))
         )
-        _wait(fut.done, 10.0, "goal acceptance")
+        # 30 s: the answer is immediate, but a clean-clone CI run on a loaded 2-core machine
+        # once took over 10 s to carry it between the two processes
+        _wait(fut.done, 30.0, "goal acceptance")
         handle = fut.result()
         assert handle.accepted
         return handle, handle.get_result_async(), feedback
