@@ -48,6 +48,7 @@ import numpy as np
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.signage import Mounting
 from pmnav_bt.perception.depth import PlatePose, back_project, polygon_mask, surfaces, wall_rect
+from pmnav_bt.perception.door_sightings import REF_BAND_M  # the wall's colour: above the doors
 from pmnav_bt.perception.doors import DoorEstimate, DoorLayout, door_beside, door_from_sign
 from pmnav_bt.pose.walls import wall_lines, wall_points
 from pmnav_bt.seams import Observation
@@ -57,7 +58,6 @@ WINDOW_M = 2.6  # along the wall either side of the plate: a beside plate's far 
 NEAR_M = 3.0  # wall pixels this near the plate fit its wall ...
 WALL_STRIDE = 4  # ... every this many pixels (the fit's cost is in its points)
 BAND_M = (1.1, 2.0)  # heights looked at: above a bumper rail (0.9-1.02 m), below a frame's top
-REF_BAND_M = (2.25, 2.6)  # the wall's own colour: above the door frames (2.18 m)
 ON_WALL_M = 0.12  # a point this near the wall plane is on it (frames stand 4 cm out)
 BEHIND_M = 0.12  # ... this far behind it: an opening, a glazed or recessed leaf
 IN_FRONT_M = 0.25  # ... this far in front: something standing before the wall
