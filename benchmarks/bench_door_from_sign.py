@@ -31,13 +31,13 @@ from collections import defaultdict
 import numpy as np
 
 from pmnav_bt.config import WorldConfig
+from pmnav_bt.geometry import se2_apply
 from pmnav_bt.map.catalogue import builtin_buildings
 from pmnav_bt.perception.depth import plate_pose
 from pmnav_bt.perception.door_scene import door_for_plate
 from pmnav_bt.perception.doors import DoorLayout, door_from_sign
 from pmnav_bt.seams import EntityKind
 from pmnav_bt.sim.sign_views import (
-    body_to_map,
     built_mounting,
     labelled_plate_box,
     sample_views,
@@ -93,11 +93,12 @@ def main() -> None:
                     st = world.door_states.get(rid)
                     state = "open" if st and st.open else ("glass" if st and st.glass else "closed")
                     truth = np.asarray(door.centre, float)
+                    here = (obs.pose.x, obs.pose.y, obs.pose.yaw)
                     for meth, fn in methods.items():
                         t0 = time.process_time()
                         est = fn(obs, plate, box)
                         ms[meth].append((time.process_time() - t0) * 1000.0)
-                        e = float(np.linalg.norm(body_to_map(obs, est.centre) - truth))
+                        e = float(np.linalg.norm(se2_apply(here, est.centre) - truth))
                         errs[(meth, kind)].append(e)
                         states[(meth, state)].append(e)
             print(f"{name} seed {seed}: done", flush=True)

@@ -139,11 +139,3 @@ def labelled_plate_box(obs: Observation, rid: str) -> tuple[float, float, float,
         return None
     ys, xs = np.nonzero(m)
     return (float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max()))
-
-
-def body_to_map(obs: Observation, centre) -> np.ndarray:
-    """A point in the camera body frame of ``obs`` (x ahead, y left) in the map frame."""
-    p = obs.pose
-    c, s = math.cos(p.yaw), math.sin(p.yaw)
-    x, y = float(centre[0]), float(centre[1])
-    return np.array([p.x + c * x - s * y, p.y + s * x + c * y])

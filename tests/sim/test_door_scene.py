@@ -16,6 +16,7 @@ import pytest
 from shapely.geometry import Point
 
 from pmnav_bt.config import WorldConfig
+from pmnav_bt.geometry import se2_apply
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.signage import Signage, SignStyleSpec
 from pmnav_bt.perception.depth import plate_pose
@@ -24,7 +25,6 @@ from pmnav_bt.perception.doors import DoorLayout, door_from_sign
 from pmnav_bt.seams import CameraIntrinsics, EntityKind
 from pmnav_bt.sim.robot import HFOV, RADIUS
 from pmnav_bt.sim.sign_views import (
-    body_to_map,
     built_mounting,
     labelled_plate_box,
     observe,
@@ -55,10 +55,11 @@ def _errors(world: SimWorld, mounting: str, rooms: int = 4) -> tuple[list[float]
             if plate is None:
                 continue
             truth = np.asarray(world.doors[rid].centre, float)
+            here = (obs.pose.x, obs.pose.y, obs.pose.yaw)
             est = door_for_plate(obs, plate, box, LAYOUT)
-            scene.append(float(np.linalg.norm(body_to_map(obs, est.centre) - truth)))
+            scene.append(float(np.linalg.norm(se2_apply(here, est.centre) - truth)))
             old = door_from_sign(obs, plate, LAYOUT)
-            convention.append(float(np.linalg.norm(body_to_map(obs, old.centre) - truth)))
+            convention.append(float(np.linalg.norm(se2_apply(here, old.centre) - truth)))
     return scene, convention
 
 
