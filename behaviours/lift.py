@@ -477,7 +477,7 @@ class LiftWordStands(PmNavBehaviour):
         belief, tf = self.get("belief"), self.get("map_T_odom")
         if belief is None or belief.ref is None or tf is None:
             return Status.FAILURE
-        est = se2_apply(tf, (belief.ref.x, belief.ref.y))  # both at the belief's reference
+        est = se2_apply(tf, belief.ref.xy())  # both at the belief's reference
         off = np.linalg.norm(belief.xy - est, axis=1)
         share = float(belief.weights()[off <= CLUSTER_M].sum())
         if share < FIX_MASS:
@@ -486,14 +486,10 @@ class LiftWordStands(PmNavBehaviour):
             )
             return Status.FAILURE
         self.bb.set("belief", None)
-        est_x, est_y = (float(v) for v in se2_apply(tf, _xy(self.ctx.base.pose())))
+        est_x, est_y = (float(v) for v in se2_apply(tf, self.ctx.base.pose().xy()))
         self.ctx.log("fix", "the lift's word", map_pose=[est_x, est_y], share=share)
         self.feedback_message = f"at ({est_x:.1f}, {est_y:.1f}): the lift's word stands"
         return Status.SUCCESS
-
-
-def _xy(p: Pose2D) -> tuple[float, float]:
-    return p.x, p.y
 
 
 def sign_key(text: str) -> str:
