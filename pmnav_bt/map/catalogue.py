@@ -183,14 +183,23 @@ def resolve_building_path(name_or_path: str | Path) -> Path:
 # -- generated families -----------------------------------------------------------------
 
 
+def _member(name: str, families, ranged) -> tuple[str, int] | None:
+    """(family, seed) of a generated member's name such as "sign_sparse_3" among
+    ``families``; None for any other name, or a seed of a ``ranged`` family outside its
+    development and held-out ranges."""
+    stem, _, seed = name.rpartition("_")
+    if stem not in families or not seed.isdigit() or len(seed) >= 10:
+        return None
+    if stem in ranged and int(seed) not in DEV_SEEDS and int(seed) not in HELDOUT_SEEDS:
+        return None
+    return stem, int(seed)
+
+
 def is_generated_name(name: str) -> bool:
     """True for a generated family's building name, such as "sign_sparse_3" or
     "hospital_1004" (a realistic family's seed must be in its development or held-out
     range)."""
-    stem, _, seed = name.rpartition("_")
-    if stem not in FAMILIES or not seed.isdigit() or len(seed) >= 10:
-        return False
-    return stem not in RANGED_FAMILIES or int(seed) in DEV_SEEDS or int(seed) in HELDOUT_SEEDS
+    return _member(name, FAMILIES, RANGED_FAMILIES) is not None
 
 
 def family_members(spec: str) -> list[str] | None:
@@ -226,10 +235,11 @@ def family_members(spec: str) -> list[str] | None:
 
 def generated_family(name: str) -> Building | None:
     """The generated building a name such as "sign_sparse_3" denotes, or None."""
-    if not is_generated_name(name):
+    member = _member(name, FAMILIES, RANGED_FAMILIES)
+    if member is None:
         return None
-    stem, _, seed = name.rpartition("_")
-    return FAMILIES[stem](int(seed))
+    family, seed = member
+    return FAMILIES[family](seed)
 
 
 def generated_file(name: str) -> Path | None:
@@ -247,10 +257,7 @@ def generated_file(name: str) -> Path | None:
 def is_generated_site_name(name: str) -> bool:
     """True for a generated site's name, such as "hospital_site_3" or "office_site_1004"
     (its seed in the development or the held-out range)."""
-    stem, _, seed = name.rpartition("_")
-    if stem not in SITE_FAMILIES or not seed.isdigit() or len(seed) >= 10:
-        return False
-    return int(seed) in DEV_SEEDS or int(seed) in HELDOUT_SEEDS
+    return _member(name, SITE_FAMILIES, SITE_FAMILIES) is not None
 
 
 def generated_site_path(name: str) -> Path:
@@ -263,10 +270,11 @@ def generated_site_file(name: str) -> Path | None:
     """The site file of a generated site's name ("hospital_site_3"), written once to the
     cache folder with its levels' building files (``generated_site_path``), or None for
     any other name. A site travels by its name: a Ray node writes its own copy."""
-    if not is_generated_site_name(name):
+    member = _member(name, SITE_FAMILIES, SITE_FAMILIES)
+    if member is None:
         return None
-    stem, _, seed = name.rpartition("_")
-    gen = SITE_FAMILIES[stem](int(seed))
+    family, seed = member
+    gen = SITE_FAMILIES[family](seed)
     path = generated_site_path(name)
     refs = {}
     for level, text in gen.level_texts().items():
