@@ -130,6 +130,11 @@ class GridMounts:
         if not found:
             self.missed.add(mounted)
 
+    def annotated(self, wall: int, s: float) -> tuple[int, float]:
+        """Where ``s`` along wall ``wall`` is on the annotated wall it was mounted for (its
+        parent, in that wall's measure); a wall not mounted here is its own."""
+        return self.parent.get(wall, wall), s - self.shift.get(wall, 0.0)
+
 
 def moved_items(world) -> list[MovedItem]:
     """Every door, sign and landmark of a grid-walled ``world``: annotated and placed."""
@@ -140,8 +145,8 @@ def moved_items(world) -> list[MovedItem]:
         if where is None or where[0] not in mounts.parent:
             continue  # a styled plate: it hangs by its door, on the door's wall
         wi, s = where
-        parent = world.walls[mounts.parent[wi]]
-        was, now = parent.point(s - mounts.shift[wi]), world.walls[wi].point(s)
+        parent, s_parent = mounts.annotated(wi, s)
+        was, now = world.walls[parent].point(s_parent), world.walls[wi].point(s)
         found = wi not in mounts.missed
         out.append(MovedItem(item.id, item.kind, item.label, _xy(was), _xy(now), found))
     return out

@@ -933,9 +933,8 @@ class SimWorld:
         for lid in sorted(self.lift_lobbies):
             wi, s = self._where[landmark_label(lid)]
             near, s_near = self._placer.nearest(self.building.landmark(lid).pos)
-            on, s_on = wi, s
-            if self._mounts:  # grid: the annotated wall of the real one, in its measure
-                on, s_on = self._mounts.parent.get(wi, wi), s - self._mounts.shift.get(wi, 0.0)
+            # grid: the annotated wall of the real one, in its measure
+            on, s_on = self._mounts.annotated(wi, s) if self._mounts else (wi, s)
             if (on, round(s_on, 3)) != (near, round(s_near, 3)):
                 raise SimError(
                     f"{self.building.name}: lift {lid} hangs {abs(s_on - s_near):.2f} m from its "
