@@ -180,7 +180,7 @@ class Crowd:
         self.corridors = {c.index: c for c in ways}
         self.contacts = 0  # times a robot came into contact with a person
         self._robots: list[Walker] = []
-        self._moves: dict[int, tuple[float, float]] = {}  # robot -> metres ahead it will go
+        self._moves: dict[int, float] = {}  # robot -> metres ahead it will go (back: < 0)
         self._last: dict[int, Pose2D] = {}  # robot -> its pose a tick ago
         self._clock: SimClock | None = None
         self._touching: set[tuple[int, int]] = set()
@@ -288,10 +288,10 @@ class Crowd:
             last = self._last.get(k)
             self._last[k] = r
             if last is None or h <= 0.0:
-                self._moves[k] = (0.0, 0.0)
+                self._moves[k] = 0.0
                 continue
             along = (r.x - last.x) * math.cos(r.yaw) + (r.y - last.y) * math.sin(r.yaw)
-            self._moves[k] = (0.0, along / h * ROBOT_REACH_S)
+            self._moves[k] = along / h * ROBOT_REACH_S
 
     # -- walking --------------------------------------------------------------------------------
 
@@ -304,7 +304,7 @@ class Crowd:
         """The gap from a person at (x, y) to the floor ``robot`` covers from where it is
         to where it will be in ``ROBOT_REACH_S`` (its body swept along its heading)."""
         r = robot.pose()
-        lo, hi = sorted(self._moves.get(id(robot), (0.0, 0.0)))
+        lo, hi = sorted((0.0, self._moves.get(id(robot), 0.0)))
         c, s = math.cos(r.yaw), math.sin(r.yaw)
         t = max(lo, min(hi, (x - r.x) * c + (y - r.y) * s))
         return math.hypot(x - r.x - t * c, y - r.y - t * s) - PERSON_RADIUS_M - robot.radius
