@@ -265,11 +265,13 @@ def _add_spurs(
     corridor narrower in the drawing's centre-line model than at the lift, or a lane run
     on into the cabin) would hang elsewhere, where its shaft is not."""
 
-    def gap(centre) -> float:
+    def gap(centre, slack: float) -> float:
+        """How far ``centre`` is beyond reach of the nearest centre line (``slack`` past
+        its corridor's wall): above 0, it needs a spur."""
         seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])
         seg_b = np.array([cor.pos[v] for _, v, _ in cor.edges])
         j, _, d = project_points_to_segments(np.asarray(centre)[None], seg_a, seg_b)
-        return float(d[0] - cor.edges[j[0]][2] / 2.0 - DOOR_REACH_SLACK)
+        return float(d[0] - cor.edges[j[0]][2] / 2.0 - slack)
 
     slack = [DOOR_REACH_SLACK] * len(doors) + [LIFT_OFF_WALL_M] * len(lift_doors)
     past = [PAST_M] * len(doors) + [LIFT_PAST_M] * len(lift_doors)
@@ -277,9 +279,9 @@ def _add_spurs(
     added = sum(
         turn_at_door(cor, plan, free, c, along, past[k]) for k, (_, c, along) in enumerate(doors)
     )
-    far = sorted((gap(c) + DOOR_REACH_SLACK - slack[k], k) for k, (_, c, _) in enumerate(doors))
+    far = sorted((gap(c, slack[k]), k) for k, (_, c, _) in enumerate(doors))
     for g, k in far:
-        if g > 0 and gap(doors[k][1]) + DOOR_REACH_SLACK - slack[k] > 0:
+        if g > 0 and gap(doors[k][1], slack[k]) > 0:
             added += add_spur(cor, plan, free, doors[k][1], doors[k][2], past[k])
     return added
 
