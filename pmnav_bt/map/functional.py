@@ -370,19 +370,8 @@ def core_landmarks(
         if _reserve(wall, s, STAIRS_SLOT_M):
             out.append(_lm("stairs1", "stairs", f"Stairs {wing_letter(0)}", "Stairs",
                            _on_wall(layout, lobby, ends[lobby], -core.desk_side, s)))
-    # The lift faces the entrance, on the back wall of the lift lobby past the main corridor
-    # (the world mounts it on the nearest wall). Its position in the file stands in front
-    # of it, within reach of the main corridor: the file's rule measures reach from the
-    # nearest centre line, which there is the main corridor's.
-    cx, cy = layout.pos[layout.core]
-    main_w = max(
-        c.width for c in layout.corridors if c.role != "lobby" and layout.core in (c.a, c.b)
-    )
-    half = min(layout.lobby_width, main_w + 2.0 * DOOR_REACH_SLACK) / 2.0 - 0.05
     lift = f"{prog.lift} {wing_letter(0)}"
-    pos = (round(cx + ux * half, 3), round(cy + uy * half, 3))
-    if shaft:
-        pos = _shaft_spot(shell, walls)
+    pos = _shaft_spot(shell, walls) if shaft else _lobby_back_spot(layout, (ux, uy))
     out.append(_lm("lift1", "elevator", lift, lift, pos))
     # Escape stairs near the far end of the corridor farthest from the core.
     g = nx.Graph()
@@ -400,6 +389,20 @@ def core_landmarks(
                            _on_wall(layout, far, ends[far], side, s)))
             break
     return out
+
+
+def _lobby_back_spot(layout: Layout, lobby_way: tuple[float, float]) -> tuple[float, float]:
+    """A floor's own lift point: the lift faces the entrance, on the back wall of the lift
+    lobby past the main corridor (``lobby_way``: the entrance lobby's direction in; the
+    world mounts it on the nearest wall). The point stands in front of it, within reach of
+    the main corridor: the file's rule measures reach from the nearest centre line, which
+    there is the main corridor's."""
+    cx, cy = layout.pos[layout.core]
+    main_w = max(
+        c.width for c in layout.corridors if c.role != "lobby" and layout.core in (c.a, c.b)
+    )
+    half = min(layout.lobby_width, main_w + 2.0 * DOOR_REACH_SLACK) / 2.0 - 0.05
+    return (round(cx + lobby_way[0] * half, 3), round(cy + lobby_way[1] * half, 3))
 
 
 def _shaft_spot(shell: Shell, walls) -> tuple[float, float]:
