@@ -140,11 +140,11 @@ class _Progress:
 
 def _run_action(node, rt, args, goal_type) -> int:
     from action_msgs.msg import GoalStatus
-    from rclpy.action import ActionClient
 
+    from pmnav_bt.hardware.action_client import ThreadSafeActionClient
     from pmnav_bt.hardware.action_server import ACTION_NAME
 
-    client = ActionClient(node, goal_type, ACTION_NAME)
+    client = ThreadSafeActionClient(node, goal_type, ACTION_NAME)
     rt.add(node)
     rt.start()
     name = node.resolve_topic_name(ACTION_NAME)

@@ -35,12 +35,13 @@ class ActionClient:
     """An rclpy action client in this process, spun in the background."""
 
     def __init__(self, runtime):
-        from rclpy.action import ActionClient as RclpyActionClient
         from rclpy.node import Node
+
+        from pmnav_bt.hardware.action_client import ThreadSafeActionClient
 
         self.node = Node("action_test_client", context=runtime.context)
         self.type = action_type()
-        self.client = RclpyActionClient(self.node, self.type, "navigate_to_room")
+        self.client = ThreadSafeActionClient(self.node, self.type, "navigate_to_room")
         runtime.add(self.node)
 
     def send(self, room: str = "", pose=None, frame: str = "map"):
@@ -52,9 +53,7 @@ class ActionClient:
         fut = self.client.send_goal_async(
             goal, feedback_callback=lambda m: feedback.append((time.monotonic(), m.feedback))
         )
-        # 30 s: the answer is immediate, but a clean-clone CI run on a loaded 2-core machine
-        # once took over 10 s to carry it between the two processes
-        _wait(fut.done, 30.0, "goal acceptance")
+        _wait(fut.done, 10.0, "goal acceptance")
         handle = fut.result()
         assert handle.accepted
         return handle, handle.get_result_async(), feedback

@@ -161,9 +161,9 @@ def test_pmnav_ros_on_a_site_calls_the_lift_for_a_goal_on_another_level(domain_i
     L2 as the mission across levels: its feedback names the start level L1, and at the
     lift's lobby it calls the lift by its own name, which the simulated lift node grants
     (the ride itself needs the simulated Create 3 to change levels, which it cannot)."""
-    from rclpy.action import ActionClient
     from rclpy.node import Node
 
+    from pmnav_bt.hardware.action_client import ThreadSafeActionClient
     from pmnav_bt.hardware.action_server import action_type
     from pmnav_bt.hardware.lift_client import RosLiftClient
     from pmnav_bt.hardware.runtime import RosRuntime
@@ -184,7 +184,7 @@ def test_pmnav_ros_on_a_site_calls_the_lift_for_a_goal_on_another_level(domain_i
     rt = RosRuntime(args=[], domain_id=domain_id)
     node = Node("site_test", context=rt.context)
     lifts = RosLiftClient(node)  # only listens: what the lifts say
-    client = ActionClient(node, action_type(), "navigate_to_room")
+    client = ThreadSafeActionClient(node, action_type(), "navigate_to_room")
     rt.add(node)
     rt.start()
     logs = lambda: "\n".join(f"--- {p.log.name}\n{p.tail()}" for p in procs)  # noqa: E731
