@@ -104,16 +104,19 @@ class LineFit:
     """How well an annotated centre line sits in a grid's free space.
 
     ``outside``: the share of the line's length on cells the grid does not read free (a
-    line through a wall or unknown space is no corridor); ``off_centre_m``: the median,
+    line through a wall or unknown space is no corridor). ``off_centre_m``: the median,
     over points every 0.5 m with a wall on both sides (a corridor open to a hall on one
     side has no middle there), of how far the point lies from the middle of the free run
     square to the line (half the difference of the free distances either side: a line
-    drawn along one wall is off by half the corridor's width). Junctions, doors and
-    pillars put single points off: the median is the line's own.
+    drawn along one wall is off by half the corridor's width); junctions, doors and
+    pillars put single points off, the median is the line's own. ``narrowest_m``: the
+    narrowest free run square to the line, every ``STEP_M`` on free cells (a line drawn
+    through a door is as narrow there as the door).
     """
 
     outside: float
     off_centre_m: float
+    narrowest_m: float
 
 
 def line_fit(plan: FloorPlanImage, line: LineString, reach_m: float = 3.0) -> LineFit:
@@ -128,20 +131,31 @@ def line_fit(plan: FloorPlanImage, line: LineString, reach_m: float = 3.0) -> Li
         out[ok] = free[r[ok], c[ok]]
         return out.reshape(pts.shape[:-1])
 
+    def runs(ts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Points at ``ts`` along the line and the free distance either side of each."""
+        pts = np.array([line.interpolate(t).coords[0] for t in ts])
+        ahead = np.array([line.interpolate(t + 0.05).coords[0] for t in ts]) - pts
+        u = ahead / np.linalg.norm(ahead, axis=1, keepdims=True)
+        normal = np.stack([-u[:, 1], u[:, 0]], axis=1)
+        steps = np.arange(1, round(reach_m / res) + 1) * res
+        out = []
+        for side in (1.0, -1.0):
+            blocked = ~is_free(pts[:, None, :] + side * steps[None, :, None] * normal[:, None, :])
+            out.append(np.where(blocked.any(axis=1), np.argmax(blocked, axis=1), len(steps)) * res)
+        return pts, out[0], out[1]
+
+    def along(step: float) -> np.ndarray:
+        ts = np.arange(0.5, line.length - 0.5, step)
+        return ts if len(ts) else np.array([line.length / 2.0])
+
+    _, left, right = runs(along(0.5))
+    walled = (left < reach_m) & (right < reach_m)
+    off = np.abs(left - right)[walled] / 2.0
+    pts, left, right = runs(along(STEP_M))
+    across = (left + right + res)[is_free(pts)]
     on = np.array([p.coords[0] for p in _samples(line)])
-    ts = np.arange(0.5, line.length - 0.5, 0.5)
-    if not len(ts):
-        ts = np.array([line.length / 2.0])
-    pts = np.array([line.interpolate(t).coords[0] for t in ts])
-    ahead = np.array([line.interpolate(t + 0.05).coords[0] for t in ts]) - pts
-    u = ahead / np.linalg.norm(ahead, axis=1, keepdims=True)
-    normal = np.stack([-u[:, 1], u[:, 0]], axis=1)
-    steps = np.arange(1, round(reach_m / res) + 1) * res
-    runs = []
-    for side in (1.0, -1.0):
-        ray = is_free(pts[:, None, :] + side * steps[None, :, None] * normal[:, None, :])
-        blocked = ~ray
-        runs.append(np.where(blocked.any(axis=1), np.argmax(blocked, axis=1), len(steps)) * res)
-    walled = (runs[0] < reach_m) & (runs[1] < reach_m)
-    off = np.abs(runs[0] - runs[1])[walled] / 2.0
-    return LineFit(float(1.0 - is_free(on).mean()), float(np.median(off)) if len(off) else 0.0)
+    return LineFit(
+        float(1.0 - is_free(on).mean()),
+        float(np.median(off)) if len(off) else 0.0,
+        float(across.min()) if len(across) else 0.0,
+    )

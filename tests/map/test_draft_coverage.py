@@ -110,13 +110,18 @@ def _measured(name: str):
 @pytest.mark.parametrize("name", sorted(REAL))
 def test_the_hand_annotations_run_down_the_middle_of_free_space(name):
     # The annotation is half the measure. Willow's used to run through walls and unknown
-    # space (12 to 20 % of four of its lines) and along a wall (0.6 m off the middle of the
-    # corridor to the west office), which the draft's centred lines were counted against.
+    # space (12 to 20 % of four of its lines), along a wall (0.6 m off the middle of the
+    # corridor to the west office) and through doors 0.65 to 0.75 m wide into rooms seen
+    # only through laser rays, which the draft's centred lines were counted against. A
+    # corridor is no narrower than the narrowest the draft looks for (1.0 m, a cell less
+    # for the grid's rounding); the hospital's cross corridor under the lobby, open to
+    # it behind a dotted glass front, is 0.48 m off by this measure.
     grid, ann = REAL[name]
     plan = load_ros_map(grid)
     for line in load_annotation(ann).corridors:
         fit = line_fit(plan, line)
-        assert fit.outside <= 0.05 and fit.off_centre_m <= 0.5, (name, list(line.coords), fit)
+        assert fit.outside <= 0.05, (name, list(line.coords), fit)
+        assert fit.off_centre_m <= 0.55 and fit.narrowest_m >= 0.9, (name, list(line.coords), fit)
 
 
 @pytest.mark.parametrize("name", sorted(REAL))
@@ -136,10 +141,9 @@ def test_draft_finds_most_of_a_real_building(name):
             "willow",
             marks=pytest.mark.xfail(
                 strict=True,
-                reason="not met yet: measured 86.3 % covered / 30.1 % spurious: corridor-shaped "
+                reason="not met yet: measured 96.3 % covered / 30.1 % spurious: corridor-shaped "
                 "aisles between the cluttered offices' desk rows, ways into the rooms and fans "
-                "east of the lounge and the east office, the north stubs (seen only through "
-                "laser rays) missed (docs/real-maps.md)",
+                "east of the lounge and the east office (docs/real-maps.md)",
             ),
         ),
     ],
