@@ -692,8 +692,12 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
     h.remove_edges_from(nx.selfloop_edges(h))
     prune_room_spurs(h, dist, res, params.room_widening)
     prune_alcoves(h, dist, params.corridor_ratio)
-    prune_fans(h, dist, seen_mask(plan), free, params.wall_min)
-    prune_unlined(h, corridor, dist, res, params.lined_min)
+    seen = seen_mask(plan)
+    # A loop the lined rule cuts leaves dead ends; the fan rule judges those too.
+    while prune_fans(h, dist, seen, free, params.wall_min) + prune_unlined(
+        h, corridor, dist, res, params.lined_min
+    ):
+        pass
     hall_hubs(h, open_mask, free, dist)
     warnings = []
     for rc, n_px in link_parts(h, free, params.link_max_m / res):

@@ -29,6 +29,7 @@ from shapely.geometry import LineString, MultiLineString, Point, Polygon
 
 from pmnav_bt.loading import InputFileError, load_yaml
 from pmnav_bt.map.building import Building
+from pmnav_bt.map.floorplan import FloorPlanImage
 
 TOL_M = 0.75  # a drafted centre line this close to the annotated one covers it
 STEP_M = 0.1
@@ -96,3 +97,65 @@ def measure(b: Building, ann: Annotation, tol_m: float = TOL_M) -> Coverage:
     ]
     spurious = np.mean([truth.distance(p) > tol_m for p in out_pts]) if out_pts else 0.0
     return Coverage(float(covered), float(spurious), ann.length_m, float(drafted.length))
+
+
+@dataclass(frozen=True)
+class LineFit:
+    """How well an annotated centre line sits in a grid's free space.
+
+    ``outside``: the share of the line's length on cells the grid does not read free (a
+    line through a wall or unknown space is no corridor). ``off_centre_m``: the median,
+    over points every 0.5 m with a wall on both sides (a corridor open to a hall on one
+    side has no middle there), of how far the point lies from the middle of the free run
+    square to the line (half the difference of the free distances either side: a line
+    drawn along one wall is off by half the corridor's width); junctions, doors and
+    pillars put single points off, the median is the line's own. ``narrowest_m``: the
+    narrowest free run square to the line, every ``STEP_M`` on free cells (a line drawn
+    through a door is as narrow there as the door).
+    """
+
+    outside: float
+    off_centre_m: float
+    narrowest_m: float
+
+
+def line_fit(plan: FloorPlanImage, line: LineString, reach_m: float = 3.0) -> LineFit:
+    """``LineFit`` of an annotated line on ``plan``; free runs looked for up to ``reach_m``."""
+    free = plan.occupancy() == 0
+    res = plan.resolution
+
+    def is_free(pts: np.ndarray) -> np.ndarray:
+        c, r = np.moveaxis(plan.world_to_pixel(pts.reshape(-1, 2)).round().astype(int), 1, 0)
+        ok = (r >= 0) & (r < free.shape[0]) & (c >= 0) & (c < free.shape[1])
+        out = np.zeros(len(r), bool)
+        out[ok] = free[r[ok], c[ok]]
+        return out.reshape(pts.shape[:-1])
+
+    def runs(ts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Points at ``ts`` along the line and the free distance either side of each."""
+        pts = np.array([line.interpolate(t).coords[0] for t in ts])
+        ahead = np.array([line.interpolate(t + 0.05).coords[0] for t in ts]) - pts
+        u = ahead / np.linalg.norm(ahead, axis=1, keepdims=True)
+        normal = np.stack([-u[:, 1], u[:, 0]], axis=1)
+        steps = np.arange(1, round(reach_m / res) + 1) * res
+        out = []
+        for side in (1.0, -1.0):
+            blocked = ~is_free(pts[:, None, :] + side * steps[None, :, None] * normal[:, None, :])
+            out.append(np.where(blocked.any(axis=1), np.argmax(blocked, axis=1), len(steps)) * res)
+        return pts, out[0], out[1]
+
+    def along(step: float) -> np.ndarray:
+        ts = np.arange(0.5, line.length - 0.5, step)
+        return ts if len(ts) else np.array([line.length / 2.0])
+
+    _, left, right = runs(along(0.5))
+    walled = (left < reach_m) & (right < reach_m)
+    off = np.abs(left - right)[walled] / 2.0
+    pts, left, right = runs(along(STEP_M))
+    across = (left + right + res)[is_free(pts)]
+    on = np.array([p.coords[0] for p in _samples(line)])
+    return LineFit(
+        float(1.0 - is_free(on).mean()),
+        float(np.median(off)) if len(off) else 0.0,
+        float(across.min()) if len(across) else 0.0,
+    )

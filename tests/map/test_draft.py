@@ -238,6 +238,37 @@ def test_a_dead_end_bordered_by_unseen_space_is_a_laser_fan(tmp_path):
     assert not any(w.pos[1] > 6.0 and w.pos[0] > 20 for w in b.waypoints)
 
 
+def test_a_fan_whose_rays_close_a_loop_is_a_fan_once_the_loop_is_cut(tmp_path):
+    # Off a walled corridor, rays with no wall seen round them: a strip north, a band
+    # across its top and a wedge widening from a second opening up to the band (Willow's
+    # big fan north of its west office, whose rays met again). The skeleton runs round
+    # the loop; the lined rule cuts the wedge (its sides diverge), which leaves the strip
+    # and the band a dead end bordered by space never seen: a fan, judged after the cut.
+    import cv2
+
+    res, (w, h) = 0.05, (680, 320)
+
+    def px(poly):
+        return np.array([[round(x / res), h - round(y / res)] for x, y in poly], np.int32)
+
+    free = np.zeros((h, w), np.uint8)
+    cv2.fillPoly(free, [px([(2, 2), (30, 2), (30, 4.4), (2, 4.4)])], 1)
+    img = np.full((h, w), 205, np.uint8)
+    img[cv2.dilate(free, np.ones((5, 5), np.uint8)) > 0] = 0
+    rays = [
+        [(20, 4.3), (21.8, 4.3), (21.8, 12), (20, 12)],
+        [(20, 10.4), (28.5, 10.4), (28.5, 12), (20, 12)],
+        [(24, 4.3), (26, 4.3), (28.5, 10.5), (21.8, 10.5)],
+    ]
+    for p in rays:  # one at a time: polygons filled together leave their overlaps out
+        cv2.fillPoly(free, [px(p)], 1)
+    img[free > 0] = 254
+    grid = save_ros_map(FloorPlanImage(img, res, (0.0, 0.0, 0.0)), tmp_path / "fan.yaml")
+    b, _, _ = draft_building(grid, tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert not any(wp.pos[1] > 5.0 for wp in b.waypoints), b.waypoints
+
+
 def test_walls_saved_as_grey_likelihoods_are_seen_and_unknown_is_not():
     from pmnav_bt.map.grid import seen_mask
 
