@@ -52,6 +52,10 @@ def _shared() -> Path:
 MAPS = {
     "hospital": (ROOT / "examples/hospital/hospital.yaml", None, DATA / "hospital_corridors.yaml"),
     "willow": (ROOT / "examples/maps/willow/willow.yaml", None, DATA / "willow_corridors.yaml"),
+    "stata": (ROOT / "examples/maps/stata/stata.yaml", None, DATA / "stata_corridors.yaml"),
+    "ipa_office": (
+        ROOT / "examples/maps/ipa_office/ipa_office.yaml", None, DATA / "ipa_office_corridors.yaml"
+    ),
     "ccia": (_shared() / "ccia/ccia.yaml", None, None),
     # The drawings' scales from their .building.yaml measurements (pixel pairs and metres).
     "clinic": (_shared() / "rmf/clinic/clinic.png", 0.7 / 26.001, None),

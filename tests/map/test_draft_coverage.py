@@ -96,6 +96,11 @@ def test_line_fit_tells_a_line_along_a_wall_or_through_one():
 REAL = {
     "hospital": (ROOT / "examples/hospital/hospital.yaml", DATA / "hospital_corridors.yaml"),
     "willow": (ROOT / "examples/maps/willow/willow.yaml", DATA / "willow_corridors.yaml"),
+    # Measured only, never tuned on: annotated before any draft of them was run.
+    "stata": (ROOT / "examples/maps/stata/stata.yaml", DATA / "stata_corridors.yaml"),
+    "ipa_office": (
+        ROOT / "examples/maps/ipa_office/ipa_office.yaml", DATA / "ipa_office_corridors.yaml"
+    ),
 }
 
 
@@ -144,6 +149,24 @@ def test_draft_finds_most_of_a_real_building(name):
                 reason="not met yet: measured 96.3 % covered / 30.1 % spurious: corridor-shaped "
                 "aisles between the cluttered offices' desk rows, ways into the rooms and fans "
                 "east of the lounge and the east office (docs/real-maps.md)",
+            ),
+        ),
+        pytest.param(
+            "stata",
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="not met yet: measured 85.3 % covered / 0.0 % spurious: the fan rule "
+                "takes the north corridor's 20 m west part, a dead end that ends in laser fans "
+                "(docs/real-maps.md)",
+            ),
+        ),
+        pytest.param(
+            "ipa_office",
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="not met yet: measured 100 % covered / 36.7 % spurious: corridors up "
+                "spaces seen only through laser rays north-west of the hall and at the "
+                "corridor's south-west end, stubs into rooms (docs/real-maps.md)",
             ),
         ),
     ],
