@@ -13,7 +13,7 @@ import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
-from pmnav_bt.behaviours.context import Context, thumbnail
+from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.localize import forget_stale_sightings
 from pmnav_bt.errors import UnknownNameError
 from pmnav_bt.failures import FailureCode
@@ -421,7 +421,7 @@ class FixFromBelief(PmNavBehaviour):
         self.ctx.log(
             "fix",
             how,
-            thumbnail(views[-1].observation.rgb) if views else None,
+            views[-1].observation.rgb if views else None,
             map_pose=[est_x, est_y],
             attempts=attempts,
         )

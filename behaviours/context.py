@@ -29,14 +29,33 @@ if TYPE_CHECKING:  # pragma: no cover
 
 @dataclass
 class TraceEvent:
-    """Something worth drawing later: a detection, a fix, a turn, a plan."""
+    """Something worth drawing later: a detection, a fix, a turn, a plan; with the camera
+    frame it was seen in, if any, shown by a thumbnail.
+
+    Shrinking a frame to its thumbnail takes a third of a millisecond, too long for a
+    tick (docs/architecture.md: a tick never blocks): ``Context.log`` keeps the frame and
+    has the worker shrink it (``shrink``); an event whose shrinking never ran (the run
+    ended first) shrinks its frame when its thumbnail is first asked for, after the run."""
 
     kind: str
     time: float
     odom: tuple[float, float, float]
     label: str = ""
     data: dict[str, Any] = field(default_factory=dict)
-    thumbnail: np.ndarray | None = None
+    frame: np.ndarray | None = None  # the frame, until it is shrunk to ``thumbnail``
+    _thumbnail: np.ndarray | None = field(default=None, repr=False)
+
+    def shrink(self) -> None:
+        """Replace the frame by its thumbnail (in the worker; nothing to do once done)."""
+        frame = self.frame
+        if frame is not None:
+            self._thumbnail, self.frame = thumbnail(frame), None
+
+    @property
+    def thumbnail(self) -> np.ndarray | None:
+        """A small copy of the frame (None: the event has none)."""
+        self.shrink()
+        return self._thumbnail
 
 
 @dataclass
@@ -101,9 +120,14 @@ class Context:
     def now(self) -> float:
         return self.base.clock.now()
 
-    def log(self, kind: str, label: str = "", thumbnail: np.ndarray | None = None, **data) -> None:
+    def log(self, kind: str, label: str = "", frame: np.ndarray | None = None, **data) -> None:
+        """Add an event to the trace, with the camera ``frame`` (RGB) it was seen in, if any:
+        its thumbnail is made in the worker (``TraceEvent``), not in the tick."""
         p = self.base.pose()
-        self.trace.append(TraceEvent(kind, self.now(), (p.x, p.y, p.yaw), label, data, thumbnail))
+        event = TraceEvent(kind, self.now(), (p.x, p.y, p.yaw), label, data, frame)
+        self.trace.append(event)
+        if frame is not None:
+            self.worker.submit(lambda cancelled: event.shrink())
 
 
 def map_pose(map_T_odom: tuple[float, float, float] | None, odom: Pose2D) -> Pose2D:

@@ -14,7 +14,7 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.capture import CaptureViews
 from pmnav_bt.behaviours.common import PmNavBehaviour
-from pmnav_bt.behaviours.context import Context, thumbnail
+from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.motion import DriveTo
 from pmnav_bt.behaviours.search import FaceAndGround
 from pmnav_bt.errors import UnknownNameError
@@ -194,7 +194,7 @@ class ExploreFrontier(RouteDrive):
             self._grid.integrate(found["scan"])
         if found.get("seen"):
             self._seen = True
-            self.ctx.log("sign", str(self._entity), thumbnail(obs.rgb))
+            self.ctx.log("sign", str(self._entity), obs.rgb)
 
     def update(self) -> Status:
         if self._choice is None:
@@ -281,7 +281,7 @@ class PlaceDoor(PmNavBehaviour):
         self.ctx.log(
             "detection",
             det.entity.id if det.entity else det.label,
-            thumbnail(obs.rgb),
+            obs.rgb,
             score=det.score,
             seen_odom=list(door),
         )

@@ -19,7 +19,7 @@ import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
-from pmnav_bt.behaviours.context import Context, heading_error, map_pose, thumbnail
+from pmnav_bt.behaviours.context import Context, heading_error, map_pose
 from pmnav_bt.behaviours.pose import axis_correction, keep_on_axis, measure_walls
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
@@ -232,7 +232,7 @@ class DriveTo(PmNavBehaviour):
         point = found.get("detour") if self._detours < MAX_DETOURS else None
         if self._hold is None:
             self._hold = Hold(now, free, obs, point, moving=bool(found.get("moved")))
-            self.ctx.log("obstacle", "", thumbnail(obs.rgb), free=free, moving=self._hold.moving)
+            self.ctx.log("obstacle", "", obs.rgb, free=free, moving=self._hold.moving)
         else:
             self._hold.seen(obs, free, point, found.get("moved"))
         hold = self._hold
@@ -427,7 +427,7 @@ class DriveToWaypoint(DriveTo):
             self._goal = p
             self._corner_seen = True
             r = found["ratios"]
-            self.ctx.log("corner", t.landmark, thumbnail(obs.rgb), wall=r.wall, floor=r.floor)
+            self.ctx.log("corner", t.landmark, obs.rgb, wall=r.wall, floor=r.floor)
 
 
 def wall_beyond(pm, position, heading: float) -> bool:

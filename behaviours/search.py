@@ -8,7 +8,7 @@ import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
-from pmnav_bt.behaviours.context import map_pose, thumbnail
+from pmnav_bt.behaviours.context import map_pose
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import se2_apply, wrap_angle
 from pmnav_bt.planning.resolve import entity_position, step_entity
@@ -193,23 +193,19 @@ class FineDirection(PmNavBehaviour):
         choice: CoarseChoice = self.get("choice")
         obs, det = choice.view.observation, choice.detection
         refiner = self.ctx.refiner
-        # A refiner may be a network (PixelNav): it runs in the worker, and so does the
-        # trace's thumbnail of the view (a third of a millisecond: not in a tick).
+        # A refiner may be a network (PixelNav): it runs in the worker.
         self._job = (
-            self.ctx.worker.submit(lambda c: (refiner.refine(obs, det), thumbnail(obs.rgb)))
-            if self.refine
-            else None
+            self.ctx.worker.submit(lambda c: refiner.refine(obs, det)) if self.refine else None
         )
 
     def update(self) -> Status:
         choice: CoarseChoice = self.get("choice")
         obs, det = choice.view.observation, choice.detection
-        bearing, rng, thumb = 0.0, None, None
+        bearing, rng = 0.0, None
         if self._job is not None:
-            status, done = self.poll(self._job, "refining the direction")
+            status, refined = self.poll(self._job, "refining the direction")
             if status is not None:
                 return status
-            refined, thumb = done
             bearing, rng = float(refined.bearing), refined.range
         t = self.get("target")
         entity = target_entity(self)
@@ -222,9 +218,7 @@ class FineDirection(PmNavBehaviour):
         s = Sighting(entity, (float(m[0]), float(m[1])), (float(odom[0]), float(odom[1])))
         self.bb.set("bearing", bearing)
         self.bb.set("sighting", s)
-        if thumb is None:  # not refined: no job to make it in
-            thumb = thumbnail(obs.rgb)
-        self.ctx.log("detection", t.look_for, thumb, score=det.score, seen_odom=list(s.odom_xy))
+        self.ctx.log("detection", t.look_for, obs.rgb, score=det.score, seen_odom=list(s.odom_xy))
         self.feedback_message = f"{t.look_for} at {math.degrees(bearing):+.1f} deg"
         return Status.SUCCESS
 

@@ -129,3 +129,24 @@ def make_rig(request, body, pm, clean_blackboard):
     yield make
     for rig in made:
         rig.close()
+
+
+@pytest.fixture
+def thumbnails_off_the_tick(monkeypatch):
+    """A trace thumbnail made on the ticking (main) thread fails the test
+    (docs/architecture.md: a tick never blocks; ``context.TraceEvent``); yields the names of
+    the threads that made them."""
+    import threading
+
+    from pmnav_bt.behaviours import context
+
+    made, shrink = [], context.thumbnail
+
+    def off_the_tick(rgb, *args, **kw):
+        if threading.current_thread() is threading.main_thread():
+            raise AssertionError("a trace thumbnail made in the tick")
+        made.append(threading.current_thread().name)
+        return shrink(rgb, *args, **kw)
+
+    monkeypatch.setattr(context, "thumbnail", off_the_tick)
+    return made

@@ -153,7 +153,9 @@ def test_move_toward_stops_keep_short_or_after_distance(make_rig):
     assert seen == [Status.SUCCESS]  # already closer than keep: nothing to do
 
 
-def test_drive_to_waypoint_corner_check_stops_at_turn1_despite_a_bad_estimate(make_rig):
+def test_drive_to_waypoint_corner_check_stops_at_turn1_despite_a_bad_estimate(
+    make_rig, thumbnails_off_the_tick
+):
     rig = make_rig(Pose2D(0.0, 5.0, SOUTH))
     plan, step = turn1(rig)
     # The estimate is 1.5 m north of the truth: by the map alone it would drive into the
@@ -167,6 +169,7 @@ def test_drive_to_waypoint_corner_check_stops_at_turn1_despite_a_bad_estimate(ma
     assert rig.stopped()
     corners = [e for e in rig.ctx.trace if e.kind == "corner"]
     assert len(corners) == 1 and corners[0].label == "turn1"
+    assert corners[0].frame is None and corners[0].thumbnail is not None  # shrunk in the worker
     assert corners[0].data["wall"] >= 0.5 and corners[0].data["floor"] <= 0.15
 
 

@@ -313,7 +313,7 @@ def test_a_drive_adds_no_ray_after_a_new_distance_gain_until_a_look(
     assert (len(after.rays) == 0) == new_gain, len(after.rays)
 
 
-def test_a_fix_forgets_the_sightings_kept_for_heading_re_fits(make_rig):
+def test_a_fix_forgets_the_sightings_kept_for_heading_re_fits(make_rig, thumbnails_off_the_tick):
     """Sightings verified before this fix were made in an odometry frame that the
     panorama's spin has since turned: kept, they would re-fit the heading off by that turn
     (``forget_stale_sightings``)."""
@@ -329,6 +329,9 @@ def test_a_fix_forgets_the_sightings_kept_for_heading_re_fits(make_rig):
     rig.expect(rig.run(FixFromBelief("LocalizeFix", rig.ctx)), Status.SUCCESS)
     assert rig.get("map_T_odom") is not None
     assert rig.get("recent_sightings") is None
+    rig.wait()  # the worker's jobs after the tick
+    fix = rig.ctx.trace[-1]  # the view fixed from, shrunk in the worker (not in the tick)
+    assert fix.kind == "fix" and fix.frame is None and fix.thumbnail is not None
 
 
 def test_a_look_halted_half_way_leaves_the_belief_as_it_was(make_rig):

@@ -204,7 +204,9 @@ def fine_and_verify(rig, map_T_odom):
     return verify
 
 
-def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_truth(make_rig, pm):
+def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_truth(
+    make_rig, pm, thumbnails_off_the_tick
+):
     rig = make_rig(NORTH_OF_ROOM4, grounder=ScriptedGrounder(pm, masks=True))
     search(rig, targets(rig)["room4"])
     # Odometry is the map frame here; the estimate is off by (0.5, 1.0) m.
@@ -222,7 +224,9 @@ def test_a_true_sighting_verifies_and_pulls_an_offset_map_t_odom_towards_the_tru
     seen_dir = math.atan2(s.odom_xy[1] - p.y, s.odom_xy[0] - p.x)
     assert rig.yaw_error(seen_dir, p.yaw + bearing) < 0.01  # along the refined bearing
     event = rig.ctx.trace[-1]
-    assert event.kind == "detection" and event.label == "room4" and event.thumbnail is not None
+    assert event.kind == "detection" and event.label == "room4"
+    rig.wait()  # the worker's jobs after the tick
+    assert event.frame is None and event.thumbnail is not None  # shrunk in the worker
 
     tf = rig.get("map_T_odom")
     assert tf[2] == 0.0  # one landmark: position only

@@ -83,12 +83,15 @@ def test_someone_who_stays_in_the_way_is_passed_only_after_the_patience(make_rig
     assert gap > 0.2
 
 
-def test_clutter_that_stands_still_is_driven_round_without_waiting(make_rig):
+def test_clutter_that_stands_still_is_driven_round_without_waiting(
+    make_rig, thumbnails_off_the_tick
+):
     rig = make_rig(START)
     rig.body.obstacles = [FakeObstacle.standing(7.0, 0.0, 0.3)]
     seen, gap = drive(rig)
     rig.expect(seen, Status.SUCCESS)
     (stop,), (passed,) = events(rig, "obstacle"), events(rig, "detour")
+    assert stop.frame is None and stop.thumbnail is not None  # shrunk in the worker
     assert not passed.data["moving"] and passed.time - stop.time < 3.0
     assert gap > 0.0
 
