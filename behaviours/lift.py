@@ -10,6 +10,8 @@ leaves, in the order ``trees/lift.py`` strings them:
 - ``CallLift``: ask for the lift at a level (again with another level to ride);
 - ``WaitForLift``: until the lift says it is at that level with its door open for us
   (LIFT_NOT_COMING after a clock timeout);
+- ``FindDoors``: depth finds the open doorway, ahead or turned aside, and the estimate
+  is moved along the wall to put it where the map has it;
 - ``CabinHasRoom``: depth says whether the cabin's floor is free (LIFT_FULL, counted);
 - ``ReleaseLift``: end the session (a full cabin goes on without us; off at the far end);
 - ``DriveThrough``: straight through the doorway, into the cabin's middle or out to the
@@ -35,6 +37,7 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
+from enum import Enum
 
 import numpy as np
 from py_trees.common import Status
@@ -77,6 +80,28 @@ SCAN_STEP = math.radians(2.5)
 # action; walking off to look elsewhere would.
 CABIN_LOOKS = 4
 CABIN_LOOK_AGAIN_S = 4.0
+# The open doors are looked for turned this far either way from facing them, when the look
+# straight at them does not show the whole opening: an estimate off along the wall (a
+# lift's plate, the sign the leg found it by, hangs 1-2 m beside its doors) puts the
+# doors aside. A 60-degree camera turned 40 degrees sees 10-70 degrees off the doors'
+# normal: from the corridor's centre line 1.2 m off the wall, 0.2-3.3 m along it.
+DOORS_ASIDE = math.radians(40.0)
+# A ray through the doorway shows floor this far past the wall's far face at least (the
+# cabin is 1.6 m deep; the wall beside the doors shows none).
+PAST_WALL_M = 0.2
+# A ray that stops this near the wall's face meets the wall (a jamb), not someone before it.
+JAMB_M = 0.3
+# Rays more oblique than this to the wall see too little through a doorway to tell.
+DOORS_OBLIQUE = math.radians(75.0)
+# The opening found is the lift's when its middle is at most this far along the wall from
+# where the estimate puts the doors: a lift's plate is 0.8-2.2 m beside them, so an
+# estimate the plate placed is off by as much (an open room door farther off is not it).
+DOORS_SHIFT_M = 2.5
+# A stretch of rays through an opening narrower than this along the wall is not taken
+# for a doorway (someone standing in it, a gap between people), nor one wider than the
+# doorway by this (a side corridor, a lobby open to the corridor).
+DOORS_MIN_RUN_M = 0.4
+DOORS_WIDER_M = 0.3
 # The estimate on arrival: the cabin on the new level's map, as sure as the ride put the
 # robot there (it drove in on the old level's estimate, a few tenths of a metre off).
 ARRIVAL_SIGMA_M = 0.5
@@ -239,6 +264,180 @@ def look_into_cabin(obs, est: Pose2D, d: Doorway) -> CabinLook:
             passing.append((float(b), reach))
     way = passing[len(passing) // 2] if passing else None
     return CabinLook(way, deepest > to_wall + DOORWAY_WALL_M + 0.2)
+
+
+class Ray(Enum):
+    """What one ray of ``opening_samples`` meets at the lift's wall: it sees floor past
+    the wall (``THROUGH`` an opening), the wall's face (``WALL``, within ``JAMB_M``: a
+    jamb beside an opening), or something nearer (``NEAR``: a person, a cart)."""
+
+    THROUGH = "through"
+    WALL = "wall"
+    NEAR = "near"
+
+
+def opening_samples(obs, est: Pose2D, d: Doorway) -> list[tuple[float, Ray]]:
+    """Where the frame's rays cross the plane of the lift's wall and what each meets there
+    (``Ray``): ``(s, ray)`` per ray, ``s`` metres along the wall from the doorway's centre
+    on the estimate ``est`` (the map pose the frame was taken from). Rays more oblique
+    than ``DOORS_OBLIQUE`` are left out; none without depth."""
+    if obs.depth is None:
+        return []
+    k = obs.intrinsics
+    u = np.asarray(d.into, float)
+    along = np.array([-u[1], u[0]])
+    to_wall = float(np.dot(np.subtract(d.centre, (est.x, est.y)), u))
+    if to_wall <= 0.0:
+        return []
+    half_fov = math.atan2(k.cx, k.fx) - SCAN_STEP
+    out = []
+    for b in np.arange(-half_fov, half_fov + 1e-9, SCAN_STEP / 2.0):
+        yaw = est.yaw + float(b)
+        off = wrap_angle(yaw - d.yaw_in)
+        if abs(off) >= DOORS_OBLIQUE:
+            continue
+        reach = to_wall / math.cos(off)  # along the ray to the wall's near face
+        cross = np.array([est.x, est.y]) + reach * np.array([math.cos(yaw), math.sin(yaw)])
+        s = float(np.dot(cross - np.asarray(d.centre), along))
+        deep = free_distance(obs, float(b), half_width=0.02) * math.cos(off)
+        if deep >= to_wall + DOORWAY_WALL_M + PAST_WALL_M:
+            out.append((s, Ray.THROUGH))
+        else:
+            out.append((s, Ray.WALL if deep >= to_wall - JAMB_M else Ray.NEAR))
+    return out
+
+
+def doors_along(samples: list[tuple[float, Ray]], s_robot: float, width: float) -> float | None:
+    """Where along the wall (m from where the estimate puts the doorway's centre) the open
+    doorway is, from the rays of ``opening_samples`` (several frames together), or None
+    when no doorway is seen within ``DOORS_SHIFT_M``. ``s_robot``: the robot's own place
+    along the wall, ``width``: the doorway's.
+
+    An opening is a run of rays, in order along the wall, that all see through. Its edge
+    is a jamb where the ray beside it meets the wall; where it meets something nearer,
+    someone stands before the opening and hides where it ends. Seen from aside, the near
+    jamb is sharp but the far one is hidden by the cabin's side (a ray at 70 degrees
+    enters only a metre deep): the doorway's middle is then half its ``width`` beyond the
+    near jamb. Seen from in front of it, both jambs are: their middle. An opening whose
+    jambs are hidden says nothing."""
+    ordered = sorted(samples, key=lambda sr: sr[0])
+    runs: list[tuple[int, int]] = []  # first and last index of each run of THROUGH rays
+    for i, (_, ray) in enumerate(ordered):
+        if ray is not Ray.THROUGH:
+            continue
+        if runs and runs[-1][1] == i - 1:
+            runs[-1] = (runs[-1][0], i)
+        else:
+            runs.append((i, i))
+
+    def jamb(j: int) -> bool:
+        return 0 <= j < len(ordered) and ordered[j][1] is Ray.WALL
+
+    best = None
+    for i, j in runs:
+        lo, hi = ordered[i][0], ordered[j][0]
+        if not DOORS_MIN_RUN_M <= hi - lo <= width + DOORS_WIDER_M:
+            continue
+        if lo > s_robot and jamb(i - 1):  # the doorway is on ahead along the wall
+            middle = lo + width / 2.0
+        elif hi < s_robot and jamb(j + 1):
+            middle = hi - width / 2.0
+        elif lo <= s_robot <= hi and jamb(i - 1) and jamb(j + 1):
+            middle = (lo + hi) / 2.0
+        else:
+            continue
+        if abs(middle) <= DOORS_SHIFT_M and (best is None or abs(middle) < abs(best)):
+            best = middle
+    return best
+
+
+class FindDoors(PmNavBehaviour):
+    """The lift says its doors are open here: find the doorway with depth and put the
+    estimate where the doorway says. It looks straight at the doors (the robot stands at
+    the lobby point on its estimate); unless that frame shows the whole opening, turned
+    ``DOORS_ASIDE`` to either side too. The rays through an opening (``opening_samples``,
+    ``doors_along``) say where the doorway is along the wall; the map places it exactly,
+    so the estimate is moved along the wall by the difference (the across-wall distance
+    it already had from the walls). The leg found the lift by its plate, which hangs a
+    metre or two beside the doors, so the estimate may be off by that much along the wall:
+    the doors then stand aside of the lobby point, out of the straight look. The next leaf
+    (``ToLobby`` again) drives to the lobby point on the corrected estimate.
+
+    SUCCESS in any case (no opening seen: someone may stand before the doors, which
+    ``CabinHasRoom`` waits for). Each frame is judged in the worker.
+
+    Reads ``map_T_odom``, ``pose_tracker``; writes ``map_T_odom``, ``pose_tracker``."""
+
+    READS = ("map_T_odom", "pose_tracker")
+    WRITES = ("map_T_odom", "pose_tracker")
+    JOBS = ("_job",)
+    STOPS_BASE = True
+
+    def __init__(self, name: str, ctx: Context, ride: Ride):
+        super().__init__(name, ctx)
+        self.ride = ride
+
+    def initialise(self) -> None:
+        self._turns = [0.0, DOORS_ASIDE, -DOORS_ASIDE]
+        self._samples: list[tuple[float, Ray]] = []
+        self._job = None
+
+    def update(self) -> Status:
+        d, tf = self.ride.board, self.get("map_T_odom")
+        if tf is None:
+            return Status.SUCCESS
+        if self._job is None:
+            est = map_pose(tf, self.ctx.base.pose())
+            if not self.face(wrap_angle(d.yaw_in + self._turns[0]), est):
+                return Status.RUNNING
+            base = self.ctx.base
+
+            def look(cancelled):
+                obs = base.observe()
+                return opening_samples(obs, map_pose(tf, obs.pose), d)
+
+            self._job = self.ctx.worker.submit(look)
+            return Status.RUNNING
+        status, samples = self.poll(self._job, "looking for the lift's doors")
+        if status is not None:
+            return status
+        self._job = None
+        first = self._turns.pop(0) == 0.0
+        self._samples += samples
+        if first and not _whole_opening(samples, d.width):
+            return Status.RUNNING  # and look aside
+        if self._turns and not first:
+            return Status.RUNNING
+        return self._correct(tf)
+
+    def _correct(self, tf) -> Status:
+        d, r = self.ride.board, self.ride
+        u = np.asarray(d.into, float)
+        along = np.array([-u[1], u[0]])
+        est = map_pose(tf, self.ctx.base.pose())
+        s_robot = float(np.dot(np.subtract((est.x, est.y), d.centre), along))
+        shift = doors_along(self._samples, s_robot, d.width)
+        if shift is None:
+            self.feedback_message = f"no open doorway of {r.name} seen"
+            return Status.SUCCESS
+        moved = (tf[0] - shift * along[0], tf[1] - shift * along[1], tf[2])
+        self.bb.set("map_T_odom", moved)
+        tracker = self.get("pose_tracker")
+        if tracker is not None:
+            tracker.reset(moved, 0.0, self.ctx.odometer.distance)
+            self.bb.set("pose_tracker", tracker)
+        self.ctx.log("lift_doors", r.lift, shift=shift)
+        self.feedback_message = f"the doors of {r.name} {shift:+.2f} m along the wall"
+        return Status.SUCCESS
+
+
+def _whole_opening(samples: list[tuple[float, Ray]], width: float) -> bool:
+    """Whether one frame's rays show an opening with the wall on both sides, as wide as
+    half a doorway at least (the straight look at doors where the estimate has them)."""
+    if len(samples) < 3 or samples[0][1] is not Ray.WALL or samples[-1][1] is not Ray.WALL:
+        return False
+    through = [s for s, ray in samples if ray is Ray.THROUGH]
+    return bool(through) and max(through) - min(through) >= width / 2.0
 
 
 class CabinHasRoom(PmNavBehaviour):

@@ -40,6 +40,10 @@ MAX_BUMPS = 3  # collisions before a drive gives up as blocked
 # corridor width and this margin, the estimate at most this far from the waypoint.
 WALL_ARRIVAL_MARGIN_M = 0.4
 WALL_ARRIVAL_NEAR_M = 3.0
+# ... and that wall spans the way: depth this far either side of the way shows it too (a
+# wall across a corridor fills the view; someone standing 1.1 m ahead, half a metre
+# wide, covers 13 degrees either side of the way and leaves the wall beyond in view).
+WALL_ACROSS = math.radians(20.0)
 # Depth is checked this far ahead: a 1 m box leaves the 1.6 m camera's view 1.4 m away.
 OBSTACLE_RANGE = 2.0
 # Round an obstacle: the nearest bearing off the way to the goal (either side, in view)
@@ -188,6 +192,7 @@ class DriveTo(PmNavBehaviour):
                     if line is not None and tf is not None:
                         found["axis"] = axis_correction(self.ctx.pm, tf, obs.pose, line)
                     found["ahead"] = ahead = _toward_goal(obs, est, goal)
+                    found["wall_across"] = _wall_across(obs, est, goal, ahead)
                     blocked = _closer_than_goal(ahead, est, goal)
                     if blocked is not None and before is not None and steer.movers(before, obs):
                         way = wrap_angle(heading((est.x, est.y), goal) - est.yaw)
@@ -213,7 +218,7 @@ class DriveTo(PmNavBehaviour):
             keep_on_axis(self, obs.pose, found["walls"], found.get("axis"))
         self.on_watch(found, obs)
         ahead = found.get("ahead")
-        if ahead is not None and self.arrived_at_wall(ahead):
+        if ahead is not None and found["wall_across"] and self.arrived_at_wall(ahead):
             self.feedback_message = f"at the wall beyond the waypoint ({ahead:.1f} m ahead)"
             return Status.SUCCESS
         if free is None:
@@ -313,6 +318,20 @@ def _toward_goal(obs, est, goal) -> float | None:
     if abs(wrap_angle(bearing)) > math.radians(25):
         return None  # still turning towards the goal: nothing to judge yet
     return free_distance(obs, bearing)
+
+
+def _wall_across(obs, est, goal, ahead: float | None) -> bool:
+    """Whether what stands ``ahead`` m towards ``goal`` spans the way as a wall does:
+    depth along thin rays ``WALL_ACROSS`` either side of the way stops no farther than
+    the plane there."""
+    if ahead is None:
+        return False
+    bearing = heading((est.x, est.y), goal) - est.yaw
+    return all(
+        free_distance(obs, bearing + side, half_width=0.05) * math.cos(side)
+        <= ahead + WALL_ARRIVAL_MARGIN_M
+        for side in (-WALL_ACROSS, WALL_ACROSS)
+    )
 
 
 def _closer_than_goal(free: float | None, est, goal) -> float | None:

@@ -6,7 +6,9 @@ where the robot is on the new level (issue 40)::
         ToLobby                      to the lobby point, facing the doors
         Board (again while it came full, up to tree.lift_full_tries times)
           BoardOrLetGo
-            BoardOnce: CallLift, WaitForLift (LIFT_NOT_COMING), CabinHasRoom (LIFT_FULL)
+            BoardOnce: CallLift, WaitForLift (LIFT_NOT_COMING), FindDoors (the doorway
+                       in depth puts the estimate right along the wall), ToLobby again,
+                       CabinHasRoom (LIFT_FULL)
             LetItGo: it came full -> ReleaseLift, Wait tree.lift_full_wait_s, CallAgain
         IntoCabin, TurnRound         drive into the cabin's middle, face the doors
         AskForLevel, RideToLevel     ask for the level, wait for the door there
@@ -43,6 +45,7 @@ from pmnav_bt.behaviours.lift import (
     CallLift,
     CheckLevel,
     DriveThrough,
+    FindDoors,
     LiftWordStands,
     OnNewLevel,
     ReleaseLift,
@@ -77,6 +80,8 @@ def lift_subtree(
         f"{name}BoardOnce",
         CallLift(f"{name}Call", ctx_from, lift, ride, ride.from_level),
         WaitForLift(f"{name}WaitForDoor", ctx_from, lift, ride, ride.from_level, cfg.lift_wait_s),
+        FindDoors(f"{name}FindDoors", ctx_from, ride),
+        ToLobby(f"{name}BeforeDoors", ctx_from, ride),
         CabinHasRoom(f"{name}CabinHasRoom", ctx_from, ride, cfg.lift_full_tries),
     )
     let_go = sequence(

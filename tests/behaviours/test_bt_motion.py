@@ -209,6 +209,20 @@ def test_drive_to_waypoint_stops_at_the_wall_beyond_a_t_junction_it_cannot_place
     assert [e.label for e in rig.ctx.trace if e.kind == "at_wall"] == ["branch1"]
 
 
+def test_someone_standing_before_a_t_junction_is_not_taken_for_its_wall(make_rig):
+    # hospital_2l cross_level #6: 2.5 m before the T, someone stood 1.1 m ahead; depth
+    # towards the waypoint stopped there, within half a corridor width, and the drive
+    # took them for the wall beyond the T: it turned into the wing's wall and failed
+    # BLOCKED. A wall spans the way; a person leaves the wall beyond in view either side:
+    # the drive goes round them or waits, but it is not at the T.
+    rig = make_rig(Pose2D(36.0, 17.5, NORTH))
+    plan = rig.plan("36,17.5,90", "room19")
+    rig.set(plan=plan, target=plan.steps[0], map_T_odom=(0.0, 0.0, 0.0))
+    rig.add_obstacle(36.0, 18.6 + 0.25, size=0.5, height=1.9)  # someone standing
+    rig.run(DriveToWaypoint("CornerCheck", rig.ctx), max_ticks=600)
+    assert not [e for e in rig.ctx.trace if e.kind == "at_wall"]
+
+
 def test_a_wall_beyond_a_waypoint_is_where_no_corridor_goes_straight_on(pm):
     assert wall_beyond(pm, (36.0, 20.0), math.pi / 2)  # branch1 from its stem: a T
     assert not wall_beyond(pm, (36.0, 20.0), 0.0)  # along its bar: on to end1

@@ -12,7 +12,13 @@ from blackboard_kit import writer
 from building_kit import as_floor
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.lift import Ride, look_into_cabin
+from pmnav_bt.behaviours.lift import (
+    DOORS_ASIDE,
+    Ride,
+    doors_along,
+    look_into_cabin,
+    opening_samples,
+)
 from pmnav_bt.config import load_config
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.lift_doorway import DOORWAY_WALL_M, doorway
@@ -89,6 +95,37 @@ def test_depth_sees_shut_doors_an_open_cabin_a_full_one_and_the_way_in(worlds, l
     finally:
         cabin.set_door(False)
         cabin.empty()
+        body.close()
+
+
+@pytest.mark.parametrize("off", [-1.6, -0.8, 0.0, 1.4])
+def test_the_open_doors_seen_aside_put_the_estimate_right_along_the_wall(worlds, levels, off):
+    """The robot stands ``off`` m along the corridor from the lobby point, believing it is
+    at the lobby point (the lift's plate, 1-2 m beside the doors, placed it): the doorway
+    seen in depth, straight ahead and turned aside, says where along the wall it is."""
+    body = LevelBody(worlds, "L3", Pose2D(0.0, 0.0, 0.0), width=160, height=120)
+    cabin = worlds["L3"].cabins["elevator1"]
+    d = doorway(parse_building(levels["L3"]), "elevator1")
+    u = np.asarray(d.into)
+    along = np.array([-u[1], u[0]])
+    truly = np.asarray(d.lobby) + off * along
+
+    def samples():
+        out = []
+        for turn in (0.0, DOORS_ASIDE, -DOORS_ASIDE):
+            body.carry("L3", Pose2D(*truly, d.yaw_in + turn))
+            out += opening_samples(body.observe(), Pose2D(*d.lobby, d.yaw_in + turn), d)
+        return out
+
+    try:
+        assert doors_along(samples(), 0.0, d.width) is None  # shut: no doorway
+        cabin.set_door(True)
+        shift = doors_along(samples(), 0.0, d.width)
+        assert shift is not None
+        moved = np.asarray(d.lobby) - shift * along  # the estimate, put right
+        assert np.linalg.norm(moved - truly) < 0.25
+    finally:
+        cabin.set_door(False)
         body.close()
 
 
