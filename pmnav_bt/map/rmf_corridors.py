@@ -12,11 +12,13 @@ their centre lines, and they also lead into rooms and to parking spots. The step
    kept, the others are listed as skipped.
 3. **Centred and measured**: across each corridor, rays out to ``CAP_M`` on both sides
    find the walls; where both sides hit, the centre line moves to the middle (unless the
-   middle runs into more obstacles than the lane, a hall's pillars) and the width is the
-   median wall-to-wall distance. Where one side is open (a hall), the line
-   stays and the width is twice the distance to the one wall; with no wall either side,
-   ``OPEN_WIDTH_M``. A dead end is carried on along its corridor while walls stand on
-   both sides ahead (a lane that stops at a parking spot half way down a corridor).
+   middle runs into more obstacles than the lane, a hall's pillars); where one side is
+   open (a hall), the line stays. The width is measured along the whole line: twice the
+   clearance the nearer side keeps over every stretch of ``NARROW_RUN_M`` (a corridor is
+   one rectangle about its centre line, so it is what is free all along, not a median
+   over a lane that passes a gap); with no wall either side, ``OPEN_WIDTH_M``. A dead end
+   is carried on along its corridor while walls stand on both sides ahead (a lane that
+   stops at a parking spot half way down a corridor).
 4. **Key waypoints** at the least-squares crossing of their corridors' centre lines, so
    every waypoint is on every centre line that meets there.
 """
@@ -44,6 +46,7 @@ OPEN_WIDTH_M = 3.0  # the width of a lane across a hall with no wall within CAP_
 EXTEND_M = 30.0  # a dead end is carried on at most this far
 WALLED = 0.5  # a stretch is corridor-shaped where this share has walls on both sides
 CROSSING_DEG = 20.0  # corridors meeting at more than this fix their waypoint by crossing
+NARROW_RUN_M = 0.5  # a narrowing at least this long sets a corridor's width
 
 
 @dataclass
@@ -219,16 +222,27 @@ def _centre(plan: FloorPlanImage, free, walls, a: np.ndarray, b: np.ndarray):
     left, right = dist
     both = np.isfinite(left) & np.isfinite(right)
     mid = (a + b) / 2.0
-    if both.mean() >= WALLED:
-        off = float(np.median((left[both] - right[both]) / 2.0))
-        width = float(np.median(left[both] + right[both]))
-    else:
-        one = np.minimum(left, right)
-        one = one[np.isfinite(one)]
-        off, width = 0.0, 2.0 * float(np.median(one)) if len(one) else OPEN_WIDTH_M
+    off = float(np.median((left[both] - right[both]) / 2.0)) if both.mean() >= WALLED else 0.0
     if off and _blocked(plan, free, a + off * n, b + off * n) > _blocked(plan, free, a, b):
         off = 0.0  # the middle runs into a pillar the lane passes by: keep the lane
+    reach = min(_narrowest(left - off, s), _narrowest(right + off, s))
+    width = 2.0 * reach if np.isfinite(reach) else OPEN_WIDTH_M
     return (mid + off * n, u), max(MIN_WIDTH_M, min(width, 2.0 * CAP_M))
+
+
+def _narrowest(clear: np.ndarray, s: np.ndarray) -> float:
+    """The clearance a side keeps along the whole line: the widest that every stretch of
+    ``NARROW_RUN_M`` has (``clear`` per sample at ``s``, inf where no wall is in reach).
+
+    A corridor is one rectangle about its centre line, so its half-width is what that
+    side leaves free all along, not a median: a lane through a gap between a room's
+    corner on one side and another's on the other (walls on both sides, but never
+    abreast) has a median wall-to-wall width of the hall, and the gap's is the robot's.
+    A narrowing shorter than ``NARROW_RUN_M`` (a grid speck, a door jamb) is not it."""
+    step = float(s[1] - s[0]) if len(s) > 1 else NARROW_RUN_M
+    k = min(len(clear), max(1, math.ceil(NARROW_RUN_M / max(step, 1e-9))))
+    runs = np.lib.stride_tricks.sliding_window_view(clear, k).max(axis=1)
+    return float(runs.min())
 
 
 def _blocked(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:

@@ -19,9 +19,14 @@ hold, as log-likelihoods in one currency:
 
 A reading is a sighting of the best entity only when that entity is ``MARGIN`` times as
 likely as all the others and none of them together (``decide``): otherwise it is ambiguous and
-names nothing, and the tree looks again. ``Evidence`` from several reads of one plate
-adds up (consistency), and a prior over entities (the order of the doors along the
-corridor, ``grounders/plate_memory.py``) can settle what one read leaves open.
+names nothing, and the tree looks again. A name that is the start of another's
+(``hardware`` and ``hardware 2``) is never taken from a read that stops where it ends: the
+reader drops a word or a line as easily as it reads it, so only a read that shows the
+rest tells them apart, and no prior may (``Evidence.unsettled``); a read that goes on past
+the shorter name with the longer one's words is not the shorter one's. ``Evidence`` from
+several reads of one plate adds up (consistency), and a prior over entities (the order of
+the doors along the corridor, ``grounders/plate_memory.py``) can settle what one read
+leaves open.
 """
 
 from __future__ import annotations
@@ -93,6 +98,10 @@ class Evidence:
     unknown: float = 0.0
     keys: dict[Entity, str] = field(default_factory=dict)
     code_read: bool = False  # a read showed a code: every room's code was weighed
+    # Entities the words fit alike because one's name is the start of another's (read
+    # "hardware": the room "hardware", or the place "hardware 2" with its "2" dropped):
+    # the reads tell them apart or nothing does (``decide``).
+    unsettled: frozenset[Entity] = frozenset()
 
     def add(self, other: Evidence) -> Evidence:
         ents = set(self.entities) & set(other.entities)
@@ -101,6 +110,7 @@ class Evidence:
             self.unknown + other.unknown,
             {**other.keys, **self.keys},
             self.code_read or other.code_read,
+            self.unsettled & other.unsettled,  # one read that told them apart settles it
         )
 
 
@@ -121,6 +131,10 @@ def decide(ev: Evidence, prior: Mapping[Entity, float] | None = None) -> Match |
     rival = z + math.log(sum(math.exp(v - z) for v in rest))
     if ll - rival < MARGIN:
         return None
+    if best in ev.unsettled and any(
+        ev.entities[best] - ev.entities[e] < MARGIN for e in ev.unsettled - {best}
+    ):
+        return None  # the prior (where it stands) cannot tell whether a part went unread
     return Match(best, 1.0 / (1.0 + math.exp(rival - ll)), ev.keys.get(best, ""))
 
 
@@ -131,6 +145,12 @@ class _Known:
     entity: Entity
     code: str | None
     names: tuple[str, ...]
+    plate: str = ""  # the whole sign, code and words, normalised
+
+    @property
+    def reads(self) -> frozenset[str]:
+        """What a whole read of its plate may show: its names, or its sign as one."""
+        return frozenset((*self.names, self.plate)) - {""}
 
 
 class SignMatcher:
@@ -146,6 +166,8 @@ class SignMatcher:
         self.scheme: NumberingScheme = parse_scheme(
             k.code for k in self.known if k.code and k.entity.kind == EntityKind.ROOM
         )
+        self._reads = {k.entity: k.reads for k in self.known}
+        self._extended_by = _extensions(self.known)
 
     def _add(self, entity: Entity, sign: str, *names: str) -> None:
         code = entity_code(sign)
@@ -155,7 +177,7 @@ class SignMatcher:
             k = normalise(t)
             if k and k not in keys and not (code and k == normalise(code)):
                 keys.append(k)
-        self.known.append(_Known(entity, code, tuple(keys)))
+        self.known.append(_Known(entity, code, tuple(keys), normalise(sign)))
 
     @staticmethod
     def trusted(lines: Sequence[Line]) -> bool:
@@ -197,6 +219,8 @@ class SignMatcher:
         if code:
             unknown += math.log(P_UNKNOWN) + self.model.log_read_right(code, scores)
         ents, keys = {}, {}
+        shown = normalise(words)
+        unsettled: set[Entity] = set()
         for k in self.known:
             ll, how = 0.0, []
             if code:
@@ -212,7 +236,16 @@ class SignMatcher:
                     how.append(key)
             ents[k.entity] = ll
             keys[k.entity] = " ".join(how)
-        return Evidence(ents, unknown, keys, code_read=bool(code))
+        if shown and not code:
+            for k in self.known:
+                longer = self._extended_by.get(k.entity, ())
+                if shown in k.reads and longer:
+                    unsettled |= {k.entity, *longer}  # read up to where its name ends
+                elif any(shown.startswith(n) and shown != n for n in k.reads) and any(
+                    shown in self._reads[e] for e in longer
+                ):
+                    ents[k.entity] = min(ents[k.entity], name_null)  # read on past it
+        return Evidence(ents, unknown, keys, code_read=bool(code), unsettled=frozenset(unsettled))
 
     def _code_token(
         self, tokens: list[tuple[str, list[float]]]
@@ -238,6 +271,23 @@ class SignMatcher:
             if ll > best_ll:
                 best, best_ll = (span, lls), ll
         return best
+
+
+def _extensions(known: list[_Known]) -> dict[Entity, tuple[Entity, ...]]:
+    """For each entity, the others with a name that starts with one of its names
+    ("hardware" -> "hardware 2"; "patrol", what is left of "patrol D1" less its code, ->
+    "patrol D2"): a plate of theirs read with its end lost reads as its name."""
+    out: dict[Entity, tuple[Entity, ...]] = {}
+    for k in known:
+        longer = tuple(
+            o.entity
+            for o in known
+            if o.entity != k.entity
+            and any(m.startswith(n) and m != n for n in k.reads for m in o.reads)
+        )
+        if longer:
+            out[k.entity] = longer
+    return out
 
 
 def _compact(text: str) -> str:
