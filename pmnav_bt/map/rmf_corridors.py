@@ -11,12 +11,14 @@ their centre lines, and they also lead into rooms and to parking spots. The step
    nodes that only continue a straight line are dropped; the largest connected part is
    kept, the others are listed as skipped.
 3. **Centred and measured**: across each corridor, rays out to ``CAP_M`` on both sides
-   find the walls; where both sides hit, the centre line moves to the middle (unless the
-   middle runs into more obstacles than the lane, a hall's pillars); where one side is
-   open (a hall), the line stays. The width is measured along the whole line: twice the
-   clearance the nearer side keeps over every stretch of ``NARROW_RUN_M`` (a corridor is
-   one rectangle about its centre line, so it is what is free all along, not a median
-   over a lane that passes a gap); with no wall either side, ``OPEN_WIDTH_M``. A dead end
+   find the walls, and each side's clearance is what it keeps over every stretch of
+   ``NARROW_RUN_M`` (a corridor is one rectangle about its centre line, so its width is
+   what is free all along, not a median over a lane that passes a gap). Where both sides
+   hit, the centre line moves to the middle of that band and the width is its breadth
+   (unless the middle runs into more obstacles than the lane, a hall's pillars: then the
+   lane and twice its nearer clearance); where one side is open (a hall), the line stays
+   and the width is twice the clearance of the side with a wall; with no wall either
+   side, ``OPEN_WIDTH_M``. A dead end
    is carried on along its corridor while walls stand on both sides ahead (a lane that
    stops at a parking spot half way down a corridor).
 4. **Key waypoints** at the least-squares crossing of their corridors' centre lines, so
@@ -220,13 +222,15 @@ def _centre(plan: FloorPlanImage, free, walls, a: np.ndarray, b: np.ndarray):
         first = np.where(hit, np.argmin(ok, axis=1), len(t) - 1)
         dist.append(np.where(hit, t[first], np.inf))
     left, right = dist
-    both = np.isfinite(left) & np.isfinite(right)
+    walled = (np.isfinite(left) & np.isfinite(right)).mean() >= WALLED
     mid = (a + b) / 2.0
-    off = float(np.median((left[both] - right[both]) / 2.0)) if both.mean() >= WALLED else 0.0
+    near_l, near_r = _narrowest(left, s), _narrowest(right, s)
+    off, width = 0.0, 2.0 * min(near_l, near_r)
+    if walled:  # the middle of what is free all along
+        off, width = (near_l - near_r) / 2.0, near_l + near_r
     if off and _blocked(plan, free, a + off * n, b + off * n) > _blocked(plan, free, a, b):
-        off = 0.0  # the middle runs into a pillar the lane passes by: keep the lane
-    reach = min(_narrowest(left - off, s), _narrowest(right + off, s))
-    width = 2.0 * reach if np.isfinite(reach) else OPEN_WIDTH_M
+        off, width = 0.0, 2.0 * min(near_l, near_r)  # the middle runs into a pillar: the lane
+    width = width if np.isfinite(width) else OPEN_WIDTH_M
     return (mid + off * n, u), max(MIN_WIDTH_M, min(width, 2.0 * CAP_M))
 
 
