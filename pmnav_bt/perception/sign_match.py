@@ -19,11 +19,11 @@ hold, as log-likelihoods in one currency:
 
 A reading is a sighting of the best entity only when that entity is ``MARGIN`` times as
 likely as all the others and none of them together (``decide``): otherwise it is ambiguous and
-names nothing, and the tree looks again. A name that is the start of another's
+names nothing, and the tree looks again. A plate that is the start of another's
 (``hardware`` and ``hardware 2``) is never taken from a read that stops where it ends: the
 reader drops a word or a line as easily as it reads it, so only a read that shows the
 rest tells them apart, and no prior may (``Evidence.unsettled``); a read that goes on past
-the shorter name with the longer one's words is not the shorter one's. ``Evidence`` from
+the shorter plate with the longer one's words is not the shorter one's. ``Evidence`` from
 several reads of one plate adds up (consistency), and a prior over entities (the order of
 the doors along the corridor, ``grounders/plate_memory.py``) can settle what one read
 leaves open.
@@ -98,9 +98,9 @@ class Evidence:
     unknown: float = 0.0
     keys: dict[Entity, str] = field(default_factory=dict)
     code_read: bool = False  # a read showed a code: every room's code was weighed
-    # Entities the words fit alike because one's name is the start of another's (read
-    # "hardware": the room "hardware", or the place "hardware 2" with its "2" dropped):
-    # the reads tell them apart or nothing does (``decide``).
+    # Entities whose plates the words may be, one of them cut short (read "hardware": the
+    # plate "hardware", or "hardware 2" with its "2" dropped): the reads tell them apart
+    # or nothing does (``decide``).
     unsettled: frozenset[Entity] = frozenset()
 
     def add(self, other: Evidence) -> Evidence:
@@ -145,12 +145,7 @@ class _Known:
     entity: Entity
     code: str | None
     names: tuple[str, ...]
-    plate: str = ""  # the whole sign, code and words, normalised
-
-    @property
-    def reads(self) -> frozenset[str]:
-        """What a whole read of its plate may show: its names, or its sign as one."""
-        return frozenset((*self.names, self.plate)) - {""}
+    plate: str = ""  # what its plate shows, code and words, normalised
 
 
 class SignMatcher:
@@ -166,8 +161,6 @@ class SignMatcher:
         self.scheme: NumberingScheme = parse_scheme(
             k.code for k in self.known if k.code and k.entity.kind == EntityKind.ROOM
         )
-        self._reads = {k.entity: k.reads for k in self.known}
-        self._extended_by = _extensions(self.known)
 
     def _add(self, entity: Entity, sign: str, *names: str) -> None:
         code = entity_code(sign)
@@ -220,7 +213,7 @@ class SignMatcher:
             unknown += math.log(P_UNKNOWN) + self.model.log_read_right(code, scores)
         ents, keys = {}, {}
         shown = normalise(words)
-        unsettled: set[Entity] = set()
+        unsettled: frozenset[Entity] = frozenset()
         for k in self.known:
             ll, how = 0.0, []
             if code:
@@ -237,15 +230,21 @@ class SignMatcher:
             ents[k.entity] = ll
             keys[k.entity] = " ".join(how)
         if shown and not code:
+            unsettled = self._cut_short(shown)
+            whole = any(o.plate == shown for o in self.known)  # another plate, read whole
             for k in self.known:
-                longer = self._extended_by.get(k.entity, ())
-                if shown in k.reads and longer:
-                    unsettled |= {k.entity, *longer}  # read up to where its name ends
-                elif any(shown.startswith(n) and shown != n for n in k.reads) and any(
-                    shown in self._reads[e] for e in longer
-                ):
-                    ents[k.entity] = min(ents[k.entity], name_null)  # read on past it
-        return Evidence(ents, unknown, keys, code_read=bool(code), unsettled=frozenset(unsettled))
+                if whole and k.plate and shown != k.plate and shown.startswith(k.plate):
+                    ents[k.entity] = min(ents[k.entity], name_null)  # read on past its end
+        return Evidence(ents, unknown, keys, code_read=bool(code), unsettled=unsettled)
+
+    def _cut_short(self, shown: str) -> frozenset[Entity]:
+        """The entities whose plate ``shown`` (a read's words, normalised) may be, when it
+        may be the start of a longer plate: those plates and the one it is whole. Empty
+        when no plate goes on past it (two plates alike are told apart by a prior)."""
+        longer = {k.entity for k in self.known if k.plate.startswith(shown) and k.plate != shown}
+        if not longer:
+            return frozenset()
+        return frozenset(longer | {k.entity for k in self.known if k.plate == shown})
 
     def _code_token(
         self, tokens: list[tuple[str, list[float]]]
@@ -271,23 +270,6 @@ class SignMatcher:
             if ll > best_ll:
                 best, best_ll = (span, lls), ll
         return best
-
-
-def _extensions(known: list[_Known]) -> dict[Entity, tuple[Entity, ...]]:
-    """For each entity, the others with a name that starts with one of its names
-    ("hardware" -> "hardware 2"; "patrol", what is left of "patrol D1" less its code, ->
-    "patrol D2"): a plate of theirs read with its end lost reads as its name."""
-    out: dict[Entity, tuple[Entity, ...]] = {}
-    for k in known:
-        longer = tuple(
-            o.entity
-            for o in known
-            if o.entity != k.entity
-            and any(m.startswith(n) and m != n for n in k.reads for m in o.reads)
-        )
-        if longer:
-            out[k.entity] = longer
-    return out
 
 
 def _compact(text: str) -> str:

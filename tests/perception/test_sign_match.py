@@ -123,7 +123,7 @@ def test_decide_needs_the_margin_over_the_runner_up_and_the_unknown_plate():
     assert decide(ev, {Entity.room("r0"): -gap}) is None
 
 
-def test_a_name_another_extends_is_never_taken_on_the_doors_spacing():
+def test_a_plate_another_goes_on_past_is_never_taken_on_the_doors_spacing():
     """'hardware' is one room's whole plate and the start of another's, 'hardware 2' (the
     office of Open-RMF's demos): read 'hardware', the reader may have dropped the '2', so
     the read names neither, however strongly the doors' spacing (the plate memory's prior)
@@ -137,4 +137,7 @@ def test_a_name_another_extends_is_never_taken_on_the_doors_spacing():
     # a read that showed the '2' settles the plate's other reads
     both = m.evidence(read("hardware")).add(m.evidence(read("hardware 2")))
     assert decide(both, spacing).entity == longer
-    assert m.match(read("main")).entity == Entity.room("r2")  # no other name extends it
+    assert m.match(read("main")).entity == Entity.room("r2")  # no other plate goes on past it
+    # Two plates alike, each read whole: the spacing tells them apart as before.
+    twins = SignMatcher(corridor("Stairs", "Stairs", "main"))
+    assert decide(twins.evidence(read("Stairs")), spacing).entity == short
