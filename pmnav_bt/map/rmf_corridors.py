@@ -11,12 +11,16 @@ their centre lines, and they also lead into rooms and to parking spots. The step
    nodes that only continue a straight line are dropped; the largest connected part is
    kept, the others are listed as skipped.
 3. **Centred and measured**: across each corridor, rays out to ``CAP_M`` on both sides
-   find the walls; where both sides hit, the centre line moves to the middle (unless the
-   middle runs into more obstacles than the lane, a hall's pillars) and the width is the
-   median wall-to-wall distance. Where one side is open (a hall), the line
-   stays and the width is twice the distance to the one wall; with no wall either side,
-   ``OPEN_WIDTH_M``. A dead end is carried on along its corridor while walls stand on
-   both sides ahead (a lane that stops at a parking spot half way down a corridor).
+   find the walls, and each side's clearance is what it keeps over every stretch of
+   ``NARROW_RUN_M`` (a corridor is one rectangle about its centre line, so its width is
+   what is free all along, not a median over a lane that passes a gap). Where both sides
+   hit, the centre line moves to the middle of that band and the width is its breadth
+   (unless the middle runs into more obstacles than the lane, a hall's pillars: then the
+   lane and twice its nearer clearance); where one side is open (a hall), the line stays
+   and the width is twice the clearance of the side with a wall; with no wall either
+   side, ``OPEN_WIDTH_M``. A dead end
+   is carried on along its corridor while walls stand on both sides ahead (a lane that
+   stops at a parking spot half way down a corridor).
 4. **Key waypoints** at the least-squares crossing of their corridors' centre lines, so
    every waypoint is on every centre line that meets there.
 """
@@ -44,6 +48,7 @@ OPEN_WIDTH_M = 3.0  # the width of a lane across a hall with no wall within CAP_
 EXTEND_M = 30.0  # a dead end is carried on at most this far
 WALLED = 0.5  # a stretch is corridor-shaped where this share has walls on both sides
 CROSSING_DEG = 20.0  # corridors meeting at more than this fix their waypoint by crossing
+NARROW_RUN_M = 0.5  # a narrowing at least this long sets a corridor's width
 
 
 @dataclass
@@ -217,18 +222,31 @@ def _centre(plan: FloorPlanImage, free, walls, a: np.ndarray, b: np.ndarray):
         first = np.where(hit, np.argmin(ok, axis=1), len(t) - 1)
         dist.append(np.where(hit, t[first], np.inf))
     left, right = dist
-    both = np.isfinite(left) & np.isfinite(right)
+    walled = (np.isfinite(left) & np.isfinite(right)).mean() >= WALLED
     mid = (a + b) / 2.0
-    if both.mean() >= WALLED:
-        off = float(np.median((left[both] - right[both]) / 2.0))
-        width = float(np.median(left[both] + right[both]))
-    else:
-        one = np.minimum(left, right)
-        one = one[np.isfinite(one)]
-        off, width = 0.0, 2.0 * float(np.median(one)) if len(one) else OPEN_WIDTH_M
+    near_l, near_r = _narrowest(left, s), _narrowest(right, s)
+    off, width = 0.0, 2.0 * min(near_l, near_r)
+    if walled:  # the middle of what is free all along
+        off, width = (near_l - near_r) / 2.0, near_l + near_r
     if off and _blocked(plan, free, a + off * n, b + off * n) > _blocked(plan, free, a, b):
-        off = 0.0  # the middle runs into a pillar the lane passes by: keep the lane
+        off, width = 0.0, 2.0 * min(near_l, near_r)  # the middle runs into a pillar: the lane
+    width = width if np.isfinite(width) else OPEN_WIDTH_M
     return (mid + off * n, u), max(MIN_WIDTH_M, min(width, 2.0 * CAP_M))
+
+
+def _narrowest(clear: np.ndarray, s: np.ndarray) -> float:
+    """The clearance a side keeps along the whole line: the widest that every stretch of
+    ``NARROW_RUN_M`` has (``clear`` per sample at ``s``, inf where no wall is in reach).
+
+    A corridor is one rectangle about its centre line, so its half-width is what that
+    side leaves free all along, not a median: a lane through a gap between a room's
+    corner on one side and another's on the other (walls on both sides, but never
+    abreast) has a median wall-to-wall width of the hall, and the gap's is the robot's.
+    A narrowing shorter than ``NARROW_RUN_M`` (a grid speck, a door jamb) is not it."""
+    step = float(s[1] - s[0]) if len(s) > 1 else NARROW_RUN_M
+    k = min(len(clear), max(1, math.ceil(NARROW_RUN_M / max(step, 1e-9))))
+    runs = np.lib.stride_tricks.sliding_window_view(clear, k).max(axis=1)
+    return float(runs.min())
 
 
 def _blocked(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:

@@ -19,9 +19,14 @@ hold, as log-likelihoods in one currency:
 
 A reading is a sighting of the best entity only when that entity is ``MARGIN`` times as
 likely as all the others and none of them together (``decide``): otherwise it is ambiguous and
-names nothing, and the tree looks again. ``Evidence`` from several reads of one plate
-adds up (consistency), and a prior over entities (the order of the doors along the
-corridor, ``grounders/plate_memory.py``) can settle what one read leaves open.
+names nothing, and the tree looks again. A plate that is the start of another's
+(``hardware`` and ``hardware 2``) is never taken from a read that stops where it ends: the
+reader drops a word or a line as easily as it reads it, so only a read that shows the
+rest tells them apart, and no prior may (``Evidence.unsettled``); a read that goes on past
+the shorter plate with the longer one's words is not the shorter one's. ``Evidence`` from
+several reads of one plate adds up (consistency), and a prior over entities (the order of
+the doors along the corridor, ``grounders/plate_memory.py``) can settle what one read
+leaves open.
 """
 
 from __future__ import annotations
@@ -93,6 +98,10 @@ class Evidence:
     unknown: float = 0.0
     keys: dict[Entity, str] = field(default_factory=dict)
     code_read: bool = False  # a read showed a code: every room's code was weighed
+    # Entities whose plates the words may be, one of them cut short (read "hardware": the
+    # plate "hardware", or "hardware 2" with its "2" dropped): the reads tell them apart
+    # or nothing does (``decide``).
+    unsettled: frozenset[Entity] = frozenset()
 
     def add(self, other: Evidence) -> Evidence:
         ents = set(self.entities) & set(other.entities)
@@ -101,6 +110,7 @@ class Evidence:
             self.unknown + other.unknown,
             {**other.keys, **self.keys},
             self.code_read or other.code_read,
+            self.unsettled & other.unsettled,  # one read that told them apart settles it
         )
 
 
@@ -121,6 +131,10 @@ def decide(ev: Evidence, prior: Mapping[Entity, float] | None = None) -> Match |
     rival = z + math.log(sum(math.exp(v - z) for v in rest))
     if ll - rival < MARGIN:
         return None
+    if best in ev.unsettled and any(
+        ev.entities[best] - ev.entities[e] < MARGIN for e in ev.unsettled - {best}
+    ):
+        return None  # the prior (where it stands) cannot tell whether a part went unread
     return Match(best, 1.0 / (1.0 + math.exp(rival - ll)), ev.keys.get(best, ""))
 
 
@@ -131,6 +145,7 @@ class _Known:
     entity: Entity
     code: str | None
     names: tuple[str, ...]
+    plate: str = ""  # what its plate shows, code and words, normalised
 
 
 class SignMatcher:
@@ -155,7 +170,7 @@ class SignMatcher:
             k = normalise(t)
             if k and k not in keys and not (code and k == normalise(code)):
                 keys.append(k)
-        self.known.append(_Known(entity, code, tuple(keys)))
+        self.known.append(_Known(entity, code, tuple(keys), normalise(sign)))
 
     @staticmethod
     def trusted(lines: Sequence[Line]) -> bool:
@@ -197,6 +212,8 @@ class SignMatcher:
         if code:
             unknown += math.log(P_UNKNOWN) + self.model.log_read_right(code, scores)
         ents, keys = {}, {}
+        shown = normalise(words)
+        unsettled: frozenset[Entity] = frozenset()
         for k in self.known:
             ll, how = 0.0, []
             if code:
@@ -212,7 +229,22 @@ class SignMatcher:
                     how.append(key)
             ents[k.entity] = ll
             keys[k.entity] = " ".join(how)
-        return Evidence(ents, unknown, keys, code_read=bool(code))
+        if shown and not code:
+            unsettled = self._cut_short(shown)
+            whole = any(o.plate == shown for o in self.known)  # another plate, read whole
+            for k in self.known:
+                if whole and k.plate and shown != k.plate and shown.startswith(k.plate):
+                    ents[k.entity] = min(ents[k.entity], name_null)  # read on past its end
+        return Evidence(ents, unknown, keys, code_read=bool(code), unsettled=unsettled)
+
+    def _cut_short(self, shown: str) -> frozenset[Entity]:
+        """The entities whose plate ``shown`` (a read's words, normalised) may be, when it
+        may be the start of a longer plate: those plates and the one it is whole. Empty
+        when no plate goes on past it (two plates alike are told apart by a prior)."""
+        longer = {k.entity for k in self.known if k.plate.startswith(shown) and k.plate != shown}
+        if not longer:
+            return frozenset()
+        return frozenset(longer | {k.entity for k in self.known if k.plate == shown})
 
     def _code_token(
         self, tokens: list[tuple[str, list[float]]]

@@ -60,6 +60,29 @@ def test_the_corridor_is_centred_between_the_walls_not_on_the_lane(example, tmp_
     assert b.edge_width(edge) == pytest.approx(free_width, abs=0.15)
 
 
+def test_a_corridors_width_is_what_it_leaves_free_all_along_not_a_median(tmp_path):
+    data = example_rmf()
+    lvl = data["levels"]["L1"]
+    v = lvl["vertices"]
+    # A block 0.75 m deep on the south wall from x 16 to 20 m: a narrowing over a seventh
+    # of the corridor, 2.1 m free (north wall face -5.075, the block's face -7.175).
+    k = len(v)
+    v += [[320, 160, 0, ""], [320, 145, 0, ""], [400, 145, 0, ""], [400, 160, 0, ""]]
+    lvl["walls"] += [[k, k + 1, {}], [k + 1, k + 2, {}], [k + 2, k + 3, {}]]
+    imp = import_rmf(write_example_rmf(tmp_path, data), tmp_path / "out.yaml")
+    b = imp.building
+    (edge,) = b.edges
+    assert b.edge_width(edge) <= 2.1  # the median wall-to-wall width was 2.85 m
+    # The corridor's rectangle (less 0.15 m a side: rays stop in the first wall cell)
+    # lies on the free space all along.
+    a, c = (np.array(b.waypoint(w).pos) for w in (edge.a, edge.b))
+    u = (c - a) / np.linalg.norm(c - a)
+    n = np.array([-u[1], u[0]])
+    s, t = np.meshgrid(np.linspace(0, 1, 120), np.linspace(-0.5, 0.5, 15))
+    pts = a + s.reshape(-1, 1) * (c - a) + t.reshape(-1, 1) * n * (b.edge_width(edge) - 0.3)
+    assert imp.grid.mask_at(imp.grid.occupancy() == 0, pts).all()
+
+
 def test_named_door_becomes_a_room_on_its_wall_and_the_charger_the_start(example, tmp_path):
     imp = import_rmf(example, tmp_path / "out.yaml")
     (room,) = imp.building.rooms

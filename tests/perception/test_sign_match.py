@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 from sign_kit import SURE, corridor, read
 
@@ -119,3 +121,23 @@ def test_decide_needs_the_margin_over_the_runner_up_and_the_unknown_plate():
     # a prior against it as strong as the reading's evidence leaves it open
     gap = ev.entities[Entity.room("r0")] - ev.entities[Entity.room("r1")]
     assert decide(ev, {Entity.room("r0"): -gap}) is None
+
+
+def test_a_plate_another_goes_on_past_is_never_taken_on_the_doors_spacing():
+    """'hardware' is one room's whole plate and the start of another's, 'hardware 2' (the
+    office of Open-RMF's demos): read 'hardware', the reader may have dropped the '2', so
+    the read names neither, however strongly the doors' spacing (the plate memory's prior)
+    favours one; read 'hardware 2', it names that room, even against the spacing."""
+    m = SignMatcher(corridor("hardware", "hardware 2", "main"))
+    short, longer = Entity.room("r0"), Entity.room("r1")
+    spacing = {short: 0.0, longer: math.log(0.05)}  # the spacing's strongest preference
+    assert decide(m.evidence(read("hardware")), spacing) is None
+    assert decide(m.evidence(read("hardware")), {short: math.log(0.05), longer: 0.0}) is None
+    assert decide(m.evidence(read("hardware 2")), spacing).entity == longer
+    # a read that showed the '2' settles the plate's other reads
+    both = m.evidence(read("hardware")).add(m.evidence(read("hardware 2")))
+    assert decide(both, spacing).entity == longer
+    assert m.match(read("main")).entity == Entity.room("r2")  # no other plate goes on past it
+    # Two plates alike, each read whole: the spacing tells them apart as before.
+    twins = SignMatcher(corridor("Stairs", "Stairs", "main"))
+    assert decide(twins.evidence(read("Stairs")), spacing).entity == short
