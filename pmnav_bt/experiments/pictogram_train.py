@@ -25,6 +25,7 @@ Run:
       --out pmnav_bt/data/pictograms.safetensors
   python -m pmnav_bt.experiments.pictogram_data --split heldout --worlds 16 --views 25 \
       --out heldout.npz
+  python -m pmnav_bt.experiments.pictogram_train --calibrate more_dev.npz
   python -m pmnav_bt.experiments.pictogram_train --eval heldout.npz
 """
 
@@ -178,6 +179,27 @@ def report(
     print(f"  CPU {cpu_ms:.3f} ms per plate (batch of {len(labels)}, numpy)")
 
 
+def recalibrate(out: Path, data: str) -> None:
+    """Set the model's ``sighting_p`` from the patches of ``data``: development worlds
+    neither its training nor its first calibration saw (more of them than the fifth kept
+    back, where training data were few)."""
+    d = np.load(data, allow_pickle=True)
+    r = PictogramReader(out)
+    p_toilet = r.probabilities(d["patches"])[:, TOILET]
+    threshold = calibrate(p_toilet, d["labels"])
+    meta = dict(r.meta)
+    worlds = sorted({f"{m[0]}@{int(m[1])}" for m in d["meta"]})
+    meta["sighting_p"] = threshold
+    meta["recalibration"] = {
+        "worlds": worlds,
+        "patches": {c: int((d["labels"] == k).sum()) for k, c in enumerate(CLASSES)},
+        "highest non-toilet p": round(float(p_toilet[d["labels"] != TOILET].max()), 4),
+    }
+    atomic_write_text(out.with_suffix(".json"), json.dumps(meta, indent=1) + "\n")
+    print(f"sighting_p {threshold:.3f} (was {r.sighting_p:.3f}); wrote {out.with_suffix('.json')}")
+    report(r.params, threshold, d["patches"], d["labels"], f"calibration ({data})")
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--data", help="rendered development patches (.npz of pictogram_data)")
@@ -187,7 +209,12 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=str(WEIGHTS), help=".safetensors to write (.json beside)")
     ap.add_argument("--eval", help="measure the model at --out on this .npz instead")
+    ap.add_argument("--calibrate", help="calibrate the model at --out again on this .npz "
+                    "(development worlds it was not trained on) instead")
     args = ap.parse_args(argv)
+    if args.calibrate:
+        recalibrate(Path(args.out), args.calibrate)
+        return
     if args.eval:
         d = np.load(args.eval, allow_pickle=True)
         r = PictogramReader(args.out)

@@ -9,7 +9,8 @@
   whose text names nothing is shown to the pictogram reader (``perception/pictograms.py``,
   when one is given): a toilet pictogram read above its calibrated confidence names the
   rooms the map says are toilets (``SignMatcher.pictogram_evidence``), through the same
-  plate memory; a read short of that confidence is not a sighting.
+  plate memory, when depth hangs the plate where signs hang; a read short of that
+  confidence is not a sighting.
 - ``detect(room)``: the room's *door*, found in RGB-D around its sign
   (``door_scene.door_for_plate``; the file's signage mounting a prior): box and mask of
   the door rectangle projected into the image, ``point`` its centre.
@@ -44,7 +45,13 @@ from pmnav_bt.perception.grounders.plate_memory import PlateMemory
 from pmnav_bt.perception.pictograms import PictogramRead, PictogramReader
 from pmnav_bt.perception.sign_match import Evidence, Match, SignMatcher, decide
 from pmnav_bt.perception.signs import MIN_LINE_PX, Box, SignReader, SignText, scale_sign
-from pmnav_bt.perception.unread_plates import UnreadPlate, UnreadPlates, ambiguous, unread_plate
+from pmnav_bt.perception.unread_plates import (
+    UnreadPlate,
+    UnreadPlates,
+    ambiguous,
+    hangs_like_a_plate,
+    unread_plate,
+)
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
 
 
@@ -133,7 +140,10 @@ class OcrGrounder:
         pictos = self._pictograms(obs, [box for box, _, _, _ in unnamed])
         for (box, line_px, sign, ev), picto in zip(unnamed, pictos, strict=True):
             if picto is not None and picto.sighting:
+                # No words to confirm it: only a plate depth hangs where signs hang.
                 plate = depth_geom.plate_pose(obs, box)
+                if plate is None or not hangs_like_a_plate(obs, plate):
+                    continue
                 m = self._match_pictogram(obs, picto.kind, plate)
                 if m is not None:
                     self._sighting(obs, f"[{picto.kind}]", box, float(m.score * picto.p), m,
@@ -197,13 +207,11 @@ class OcrGrounder:
         return [reads.get(b) for b in scaled]
 
     def _match_pictogram(
-        self, obs: Observation, kind: str, plate: depth_geom.PlatePose | None
+        self, obs: Observation, kind: str, plate: depth_geom.PlatePose
     ) -> Match | None:
         """Which room a plate showing the pictogram of ``kind`` is: the map's rooms of that
         kind, weighed with the plate's earlier reads and its neighbours (``PlateMemory``)."""
         ev = self.matcher.pictogram_evidence(kind)
-        if plate is None:
-            return decide(ev)
         p = obs.pose
         with self._memory_lock:
             return self.memory.read(_odom(obs, plate.centre), (p.x, p.y, p.yaw), obs.stamp, ev)
