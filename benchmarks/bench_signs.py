@@ -29,8 +29,9 @@ are then also given per plate style: capital height, font, colour scheme and mou
 (landmarks' one-line plates apart). Each view that missed its plate is put down to where
 the plate was lost: ``hidden`` (no pixel of it in the frame: a person or clutter in
 front), ``not proposed`` (no candidate of ``SignReader.candidates`` covers it), ``not
-read`` (a candidate covers it but no text was read there), ``read, not named`` (text read
-that names nothing: garbled or ambiguous) or ``named another`` (a false target).
+read`` (a candidate covers it but no text was read there, nor a pictogram sighted),
+``read, not named`` (text read that names nothing: garbled or ambiguous; or a pictogram
+sighted where the map has several toilets alike) or ``named another`` (a false target).
 
 Run: python benchmarks/bench_signs.py [--views 160] [--seed 0] [--kind "long name"]
      [--angles 0,70] [--widths 320,640] [--world realistic] [--world-seeds 3]
@@ -140,7 +141,11 @@ def where_lost(g: OcrGrounder, obs, entity, dets) -> str:
     ]
     if not found:
         return "not proposed"
-    return "read, not named" if g.reader.read(obs.rgb, found) else "not read"
+    if g.reader.read(obs.rgb, found):
+        return "read, not named"
+    boxes = [b for b, _ in found]
+    picto = g.pictograms.read(obs.rgb, boxes) if g.pictograms is not None else []
+    return "read, not named" if any(r.sighting for r in picto) else "not read"
 
 
 def run(

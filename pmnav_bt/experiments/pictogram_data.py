@@ -22,6 +22,10 @@ never used in training. Colour schemes named by ``HELDOUT_COLOURS`` are left out
 development split altogether, so the held-out split also measures signage colours the
 network never saw.
 
+``--synthetic N`` writes N patches of plates drawn by the simulator's plate renderer
+instead (``synthetic``: many more signage styles than rendered worlds give, seen as a
+camera would), half toilet pictograms, half text plates.
+
 Run: python -m pmnav_bt.experiments.pictogram_data --split dev --worlds 30 --views 20 --out d.npz
      python -m pmnav_bt.experiments.pictogram_data --split dev --synthetic 5000 --out s.npz
 """
