@@ -4,6 +4,7 @@ pictogram, and a read short of the calibrated confidence is no sighting."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import cv2
 import numpy as np
@@ -75,8 +76,10 @@ def test_a_rendered_toilet_plate_is_read_as_a_toilet(reader):
 
 
 @pytest.mark.parametrize("text", ["102 Pharmacy", "113", "117 One-Stop Service Centre"])
-def test_a_text_plate_is_not_read_as_a_pictogram(reader, text):
-    tex = make_sign(text)
+@pytest.mark.parametrize("styled", [False, True], ids=["historical plate", "toilets' style"])
+def test_a_text_plate_is_not_read_as_a_pictogram(reader, text, styled):
+    # the historical plate, or a room plate in the very style of the toilet plates
+    tex = make_plate(text, replace(TOILET_STYLE, pictogram=None)) if styled else make_sign(text)
     obs = plate_frame(tex.image, tex.width_m, tex.height_m, 2.0)
     from pmnav_bt.perception.signs import SignReader
 
