@@ -21,16 +21,21 @@ beyond the default 0-70 deg (a plate seen along its wall, e.g. from a junction),
 ``--world realistic`` renders the built-ins in the realistic preset instead
 (``world.preset=realistic``: each building and world seed draws its own signage system,
 ``sim/scene/signage.py``; ``--world-seeds`` worlds per building, the views split among
-them; pictogram plates, which carry no text, are left out). Recall, precision and CPU time
+them). Pictogram plates (toilets, in buildings that have them: the built-ins have few or
+none, ``--buildings hospital_1000,...`` names others) are counted as their own kind,
+``pictogram``, read by the pictogram reader (``perception/pictograms.py``;
+``--pictograms off`` measures the grounder without it). Recall, precision and CPU time
 are then also given per plate style: capital height, font, colour scheme and mounting
 (landmarks' one-line plates apart). Each view that missed its plate is put down to where
 the plate was lost: ``hidden`` (no pixel of it in the frame: a person or clutter in
 front), ``not proposed`` (no candidate of ``SignReader.candidates`` covers it), ``not
-read`` (a candidate covers it but no text was read there), ``read, not named`` (text read
-that names nothing: garbled or ambiguous) or ``named another`` (a false target).
+read`` (a candidate covers it but no text was read there, nor a pictogram sighted),
+``read, not named`` (text read that names nothing: garbled or ambiguous; or a pictogram
+sighted where the map has several toilets alike) or ``named another`` (a false target).
 
 Run: python benchmarks/bench_signs.py [--views 160] [--seed 0] [--kind "long name"]
      [--angles 0,70] [--widths 320,640] [--world realistic] [--world-seeds 3]
+     [--buildings fig2_hospital,hospital_1000] [--pictograms on|off]
 Target: read_signs p50 < 150 ms and p95 < 400 ms per 320x240 frame on 2 cores.
 """
 
@@ -48,6 +53,7 @@ from pmnav_bt.config import WorldConfig
 from pmnav_bt.map.catalogue import builtin_buildings
 from pmnav_bt.map.signage import PlateStyle
 from pmnav_bt.perception.grounders.ocr import OcrGrounder
+from pmnav_bt.perception.pictograms import PictogramReader
 from pmnav_bt.perception.read_range import PLATE_KINDS, plate_kind
 from pmnav_bt.seams import EntityKind, landmark_label, sign_label
 from pmnav_bt.sim.scene.signage import COLOUR_SCHEMES, BuildingSignage, resolve_signage
@@ -59,6 +65,12 @@ ANGLE_BANDS = ((0, 30), (30, 50), (50, 60), (60, 70), (70, 75), (75, 80), (80, 9
 CAP_BINS_MM = (20, 35, 50, 65)  # capital heights of the realistic preset: 20-80 mm
 STYLE_ATTRS = ("capitals", "font", "colours", "mounting")
 LOST_STAGES = ("hidden", "not proposed", "not read", "read, not named", "named another")
+KINDS = (*PLATE_KINDS, "pictogram")
+
+
+def kind_of(text: str) -> str:
+    """A plate's kind: ``read_range.plate_kind`` of its text, or "pictogram" (no text)."""
+    return plate_kind(text) if text else "pictogram"
 
 
 def plate_mask(obs, entity) -> np.ndarray:
@@ -129,7 +141,11 @@ def where_lost(g: OcrGrounder, obs, entity, dets) -> str:
     ]
     if not found:
         return "not proposed"
-    return "read, not named" if g.reader.read(obs.rgb, found) else "not read"
+    if g.reader.read(obs.rgb, found):
+        return "read, not named"
+    boxes = [b for b, _ in found]
+    picto = g.pictograms.read(obs.rgb, boxes) if g.pictograms is not None else []
+    return "read, not named" if any(r.sighting for r in picto) else "not read"
 
 
 def run(
@@ -141,8 +157,10 @@ def run(
     angles: tuple[float, float] = (0.0, 70.0),
     preset: str = "clean",
     world_seeds: int = 1,
+    buildings: list[str] | None = None,
+    pictograms: bool = True,
 ) -> None:
-    names = builtin_buildings()
+    names = buildings or builtin_buildings()
     scene = WorldConfig(preset=preset)
     seeds = world_seeds if preset != "clean" else 1
     per = math.ceil(views / (len(names) * seeds))
@@ -160,10 +178,10 @@ def run(
         for ws in range(seeds):
             world = SimWorld(name, scene=scene, seed=ws)
             signage = resolve_signage(world.building, scene.signage, world.rng("signage"))
-            g = OcrGrounder(world.building)
+            g = OcrGrounder(world.building, pictograms=PictogramReader() if pictograms else None)
 
             def select(text: str) -> bool:
-                return bool(text) and (kind is None or plate_kind(text) == kind)
+                return kind is None or kind_of(text) == kind
 
             views_k = sample_views(
                 world,
@@ -185,7 +203,7 @@ def run(
                 s = stats[band]
                 s["views"] += 1
                 s["hit"] += hit
-                kd = kinds[(plate_kind(v.text), band)]
+                kd = kinds[(kind_of(v.text), band)]
                 kd["views"] += 1
                 kd["hit"] += hit
                 deg = math.degrees(v.angle)
@@ -219,7 +237,8 @@ def run(
     only = "" if kind is None else f", {kind} plates only"
     print(
         f"\n{width}x{height}: {total} views, {len(names)} buildings, "
-        f"{angles[0]:g}-{angles[1]:g} deg off the plate{only}, world {preset}"
+        f"{angles[0]:g}-{angles[1]:g} deg off the plate{only}, world {preset}, "
+        f"pictogram reader {'on' if pictograms else 'off'}"
         + (f" ({seeds} world seeds a building)" if preset != "clean" else "")
     )
     print(
@@ -246,8 +265,8 @@ def run(
     )
     for f in false_targets:
         print(f"  false target: {f}")
-    print("recall per plate kind (read_range.plate_kind):")
-    for kind in PLATE_KINDS:
+    print("recall per plate kind (read_range.plate_kind; pictogram: no text):")
+    for kind in KINDS:
         print(f"{kind:>10s} " + recall_cells([kinds[(kind, i)] for i in range(len(BANDS))]))
     print("recall per angle off the plate's normal (rows) and distance band (columns):")
     for i, (a, b) in enumerate(ANGLE_BANDS):
@@ -281,13 +300,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--views", type=int, default=160, help="views per resolution")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--kind", choices=PLATE_KINDS, help="views of this plate kind only")
+    ap.add_argument("--kind", choices=KINDS, help="views of this plate kind only")
     ap.add_argument("--angles", default="0,70", help="deg off the plate's normal: LO,HI")
     ap.add_argument("--widths", default="320,640", help="camera widths (4:3 frames)")
     ap.add_argument("--world", default="clean", choices=("clean", "realistic"),
                     help="world preset the built-ins are rendered in")
     ap.add_argument("--world-seeds", type=int, default=3,
                     help="realistic worlds (signage systems) per building")
+    ap.add_argument("--buildings", help="comma-separated buildings (default: the built-ins)")
+    ap.add_argument("--pictograms", default="on", choices=("on", "off"),
+                    help="read pictogram plates (the ocr grounder's default) or not")
     args = ap.parse_args()
     if args.world_seeds < 1:
         ap.error(f"--world-seeds must be at least 1, not {args.world_seeds}")
@@ -296,7 +318,8 @@ def main() -> None:
         ap.error(f"--angles must be LO,HI with 0 <= LO < HI < 90, not {args.angles!r}")
     for w in (int(v) for v in args.widths.split(",")):
         run(w, w * 3 // 4, args.views, args.seed, args.kind, (lo, hi), args.world,
-            args.world_seeds)
+            args.world_seeds, args.buildings.split(",") if args.buildings else None,
+            args.pictograms == "on")
 
 
 if __name__ == "__main__":

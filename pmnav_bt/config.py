@@ -95,6 +95,11 @@ class GrounderConfig(_Section):
         le=1.0,
         description="ocr, gdino_sam: text lines read with a lower score are dropped",
     )
+    pictograms: bool = Field(
+        True,
+        description="ocr: read pictogram plates (toilets) whose text names nothing, "
+        "with the shipped classifier (perception/pictograms.py)",
+    )
     sign_to_door: float = Field(
         1.14, gt=0.0, description="m from a door sign's centre to its door's centre"
     )

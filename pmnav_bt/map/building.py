@@ -31,6 +31,7 @@ from pmnav_bt.loading import (
     is_regular_file,
     load_yaml,
 )
+from pmnav_bt.map.amenities import Amenity
 from pmnav_bt.map.signage import Signage, signage_problems
 
 SCHEMA_VERSION = 1
@@ -127,6 +128,7 @@ class Room(_Named, _Strict):
     aliases: tuple[Text, ...] = Field(default=(), max_length=MAX_ALIASES)
     door: Point
     sign: Text = ""
+    amenity: Amenity | None = None  # toilet (a pictogram plate); unset: by the name (amenities)
 
 
 class Landmark(_Named, _Strict):

@@ -37,6 +37,7 @@ import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
+from pmnav_bt.map.amenities import room_amenity
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.numbering import NumberingScheme, parse_scheme
 from pmnav_bt.map.signage import ROOM_NUMBER, split_number
@@ -56,6 +57,10 @@ NAME_NULL = 0.78 - 0.1
 NAME_READ = NAME_NULL + MARGIN / NAME_WEIGHT  # (0.78) the similarity a name is read at
 P_UNKNOWN = 0.02  # a code read right that the building does not hold (another floor, a sign)
 SURE_DIGITS = 0.85  # recogniser score of digits a map update trusts (map_check.py)
+# A pictogram sighting (already above the reader's calibrated confidence) on a room the map
+# says is not that amenity: a plate the map has wrong, or a misread; far less likely than a
+# plate the building does not hold (P_UNKNOWN), so it never names such a room.
+P_PICTOGRAM_ELSEWHERE = 1e-3
 
 # Lines of one sign as read: (text, recogniser score) or (text, score, character scores).
 Line = tuple[str, float] | tuple[str, float, Sequence[float]]
@@ -161,6 +166,7 @@ class SignMatcher:
         self.scheme: NumberingScheme = parse_scheme(
             k.code for k in self.known if k.code and k.entity.kind == EntityKind.ROOM
         )
+        self.amenities = {Entity.room(r.id): room_amenity(r) for r in building.rooms}
 
     def _add(self, entity: Entity, sign: str, *names: str) -> None:
         code = entity_code(sign)
@@ -245,6 +251,18 @@ class SignMatcher:
         if not longer:
             return frozenset()
         return frozenset(longer | {k.entity for k in self.known if k.plate == shown})
+
+    def pictogram_evidence(self, kind: str) -> Evidence:
+        """What a plate showing the pictogram of ``kind`` ("toilet") says: each room the map
+        says is a ``kind`` is as likely as the others (one such room is named; several are
+        told apart by the rooms along the corridor, ``plate_memory``), a plate the
+        building does not hold is ``P_UNKNOWN`` as likely, any other entity
+        ``P_PICTOGRAM_ELSEWHERE``."""
+        other = math.log(P_PICTOGRAM_ELSEWHERE)
+        ents = {k.entity: (0.0 if self.amenities.get(k.entity) == kind else other)
+                for k in self.known}
+        keys = {e: kind for e, v in ents.items() if v == 0.0}
+        return Evidence(ents, math.log(P_UNKNOWN), keys)
 
     def _code_token(
         self, tokens: list[tuple[str, list[float]]]

@@ -29,7 +29,7 @@ import threading
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
-from pmnav_bt.perception.depth import plate_pose
+from pmnav_bt.perception.depth import PlatePose, plate_pose
 from pmnav_bt.perception.sign_match import Evidence
 from pmnav_bt.seams import Observation
 
@@ -75,6 +75,13 @@ def ambiguous(ev: Evidence) -> bool:
     return bool(ev.entities) and max(ev.entities.values()) >= ev.unknown
 
 
+def hangs_like_a_plate(obs: Observation, plate: PlatePose) -> bool:
+    """Whether depth puts ``plate`` where signs hang: its centre ``PLATE_Z_M`` above the
+    floor, no wider than ``MAX_PLATE_WIDTH_M``."""
+    height = float(plate.centre[2]) + obs.camera_height
+    return PLATE_Z_M[0] <= height <= PLATE_Z_M[1] and plate.width <= MAX_PLATE_WIDTH_M
+
+
 def unread_plate(
     obs: Observation, box: tuple[float, float, float, float], line_px: float, read: str = ""
 ) -> UnreadPlate | None:
@@ -89,10 +96,8 @@ def unread_plate(
         return None
     x, y, z = (float(v) for v in plate.centre)
     line = line_px * x / obs.intrinsics.fy
-    height = z + obs.camera_height
     if not (
-        PLATE_Z_M[0] <= height <= PLATE_Z_M[1]
-        and plate.width <= MAX_PLATE_WIDTH_M
+        hangs_like_a_plate(obs, plate)
         and LINE_HEIGHT_M[0] <= line <= LINE_HEIGHT_M[1]
         and math.hypot(x, y) <= MAX_SEEN_M
     ):
@@ -103,7 +108,7 @@ def unread_plate(
     return UnreadPlate(
         xy=(p.x + c * x - s * y, p.y + s * x + c * y),
         normal=(c * nx - s * ny, s * nx + c * ny),
-        z=height,
+        z=z + obs.camera_height,
         line_height=line,
         width=plate.width,
         stamp=obs.stamp,

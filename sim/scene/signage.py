@@ -5,17 +5,18 @@ unset.
 A real building has one signage system (one plate size, font, colour scheme, mounting
 and layout for every room) with a few exceptions; so a random draw picks one style per
 building and episode seed, then varies it per room only where buildings do: toilets
-get pictogram plates when the room's name says toilet, WC or restroom. Across seeds every
+get pictogram plates when the map says the room is a toilet (``map.amenities``: the
+file's ``amenity``, else the room's name). Across seeds every
 mounting, layout, font and colour scheme below is drawn.
 """
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, replace
 
 import numpy as np
 
+from pmnav_bt.map.amenities import room_amenity
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.signage import SIGN_FONTS, DirectionalSignSpec, PlateStyle
 from pmnav_bt.seams import CAMERA_HEIGHT_M
@@ -63,7 +64,6 @@ CAP_PER_WIDTH = 0.22  # capitals at most this fraction of the plate's width (fit
 WALL_HEIGHT_M = (1.35, 1.7)  # plate centre of wall and door plates (ADA: 1.22-1.52 m baseline)
 FLAG_HEIGHT_M = (2.2, 2.45)  # flag signs hang above head height
 TOILET_PICTOGRAM_P = 0.75  # buildings whose toilets carry pictogram plates
-TOILET_NAME = re.compile(r"\b(toilets?|wc|restrooms?|lavator(y|ies)|washrooms?)\b", re.I)
 
 
 @dataclass(frozen=True)
@@ -117,7 +117,7 @@ def resolve_signage(b: Building, mode: str, rng: np.random.Generator) -> Buildin
     rooms = {}
     for room in b.rooms:
         style = base
-        if pictogram_toilets and TOILET_NAME.search(room.display_name):
+        if pictogram_toilets and room_amenity(room) == "toilet":
             style = replace(style, pictogram="toilet")
         override = section.rooms.get(room.id) if section is not None else None
         if override is not None:

@@ -82,6 +82,7 @@ def test_good_building_loads_with_defaults():
         (lambda d: d["rooms"][0].update(door=[5, "north"]), "rooms[0].door[1]", "number"),
         (lambda d: d.update(corridor_width=-1), "corridor_width", "greater than 0"),
         (lambda d: d["rooms"][0].update(colour="red"), "rooms[0].colour", "unknown key"),
+        (lambda d: d["rooms"][0].update(amenity="kitchen"), "rooms[0].amenity", "'toilet'"),
         (lambda d: d.update(floors=2), "floors", "unknown key"),
         (lambda d: d.pop("name"), "name", "missing"),
         (lambda d: d.update(schema_version=7), "schema_version", "reads schema_version 1"),
@@ -194,3 +195,17 @@ def test_lengths_use_positions():
     b = building_from_data(GOOD)
     g = b.corridor_graph()
     assert g.edges["start", "turn1"]["length"] == pytest.approx(math.dist((0, 0), (10, 0)))
+
+
+def test_a_rooms_amenity_is_the_files_else_its_names():
+    from pmnav_bt.map.amenities import room_amenity
+
+    def room(**kw):
+        d = {**GOOD, "rooms": [{"id": "r1", "door": GOOD["rooms"][0]["door"], **kw}]}
+        return building_from_data(d, "b.yaml").rooms[0]
+
+    assert room_amenity(room(name="Toilets")) == "toilet"
+    assert room_amenity(room(name="Accessible WC")) == "toilet"
+    assert room_amenity(room(name="Pharmacy")) is None
+    assert room_amenity(room(name="Quiet Room", amenity="toilet")) == "toilet"
+    assert room_amenity(room(name="Toilets Store", amenity="none")) is None

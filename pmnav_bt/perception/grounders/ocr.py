@@ -5,7 +5,12 @@
   around it weighed (``PlateMemory``); an ambiguous plate names nothing. The box is the
   sign's, its ``point`` where the named entity is, the point the priori-map knows it by:
   for a room its door (derived from the sign, as ``detect`` does), for a landmark its
-  sign; None without depth. Localization pairs these points with the map's.
+  sign; None without depth. Localization pairs these points with the map's. A plate
+  whose text names nothing is shown to the pictogram reader (``perception/pictograms.py``,
+  when one is given): a toilet pictogram read above its calibrated confidence names the
+  rooms the map says are toilets (``SignMatcher.pictogram_evidence``), through the same
+  plate memory, when depth hangs the plate where signs hang; a read short of that
+  confidence is not a sighting.
 - ``detect(room)``: the room's *door*, found in RGB-D around its sign
   (``door_scene.door_for_plate``; the file's signage mounting a prior): box and mask of
   the door rectangle projected into the image, ``point`` its centre.
@@ -13,7 +18,8 @@
 - ``detect(landmark)``: the landmark's sign.
 - ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
 - ``unread_plates``: the plates it found but could not read, or read and could not tell
-  apart (``perception/unread_plates.py``), placed by depth, for the tree's active read.
+  apart (``perception/unread_plates.py``), placed by depth, for the tree's active read;
+  a plate the pictogram reader is unsure of is one of them.
 
 Where the body offers a wider view of the frame for reading (``Observation.reading``),
 plates are looked for in the frame and their crops read in that view (only the crops are
@@ -36,9 +42,16 @@ from pmnav_bt.perception import depth as depth_geom
 from pmnav_bt.perception.door_scene import door_for_plate, mounting_prior
 from pmnav_bt.perception.doors import DoorLayout
 from pmnav_bt.perception.grounders.plate_memory import PlateMemory
+from pmnav_bt.perception.pictograms import PictogramRead, PictogramReader
 from pmnav_bt.perception.sign_match import Evidence, Match, SignMatcher, decide
 from pmnav_bt.perception.signs import MIN_LINE_PX, Box, SignReader, SignText, scale_sign
-from pmnav_bt.perception.unread_plates import UnreadPlate, UnreadPlates, ambiguous, unread_plate
+from pmnav_bt.perception.unread_plates import (
+    UnreadPlate,
+    UnreadPlates,
+    ambiguous,
+    hangs_like_a_plate,
+    unread_plate,
+)
 from pmnav_bt.seams import Detection, Entity, EntityKind, Observation, SurfaceMasks
 
 
@@ -60,9 +73,11 @@ class OcrGrounder:
         building: Building,
         reader: SignReader | None = None,
         layout: DoorLayout | None = None,
+        pictograms: PictogramReader | None = None,
     ):
         self.building = building
         self.reader = reader if reader is not None else SignReader()
+        self.pictograms = pictograms  # None: no pictogram is read
         self.matcher = SignMatcher(building)
         self.memory = PlateMemory(self._door_of)
         self.unread = UnreadPlates()
@@ -110,40 +125,96 @@ class OcrGrounder:
             if c is not None and c[0] is obs.rgb and c[1] == obs.stamp:
                 return c[2]
         signs, doors, unmatched = [], [], []
+        unnamed: list[tuple[Box, float, SignText | None, Evidence | None]] = []
         for box, line_px, sign in self._read_text(obs):
             if sign is None:  # a plate seen, its text not read
-                self._unread(obs, box, line_px, "")
+                unnamed.append((box, line_px, None, None))
                 continue
-            lines = [(ln.text, ln.score) for ln in sign.lines]
             plate = depth_geom.plate_pose(obs, sign.box)
             m, ev = self._match(obs, sign, plate)
             if m is None:
-                if ambiguous(ev):
-                    self._unread(obs, box, line_px, sign.text)
-                if self._observer is not None and self.matcher.trusted(lines):
-                    unmatched.append(_unmatched(obs, sign))
+                unnamed.append((box, line_px, sign, ev))
                 continue
-            if plate is not None:
-                self.unread.read_at(_odom(obs, plate.centre))
-            det = Detection(
-                label=sign.text,
-                box=sign.box,
-                score=float(m.score * sign.score),
-                entity=m.entity,
-                point=None if plate is None else tuple(float(v) for v in plate.centre),  # type: ignore[arg-type]
-            )
-            door = None
-            if m.entity.kind == EntityKind.ROOM and plate is not None:
-                door = self._door(obs, det, plate)
-                det = replace(det, point=door.point)
-            signs.append(det)
-            doors.append(door)
+            self._sighting(obs, sign.text, sign.box, float(m.score * sign.score), m, plate,
+                           signs, doors)
+        pictos = self._pictograms(obs, [box for box, _, _, _ in unnamed])
+        for (box, line_px, sign, ev), picto in zip(unnamed, pictos, strict=True):
+            if picto is not None and picto.sighting:
+                # No words to confirm it: only a plate depth hangs where signs hang.
+                plate = depth_geom.plate_pose(obs, box)
+                if plate is None or not hangs_like_a_plate(obs, plate):
+                    continue
+                m = self._match_pictogram(obs, picto.kind, plate)
+                if m is not None:
+                    self._sighting(obs, f"[{picto.kind}]", box, float(m.score * picto.p), m,
+                                   plate, signs, doors)
+                continue  # a pictogram, not a room of this map, or the map's toilets alike
+            if sign is None or ev is None:
+                self._unread(obs, box, line_px, "")
+                continue
+            lines = [(ln.text, ln.score) for ln in sign.lines]
+            if ambiguous(ev) or (picto is not None and picto.ambiguous):
+                self._unread(obs, box, line_px, sign.text)
+            if self._observer is not None and self.matcher.trusted(lines):
+                unmatched.append(_unmatched(obs, sign))
         result = _Read(signs, doors)
         with self._lock:
             self._cache = (obs.rgb, obs.stamp, result)
         if self._observer is not None:
             self._observer(obs, list(signs), unmatched)
         return result
+
+    def _sighting(
+        self,
+        obs: Observation,
+        label: str,
+        box: Box,
+        score: float,
+        m: Match,
+        plate: depth_geom.PlatePose | None,
+        signs: list[Detection],
+        doors: list[Detection | None],
+    ) -> None:
+        """Add the plate in ``box`` named ``m.entity`` to ``signs``, with its door (a room's,
+        placed from the scene) to ``doors``."""
+        if plate is not None:
+            self.unread.read_at(_odom(obs, plate.centre))
+        det = Detection(
+            label=label,
+            box=box,
+            score=score,
+            entity=m.entity,
+            point=None if plate is None else tuple(float(v) for v in plate.centre),  # type: ignore[arg-type]
+        )
+        door = None
+        if m.entity.kind == EntityKind.ROOM and plate is not None:
+            door = self._door(obs, det, plate)
+            det = replace(det, point=door.point)
+        signs.append(det)
+        doors.append(door)
+
+    def _pictograms(self, obs: Observation, boxes: list[Box]) -> list[PictogramRead | None]:
+        """The pictogram reader's read of each plate in ``boxes`` (frame pixels), made in
+        the reading view where there is one; None where not read (no reader, too small)."""
+        if self.pictograms is None or not boxes:
+            return [None] * len(boxes)
+        r = obs.reading
+        w = obs.rgb.shape[1]
+        src = obs.rgb if r is None or r.width <= w else r
+        s = 1.0 if src is obs.rgb else r.width / w  # type: ignore[union-attr]
+        scaled = [(b[0] * s, b[1] * s, b[2] * s, b[3] * s) for b in boxes]
+        reads = {pr.box: pr for pr in self.pictograms.read(src, scaled)}
+        return [reads.get(b) for b in scaled]
+
+    def _match_pictogram(
+        self, obs: Observation, kind: str, plate: depth_geom.PlatePose
+    ) -> Match | None:
+        """Which room a plate showing the pictogram of ``kind`` is: the map's rooms of that
+        kind, weighed with the plate's earlier reads and its neighbours (``PlateMemory``)."""
+        ev = self.matcher.pictogram_evidence(kind)
+        p = obs.pose
+        with self._memory_lock:
+            return self.memory.read(_odom(obs, plate.centre), (p.x, p.y, p.yaw), obs.stamp, ev)
 
     def _match(
         self, obs: Observation, sign: SignText, plate: depth_geom.PlatePose | None
@@ -236,6 +307,11 @@ def _unmatched(obs: Observation, sign: SignText) -> Detection:
     )
 
 
+def pictogram_reader(g) -> PictogramReader | None:
+    """The pictogram reader ``config.grounder`` asks for (``pictograms``), or None."""
+    return PictogramReader() if g.pictograms else None
+
+
 def reader_and_layout(g) -> tuple[SignReader, DoorLayout]:
     """The sign reader and door layout ``config.grounder`` describes (ocr and gdino_sam)."""
     reader = SignReader(
@@ -252,4 +328,5 @@ def reader_and_layout(g) -> tuple[SignReader, DoorLayout]:
 
 def build(deps: BackendDeps) -> OcrGrounder:
     """The ``ocr`` back end from ``config.grounder`` (registry factory)."""
-    return OcrGrounder(deps.pm.building, *reader_and_layout(deps.config.grounder))
+    g = deps.config.grounder
+    return OcrGrounder(deps.pm.building, *reader_and_layout(g), pictogram_reader(g))
