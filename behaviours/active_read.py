@@ -208,7 +208,7 @@ class _Planner:
             free,
             seen_from=plate.seen_from,
             robot=self.robot,
-            nearest=view_standoff(plate.z, height, vfov),
+            nearest=view_standoff(plate.top, height, vfov),
         )
         return None if pose is None else ReadingPlan(plate, pose, rng)
 

@@ -46,13 +46,15 @@ KEEP_S = 120.0  # an unread plate is remembered this long (clock s)
 class UnreadPlate:
     """A plate seen but not read, in the odometry frame: ``xy`` its centre on the wall,
     ``normal`` the wall's unit normal out towards where it was seen from, ``z`` its
-    centre's height above the floor, ``line_height`` its text-line height (m), ``width``
-    along the wall (m); ``stamp`` when and ``seen_from`` where it was seen; ``read``
-    what was read of it ("" nothing)."""
+    centre's height above the floor, ``top`` the height of its text's top (what a level
+    camera must keep in view to read it), ``line_height`` its text-line height (m),
+    ``width`` along the wall (m); ``stamp`` when and ``seen_from`` where it was seen;
+    ``read`` what was read of it ("" nothing)."""
 
     xy: tuple[float, float]
     normal: tuple[float, float]
     z: float
+    top: float
     line_height: float
     width: float
     stamp: float
@@ -88,8 +90,10 @@ def unread_plate(
     if plate is None:
         return None
     x, y, z = (float(v) for v in plate.centre)
-    line = line_px * x / obs.intrinsics.fy
+    k = obs.intrinsics
+    line = line_px * x / k.fy
     height = z + obs.camera_height
+    top = obs.camera_height + (k.cy - box[1]) * x / k.fy  # the box's top edge at its depth
     if not (
         PLATE_Z_M[0] <= height <= PLATE_Z_M[1]
         and plate.width <= MAX_PLATE_WIDTH_M
@@ -104,6 +108,7 @@ def unread_plate(
         xy=(p.x + c * x - s * y, p.y + s * x + c * y),
         normal=(c * nx - s * ny, s * nx + c * ny),
         z=height,
+        top=max(top, height),
         line_height=line,
         width=plate.width,
         stamp=obs.stamp,

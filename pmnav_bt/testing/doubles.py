@@ -327,6 +327,7 @@ class ScriptedGrounder:
                     xy=(float(at[0]), float(at[1])),
                     normal=(float(out[0] / n), float(out[1] / n)),
                     z=self.PLATE_Z_M,
+                    top=self.PLATE_Z_M + self.PLATE_LINE_M / 2.0,
                     line_height=self.PLATE_LINE_M,
                     width=0.3,
                     stamp=obs.stamp,
