@@ -20,6 +20,11 @@ A grounder that reads plates remembers the unread ones (``UnreadPlates``, odomet
 one entry per place, the newest sighting kept, dropped once the plate is read) and tells
 the tree through ``SeesUnreadPlates``. The oracle (``sim_gt``) reads every sign it sees:
 it has none.
+
+It also remembers, per room or landmark, the last plate it read as naming it
+(``plate_named``), placed the same way: a search that does not see a plate already read
+(it hangs above the view from where the search stands, a person stands before it) has
+not found it absent, and the tree reads it again from where it reads.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from typing import Protocol, runtime_checkable
 
 from pmnav_bt.perception.depth import plate_pose
 from pmnav_bt.perception.sign_match import Evidence
-from pmnav_bt.seams import Observation
+from pmnav_bt.seams import Entity, Observation
 
 SAME_PLATE_M = 0.4  # two sightings this near are one plate
 PLATE_Z_M = (1.1, 2.7)  # a plate's centre above the floor: door plates to flag signs
@@ -68,6 +73,11 @@ class SeesUnreadPlates(Protocol):
     odometry frame), seen at or after clock time ``since``."""
 
     def unread_plates(self, since: float) -> list[UnreadPlate]: ...
+
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        """The plate last read as naming ``entity`` (``read`` its text; ``stamp`` when);
+        None: none."""
+        ...
 
 
 def ambiguous(ev: Evidence) -> bool:
@@ -122,7 +132,19 @@ class UnreadPlates:
 
     def __init__(self) -> None:
         self._plates: list[UnreadPlate] = []
+        self._named: dict[Entity, UnreadPlate] = {}
         self._lock = threading.Lock()
+
+    def named(self, entity: Entity, plate: UnreadPlate) -> None:
+        """``plate`` was read as naming ``entity``: it is unread no more, and is where
+        ``entity``'s plate hangs."""
+        with self._lock:
+            self._plates = [p for p in self._plates if not _same(p, plate.xy)]
+            self._named[entity] = plate
+
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        with self._lock:
+            return self._named.get(entity)
 
     def seen(self, plate: UnreadPlate) -> None:
         """Remember ``plate``, in place of an earlier sighting of it."""

@@ -263,6 +263,9 @@ class ScriptedGrounder:
     def unread_plates(self, since: float) -> list[UnreadPlate]:
         return self.unread.since(since)
 
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        return self.unread.plate_named(entity)
+
     def detect(self, obs: Observation, target: Entity) -> list[Detection]:
         self._called("detect")
         d = self._see(obs, target)

@@ -13,7 +13,8 @@
 - ``detect(landmark)``: the landmark's sign.
 - ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
 - ``unread_plates``: the plates it found but could not read, or read and could not tell
-  apart (``perception/unread_plates.py``), placed by depth, for the tree's active read.
+  apart (``perception/unread_plates.py``), placed by depth, for the tree's active read;
+  ``plate_named``: the plate last read as naming a room or landmark, placed alike.
 
 Where the body offers a wider view of the frame for reading (``Observation.reading``),
 plates are looked for in the frame and their crops read in that view (only the crops are
@@ -94,6 +95,9 @@ class OcrGrounder:
     def unread_plates(self, since: float) -> list[UnreadPlate]:
         return self.unread.since(since)
 
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        return self.unread.plate_named(entity)
+
     # -- what a map check watches (perception.map_check.WatchesReads) ---------------------
 
     def watch_reads(self, observer) -> None:
@@ -125,6 +129,9 @@ class OcrGrounder:
                 continue
             if plate is not None:
                 self.unread.read_at(_odom(obs, plate.centre))
+                named = unread_plate(obs, box, line_px, sign.text)
+                if named is not None:
+                    self.unread.named(m.entity, named)
             det = Detection(
                 label=sign.text,
                 box=sign.box,
