@@ -189,7 +189,7 @@ class _Planner:
         near = [p for d, _, p in near if d <= self.reach]
         if not near:
             if read is not None and self.off(read) <= self.reach:
-                plan = self.plan(read, None)
+                plan = self.plan(read_from_where_read(read), None)
                 if plan is not None:
                     return replace(plan, named=True), ""
                 return None, "no free spot to read its plate, read before, from"
@@ -233,6 +233,17 @@ class _Planner:
             nearest=view_standoff(plate.top, height, vfov),
         )
         return None if pose is None else ReadingPlan(plate, pose, rng)
+
+
+def read_from_where_read(plate: UnreadPlate) -> UnreadPlate:
+    """``plate``, read before from ``seen_from``, facing that way: a plate is read from
+    where it was read. Depth's normal is its wall's, which for a flag sign (read end-on,
+    its faces across the corridor) points where its text is seen edge-on."""
+    out = np.asarray(plate.seen_from, float) - np.asarray(plate.xy, float)
+    n = float(np.linalg.norm(out))
+    if n < 1e-6:
+        return plate
+    return replace(plate, normal=(float(out[0] / n), float(out[1] / n)))
 
 
 class DriveToReadingPose(DriveTo):

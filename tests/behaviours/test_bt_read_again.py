@@ -9,10 +9,12 @@ import math
 import pytest
 from py_trees.common import Status
 
+from pmnav_bt.behaviours.active_read import read_from_where_read
 from pmnav_bt.behaviours.capture import CaptureViews, search_yaws
 from pmnav_bt.behaviours.search import target_entity
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.signage import Signage, SignStyleSpec
+from pmnav_bt.perception.unread_plates import UnreadPlate
 from pmnav_bt.seams import Entity, Pose2D
 from pmnav_bt.trees.active_read import read_closer_subtree
 
@@ -61,3 +63,12 @@ def test_a_flag_read_before_but_not_seen_from_under_it_is_read_again(make_rig, w
     assert went.data["read"]  # the plate read before, not an unread one
     p = rig.true_pose()
     assert math.dist((p.x, p.y), flag.centre) > 1.5  # backed off to see it
+
+
+def test_a_flag_read_before_is_read_again_from_the_side_it_was_read_from():
+    # A flag across the corridor, read from 4 m down it: depth gave its wall's normal
+    # (+x), from which its text is seen edge-on; it is read again from down the corridor.
+    flag = UnreadPlate((0.0, 0.0), (1.0, 0.0), 2.3, 2.35, 0.06, 0.3, 5.0, (1.0, 4.0), "135")
+    again = read_from_where_read(flag)
+    assert again.normal == pytest.approx((1.0 / math.hypot(1, 4), 4.0 / math.hypot(1, 4)))
+    assert again.xy == flag.xy and again.read == "135"
