@@ -9,7 +9,10 @@ a person walks up to it. So does the tree:
 1. ``PlanReadingPose``: of the plates the grounder saw and could not read in the last
    search (``perception.unread_plates.SeesUnreadPlates``), the one nearest where the map
    puts the target (within the pose's uncertainty and ``SIGN_REACH_M``, a sign beside,
-   above or on its door) gets a reading pose (``perception.reading_pose``): square to it,
+   above or on its door); with none, the plate the grounder read as the target before
+   the search (``plate_named``, as near the map's target), which the search did not see
+   again: a flag above the view from where the search stood, a person before it. It gets
+   a reading pose (``perception.reading_pose``): square to it,
    within the range a plate with text that size is read from at the camera's width
    (``read_range.plate_read_range``, the sign benchmark's table), inside the map's
    corridors and on floor depth showed free. Something standing before the plate is no
@@ -29,7 +32,7 @@ at once.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from py_trees.common import Status
@@ -42,7 +45,7 @@ from pmnav_bt.geometry import heading, se2_apply, wrap_angle
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.perception.read_range import plate_read_range
 from pmnav_bt.perception.reading_pose import ReadingPose, reading_pose, view_standoff
-from pmnav_bt.perception.unread_plates import SeesUnreadPlates, UnreadPlate
+from pmnav_bt.perception.unread_plates import KEEP_S, SeesUnreadPlates, UnreadPlate
 from pmnav_bt.planning.resolve import entity_position
 from pmnav_bt.seams import CAMERA_HEIGHT_M, CREATE3_RADIUS_M, Entity, Observation
 
@@ -57,11 +60,13 @@ VIEW_MARGIN = math.radians(5.0)  # a spot this near the view's border is not jud
 @dataclass(frozen=True)
 class ReadingPlan:
     """An unread plate and where to read it, both in the odometry frame; ``read_range``:
-    how far a plate of its text size is read (m)."""
+    how far a plate of its text size is read (m); ``named``: the plate is the one read as
+    the target before the search, which did not see it again."""
 
     plate: UnreadPlate
     pose: ReadingPose
     read_range: float
+    named: bool = False  # the plate was read as the target before, not seen since
 
 
 def stands_before(obs: Observation, plate: UnreadPlate) -> bool:
@@ -126,7 +131,10 @@ class PlanReadingPose(PmNavBehaviour):
         since = min(v.observation.stamp for v in views)
         here = self.ctx.base.pose()
         plan = _Planner(self.ctx, entity, tf, tol + SIGN_REACH_M, views, (here.x, here.y))
-        self._job = self.ctx.worker.submit(lambda c: plan(g.unread_plates(since)))
+        read = g.plate_named(entity)
+        if read is not None and not (since - KEEP_S <= read.stamp < since):
+            read = None  # read in this search (not found for another reason), or long ago
+        self._job = self.ctx.worker.submit(lambda c: plan(g.unread_plates(since), read))
 
     def update(self) -> Status:
         if self._job is None:
@@ -153,9 +161,15 @@ class PlanReadingPose(PmNavBehaviour):
             angle_deg=math.degrees(pose.angle),
             read=p.read,
         )
+        seen = math.dist(p.xy, p.seen_from)
+        how = (
+            f"its plate, read {seen:.1f} m off before, not seen in the search"
+            if plan.named
+            else f"a plate seen {seen:.1f} m off, not read"
+        )
         self.feedback_message = (
-            f"{t.look_for}: a plate seen {math.dist(p.xy, p.seen_from):.1f} m off, not read: "
-            f"reading it from {pose.distance:.1f} m, {math.degrees(pose.angle):+.0f} deg"
+            f"{t.look_for}: {how}: reading it from {pose.distance:.1f} m, "
+            f"{math.degrees(pose.angle):+.0f} deg"
         )
         return Status.SUCCESS
 
@@ -168,13 +182,17 @@ class _Planner:
         self.sign = np.asarray(entity_position(ctx.pm, entity), float)
         self.frames = {v.observation.stamp: v.observation for v in views}
 
-    def __call__(self, plates: list[UnreadPlate]) -> tuple[ReadingPlan | None, str]:
-        near = sorted(
-            (float(np.linalg.norm(se2_apply(self.tf, p.xy) - self.sign)), i, p)
-            for i, p in enumerate(plates)
-        )
+    def __call__(
+        self, plates: list[UnreadPlate], read: UnreadPlate | None = None
+    ) -> tuple[ReadingPlan | None, str]:
+        near = sorted((self.off(p), i, p) for i, p in enumerate(plates))
         near = [p for d, _, p in near if d <= self.reach]
         if not near:
+            if read is not None and self.off(read) <= self.reach:
+                plan = self.plan(read_from_where_read(read), None)
+                if plan is not None:
+                    return replace(plan, named=True), ""
+                return None, "no free spot to read its plate, read before, from"
             return None, f"no unread plate within {self.reach:.1f} m of the target"
         for plate in near:
             obs = self.frames.get(plate.stamp)
@@ -184,6 +202,10 @@ class _Planner:
             if plan is not None:
                 return plan, ""
         return None, "no free spot to read the plate from"
+
+    def off(self, plate: UnreadPlate) -> float:
+        """How far (m) ``plate`` hangs from where the map puts the target."""
+        return float(np.linalg.norm(se2_apply(self.tf, plate.xy) - self.sign))
 
     def plan(self, plate: UnreadPlate, obs: Observation | None) -> ReadingPlan | None:
         cfg = self.ctx.config
@@ -208,9 +230,20 @@ class _Planner:
             free,
             seen_from=plate.seen_from,
             robot=self.robot,
-            nearest=view_standoff(plate.z, height, vfov),
+            nearest=view_standoff(plate.top, height, vfov),
         )
         return None if pose is None else ReadingPlan(plate, pose, rng)
+
+
+def read_from_where_read(plate: UnreadPlate) -> UnreadPlate:
+    """``plate``, read before from ``seen_from``, facing that way: a plate is read from
+    where it was read. Depth's normal is its wall's, which for a flag sign (read end-on,
+    its faces across the corridor) points where its text is seen edge-on."""
+    out = np.asarray(plate.seen_from, float) - np.asarray(plate.xy, float)
+    n = float(np.linalg.norm(out))
+    if n < 1e-6:
+        return plate
+    return replace(plate, normal=(float(out[0] / n), float(out[1] / n)))
 
 
 class DriveToReadingPose(DriveTo):

@@ -16,7 +16,8 @@ flag, whose plate stands across the corridor. So the door is looked for in RGB-D
    open doorway or a glazed leaf (depth behind the wall) counts where it crosses the
    wall. A pixel behind the wall is door (an opening or a recessed leaf); one on the wall
    is door when its colour is ``MIN_CONTRAST`` from the wall's own (the median of the
-   same wall above the doors, ``REF_BAND_M``, as ``door_sightings`` takes it); one in
+   same wall above the doors, ``REF_BAND_M``, as ``door_sightings`` takes it; seen too
+   near for that, of the wall round the plate, what it hangs on); one in
    front of the wall (clutter, a person) tells nothing, nor do the plate's own pixels.
    Runs of door bins a door's width long are the doors; a run that reaches the edge of
    what is seen is cut, and only its seen end is its edge.
@@ -83,6 +84,7 @@ FLAG_OUT_M = (0.1, 0.8)  # a flag's points stand this far out of its wall (a 5 c
 FLAG_MIN_SHARE = 0.3  # ... at least this share of its box's points (the rest: wall behind)
 AGREE_M = 0.15  # a run's centre this near the convention's spot confirms the convention
 PLATE_MARGIN_PX = 2  # the plate's box grown by this much is not looked at
+BACKING_RING = 0.5  # the ring round a plate its backing's colour is taken in, in plate sizes
 
 
 @dataclass(frozen=True)
@@ -166,9 +168,13 @@ def door_runs(
     on_wall = np.abs(h[ok]) <= ON_WALL_M
     colour = lab[ok]
     ref = _wall_colour(obs, pts, wall, lab, box)
+    if ref is None:
+        # Too near to see above the doors: what the plate hangs on, round its box.
+        ref = _backing_colour(obs, pts, wall, lab, box)
     if ref is None and on_wall.sum() >= MIN_REF_PX:
-        # Too near to see above the doors: the band's own median. Where a leaf fills the
-        # view that is the leaf's colour, and its frame's jambs stand out of it instead.
+        # Nor that (a flag's box has no wall round it): the band's own median. Where a
+        # leaf fills the view that is the leaf's colour, and its frame's jambs stand out
+        # of it instead.
         ref = np.median(colour[on_wall], axis=0)
     if ref is None:
         door = behind
@@ -213,6 +219,22 @@ def _wall_colour(obs: Observation, pts, wall: WallFrame, lab, box) -> np.ndarray
     m = np.nan_to_num(np.abs(h), nan=1e9) <= ON_WALL_M
     m &= (np.nan_to_num(z, nan=-1) > REF_BAND_M[0]) & (np.nan_to_num(z, nan=9) < REF_BAND_M[1])
     m &= ~_box_mask(obs, box)
+    if m.sum() < MIN_REF_PX:
+        return None
+    return np.median(lab[m], axis=0)
+
+
+def _backing_colour(obs: Observation, pts, wall: WallFrame, lab, box) -> np.ndarray | None:
+    """The colour of what a flat plate hangs on: the median of the wall plane's pixels in
+    a ring round its box (``BACKING_RING``, the plate's own size out). Beside a door or
+    above it that is the wall; on the door, the leaf, whose frame's jambs then stand out
+    of it. Seen close, the band of door heights may be more leaf than wall, and its median
+    would take the leaf for the wall and the wall beside it for a door. None: too few."""
+    ring = max(box[2] - box[0], box[3] - box[1]) * BACKING_RING
+    grown = (box[0] - ring, box[1] - ring, box[2] + ring, box[3] + ring)
+    h = pts[..., :2] @ wall.normal - float(wall.normal @ wall.foot)
+    m = _box_mask(obs, grown, margin=0) & ~_box_mask(obs, box)
+    m &= np.nan_to_num(np.abs(h), nan=1e9) <= ON_WALL_M
     if m.sum() < MIN_REF_PX:
         return None
     return np.median(lab[m], axis=0)

@@ -9,8 +9,10 @@ reading pose stands on the plate's normal (the wall's, from depth) or near it
 estimate and depth are good to a few decimetres), and never farther than where the
 plate was already seen and not read, less ``CLOSER_M``: a second look from the same
 spot reads no better. It stands no nearer than ``MIN_STANDOFF_M`` (the body's radius and
-room to turn) and than where the plate leaves the top of the camera's view
-(``view_standoff``: a flag sign hangs at 2.2-2.45 m, 0.6-0.85 m above the camera). Of
+room to turn) and than where the plate's text leaves the top of the camera's view
+(``view_standoff``, from the height of the text's top as depth measured it: a flag sign
+hangs at 2.2-2.45 m, 0.6-0.85 m above the camera, and its small text is read only from
+between where it leaves the view and where it grows too small, a few decimetres). Of
 the candidate spots the first on free floor (``free``: the caller's corridors and what
 depth showed standing there) wins, the one nearest the robot at each angle.
 """
@@ -28,8 +30,8 @@ RANGE_MARGIN_M = 0.3
 CLOSER_M = 0.5
 MIN_STANDOFF_M = 0.6
 STEP_M = 0.2  # between candidate distances along each direction
-VIEW_MARGIN = math.radians(4.0)  # the plate's top this far inside the top of the view
-PLATE_HALF_HEIGHT_M = 0.1  # above its centre: a plate's top (room plates are 0.1-0.25 m)
+VIEW_MARGIN = math.radians(2.0)  # the text's top this far inside the top of the view (10
+# rows of a 240-row frame, 20 of the 480-row reading view: room round the text for OCR)
 
 
 @dataclass(frozen=True)
@@ -44,10 +46,11 @@ class ReadingPose:
     angle: float
 
 
-def view_standoff(z: float, camera_height: float, vfov: float) -> float:
-    """How near (m) a plate whose centre is ``z`` m above the floor can be stood to and
-    still be whole in a view ``vfov`` rad high from ``camera_height`` m (level camera)."""
-    above = z + PLATE_HALF_HEIGHT_M - camera_height
+def view_standoff(top: float, camera_height: float, vfov: float) -> float:
+    """How near (m) a plate whose text's top is ``top`` m above the floor can be stood to
+    and its text still be whole in a view ``vfov`` rad high from ``camera_height`` m
+    (level camera)."""
+    above = top - camera_height
     if above <= 0.0:
         return 0.0
     return above / math.tan(vfov / 2.0 - VIEW_MARGIN)

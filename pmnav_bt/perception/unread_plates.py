@@ -20,6 +20,11 @@ A grounder that reads plates remembers the unread ones (``UnreadPlates``, odomet
 one entry per place, the newest sighting kept, dropped once the plate is read) and tells
 the tree through ``SeesUnreadPlates``. The oracle (``sim_gt``) reads every sign it sees:
 it has none.
+
+It also remembers, per room or landmark, the last plate it read as naming it
+(``plate_named``), placed the same way: a search that does not see a plate already read
+(it hangs above the view from where the search stands, a person stands before it) has
+not found it absent, and the tree reads it again from where it reads.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from typing import Protocol, runtime_checkable
 
 from pmnav_bt.perception.depth import PlatePose, plate_pose
 from pmnav_bt.perception.sign_match import Evidence
-from pmnav_bt.seams import Observation
+from pmnav_bt.seams import Entity, Observation
 
 SAME_PLATE_M = 0.4  # two sightings this near are one plate
 PLATE_Z_M = (1.1, 2.7)  # a plate's centre above the floor: door plates to flag signs
@@ -46,13 +51,15 @@ KEEP_S = 120.0  # an unread plate is remembered this long (clock s)
 class UnreadPlate:
     """A plate seen but not read, in the odometry frame: ``xy`` its centre on the wall,
     ``normal`` the wall's unit normal out towards where it was seen from, ``z`` its
-    centre's height above the floor, ``line_height`` its text-line height (m), ``width``
-    along the wall (m); ``stamp`` when and ``seen_from`` where it was seen; ``read``
-    what was read of it ("" nothing)."""
+    centre's height above the floor, ``top`` the height of its text's top (what a level
+    camera must keep in view to read it), ``line_height`` its text-line height (m),
+    ``width`` along the wall (m); ``stamp`` when and ``seen_from`` where it was seen;
+    ``read`` what was read of it ("" nothing)."""
 
     xy: tuple[float, float]
     normal: tuple[float, float]
     z: float
+    top: float
     line_height: float
     width: float
     stamp: float
@@ -66,6 +73,11 @@ class SeesUnreadPlates(Protocol):
     odometry frame), seen at or after clock time ``since``."""
 
     def unread_plates(self, since: float) -> list[UnreadPlate]: ...
+
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        """The plate last read as naming ``entity`` (``read`` its text; ``stamp`` when);
+        None: none."""
+        ...
 
 
 def ambiguous(ev: Evidence) -> bool:
@@ -95,7 +107,10 @@ def unread_plate(
     if plate is None:
         return None
     x, y, z = (float(v) for v in plate.centre)
-    line = line_px * x / obs.intrinsics.fy
+    k = obs.intrinsics
+    line = line_px * x / k.fy
+    height = z + obs.camera_height
+    top = obs.camera_height + (k.cy - box[1]) * x / k.fy  # the box's top edge at its depth
     if not (
         hangs_like_a_plate(obs, plate)
         and LINE_HEIGHT_M[0] <= line <= LINE_HEIGHT_M[1]
@@ -108,7 +123,8 @@ def unread_plate(
     return UnreadPlate(
         xy=(p.x + c * x - s * y, p.y + s * x + c * y),
         normal=(c * nx - s * ny, s * nx + c * ny),
-        z=z + obs.camera_height,
+        z=height,
+        top=max(top, height),
         line_height=line,
         width=plate.width,
         stamp=obs.stamp,
@@ -122,7 +138,19 @@ class UnreadPlates:
 
     def __init__(self) -> None:
         self._plates: list[UnreadPlate] = []
+        self._named: dict[Entity, UnreadPlate] = {}
         self._lock = threading.Lock()
+
+    def named(self, entity: Entity, plate: UnreadPlate) -> None:
+        """``plate`` was read as naming ``entity``: it is unread no more, and is where
+        ``entity``'s plate hangs."""
+        with self._lock:
+            self._plates = [p for p in self._plates if not _same(p, plate.xy)]
+            self._named[entity] = plate
+
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        with self._lock:
+            return self._named.get(entity)
 
     def seen(self, plate: UnreadPlate) -> None:
         """Remember ``plate``, in place of an earlier sighting of it."""

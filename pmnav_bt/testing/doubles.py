@@ -263,6 +263,9 @@ class ScriptedGrounder:
     def unread_plates(self, since: float) -> list[UnreadPlate]:
         return self.unread.since(since)
 
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        return self.unread.plate_named(entity)
+
     def detect(self, obs: Observation, target: Entity) -> list[Detection]:
         self._called("detect")
         d = self._see(obs, target)
@@ -327,6 +330,7 @@ class ScriptedGrounder:
                     xy=(float(at[0]), float(at[1])),
                     normal=(float(out[0] / n), float(out[1] / n)),
                     z=self.PLATE_Z_M,
+                    top=self.PLATE_Z_M + self.PLATE_LINE_M / 2.0,
                     line_height=self.PLATE_LINE_M,
                     width=0.3,
                     stamp=obs.stamp,

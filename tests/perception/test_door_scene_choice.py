@@ -55,3 +55,22 @@ def test_the_nearer_door_beats_the_priors(wall):
     plate = plate_pose(obs, box)
     door = door_for_plate(obs, plate, box, DoorLayout(default_side="left"), "beside")
     assert door.centre[1] == pytest.approx(-(0.5 + 0.58), abs=0.12)
+
+
+def test_seen_too_near_to_see_above_the_doors_the_wall_is_what_the_plate_hangs_on(wall):
+    # 1.2 m from the wall the view ends below the doors' tops, and a leaf fills more of
+    # the door band than the wall does: the band's median would be the leaf's colour, and
+    # the wall beside the plate a door. The plate's backing says which colour is the wall.
+    rng = 1.2
+    obs = wall.frame([], range_m=rng)
+    k = wall.K
+    px = k.fx / rng
+    v_top = int(round(k.cy - (2.1 - obs.camera_height) * px))
+    obs.rgb[v_top:, : int(round(k.cx + 0.05 * px))] = DOOR_RGB  # the leaf, cut by the view
+    x0, x1 = (k.cx + y * px for y in (0.2, 0.35))  # a 0.15 m plate 0.15 m right of it
+    y0, y1 = (k.cy - z * px for z in (0.05, -0.05))
+    obs.rgb[int(y0) : int(y1), int(x0) : int(x1)] = (30, 30, 34)
+    box = (x0, y0, x1, y1)
+    door = door_for_plate(obs, plate_pose(obs, box), box, DoorLayout(default_side="right"))
+    assert door.seen
+    assert door.centre[1] > 0.3  # the leaf's side (where the convention's spot is kept)

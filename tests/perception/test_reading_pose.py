@@ -13,9 +13,11 @@ from pmnav_bt.perception.reading_pose import (
     CLOSER_M,
     MIN_STANDOFF_M,
     RANGE_MARGIN_M,
+    VIEW_MARGIN,
     reading_pose,
     view_standoff,
 )
+from pmnav_bt.perception.unread_plates import unread_plate
 
 # A wall running at 30 deg through the origin; the corridor is the 2.4 m in front of it.
 WALL = math.radians(30.0)
@@ -79,6 +81,29 @@ def test_a_high_plate_is_not_stood_under():
     pose = reading_pose(PLATE, tuple(NORMAL), 1.0, in_corridor, seen_from=seen, robot=seen,
                         nearest=near)  # fmt: skip
     assert pose is not None and pose.distance >= near
+
+
+def test_a_flag_is_read_from_where_its_text_stays_in_view_not_its_guessed_plate():
+    # A flag's small text is read only between where it leaves the top of the view and
+    # where it grows too small: the standoff is where the text's top, as depth measured
+    # it, is VIEW_MARGIN inside the view's top, whatever the plate's size.
+    vfov = math.radians(47.0)
+    top = 2.35
+    near = view_standoff(top, 1.6, vfov)
+    assert math.atan2(top - 1.6, near) == pytest.approx(vfov / 2.0 - VIEW_MARGIN)
+
+
+def test_an_unread_plate_knows_its_texts_top(wall):
+    # A plate's text 2.25-2.35 m above the floor on the wall 1.8 m ahead (camera 1.6 m):
+    # its top is measured from the box at the plate's depth, not guessed from its centre.
+    obs = wall.frame([], range_m=1.8)
+    k = wall.K
+    px = k.fy / 1.8
+    box = (150.0, k.cy - 0.75 * px, 170.0, k.cy - 0.65 * px)
+    plate = unread_plate(obs, box, 0.08 * px)
+    assert plate is not None
+    assert plate.z == pytest.approx(2.3, abs=0.02)
+    assert plate.top == pytest.approx(2.35, abs=0.02)
 
 
 def test_no_free_spot_no_pose():

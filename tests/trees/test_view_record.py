@@ -65,6 +65,9 @@ class _PlateReader(ScriptedGrounder):
     def unread_plates(self, since: float) -> list:
         return [f"unread since {since}"]
 
+    def plate_named(self, entity) -> None:
+        return None
+
     def watch_reads(self, observer) -> None:
         self.observer = observer
 

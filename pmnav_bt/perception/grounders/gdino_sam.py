@@ -118,6 +118,10 @@ class GdinoSamGrounder:
         """The sign reader's (``perception.unread_plates.SeesUnreadPlates``)."""
         return self.signs.unread_plates(since)
 
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        """The sign reader's (``perception.unread_plates.SeesUnreadPlates``)."""
+        return self.signs.plate_named(entity)
+
     def surfaces(self, obs: Observation) -> SurfaceMasks:
         return depth_geom.surfaces(obs)
 

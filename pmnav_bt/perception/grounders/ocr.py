@@ -19,7 +19,8 @@
 - ``surfaces``: floor and walls from depth geometry (``depth.surfaces``).
 - ``unread_plates``: the plates it found but could not read, or read and could not tell
   apart (``perception/unread_plates.py``), placed by depth, for the tree's active read;
-  a plate the pictogram reader is unsure of is one of them.
+  a plate the pictogram reader is unsure of is one of them. ``plate_named``: the plate
+  last read as naming a room or landmark, placed alike.
 
 Where the body offers a wider view of the frame for reading (``Observation.reading``),
 plates are looked for in the frame and their crops read in that view (only the crops are
@@ -109,6 +110,9 @@ class OcrGrounder:
     def unread_plates(self, since: float) -> list[UnreadPlate]:
         return self.unread.since(since)
 
+    def plate_named(self, entity: Entity) -> UnreadPlate | None:
+        return self.unread.plate_named(entity)
+
     # -- what a map check watches (perception.map_check.WatchesReads) ---------------------
 
     def watch_reads(self, observer) -> None:
@@ -136,7 +140,7 @@ class OcrGrounder:
                 unnamed.append((box, line_px, sign, ev))
                 continue
             self._sighting(obs, sign.text, sign.box, float(m.score * sign.score), m, plate,
-                           signs, doors)
+                           signs, doors, text_at=(box, line_px))
         pictos = self._pictograms(obs, [box for box, _, _, _ in unnamed])
         for (box, line_px, sign, ev), picto in zip(unnamed, pictos, strict=True):
             if picto is not None and picto.sighting:
@@ -174,11 +178,17 @@ class OcrGrounder:
         plate: depth_geom.PlatePose | None,
         signs: list[Detection],
         doors: list[Detection | None],
+        text_at: tuple[Box, float] | None = None,
     ) -> None:
         """Add the plate in ``box`` named ``m.entity`` to ``signs``, with its door (a room's,
-        placed from the scene) to ``doors``."""
+        placed from the scene) to ``doors``. ``text_at`` (the plate's box and text-line
+        height in frame pixels, for a read text) also places it as the plate last read as
+        ``m.entity`` (``plate_named``)."""
         if plate is not None:
             self.unread.read_at(_odom(obs, plate.centre))
+            named = None if text_at is None else unread_plate(obs, *text_at, label)
+            if named is not None:
+                self.unread.named(m.entity, named)
         det = Detection(
             label=label,
             box=box,

@@ -1,5 +1,6 @@
-"""The ``geometric`` refiner: goal pixel -> bearing through the camera intrinsics, range
-from depth over the goal's mask (or box).
+"""The ``geometric`` refiner: the target's bearing and range from one point, the
+grounder's 3D point where it gives one, else the goal pixel through the camera
+intrinsics and depth over the goal's mask (or box).
 
 The coarse-only ablation (paper Table 4) is a tree variant, not a refiner:
 ``tree.variant: coarse_only`` leaves grounding and refinement out of the tree.
@@ -20,16 +21,22 @@ if TYPE_CHECKING:  # pragma: no cover
 
 @dataclass(frozen=True)
 class GeometricRefiner:
-    """Bearing from the mask centre's column; range from the grounder's 3D point, else the
-    median depth over the mask (None without depth)."""
+    """Bearing and range of the grounder's 3D point where it gives one: a door placed
+    from its sign may lie beside the box that was read, even out of view, and a bearing
+    from the box with the door's range puts the target on the sign's line of sight at
+    the door's distance, behind the wall. Without a point: the mask centre's column and
+    the median depth over the mask (range None without depth)."""
 
     gives_range = True
     drives_approach = False
 
     def refine(self, obs: Observation, goal: Detection) -> Refinement:
+        if goal.point is not None:
+            x, y = float(goal.point[0]), float(goal.point[1])
+            return Refinement(math.atan2(y, x), math.hypot(x, y))
         u, _ = goal.centre
+        p = target_point(obs, goal)
         bearing = obs.intrinsics.pixel_bearing(u)
-        p = goal.point if goal.point is not None else target_point(obs, goal)
         return Refinement(bearing, None if p is None else float(math.hypot(p[0], p[1])))
 
 
