@@ -12,7 +12,7 @@ from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.seams import MotionStatus, Pose2D
 from pmnav_bt.sim.bumper import contact_bearing, pressed_zone
 from pmnav_bt.sim.clock import SimClock
-from pmnav_bt.sim.robot import SimBase
+from pmnav_bt.sim.robot import COLLISION_HEIGHT, SimBase
 
 
 @pytest.fixture(scope="module")
@@ -45,23 +45,24 @@ def at_the_wall(world):
 def test_the_zone_pressed_is_the_one_towards_the_contact(world, at_the_wall, heading_deg, zone):
     q, radius = at_the_wall
     pose = Pose2D(q.x, q.y, math.radians(heading_deg))
-    bearing = contact_bearing(world, pose, radius)
+    bearing = contact_bearing(world, pose, radius, COLLISION_HEIGHT)
     assert abs(wrap_angle(bearing - math.radians(90.0 - heading_deg))) < math.radians(2)
-    assert pressed_zone(world, pose, radius, 0.2) == zone
+    assert pressed_zone(world, pose, radius, COLLISION_HEIGHT, 0.2) == zone
 
 
 def test_the_bumper_is_pressed_only_driving_into_what_it_touches(world, at_the_wall):
     q, radius = at_the_wall
-    assert pressed_zone(world, q, radius, 0.0) is None  # at rest, or turning on the spot
-    assert pressed_zone(world, q, radius, -0.1) is None  # backing off
+    h = COLLISION_HEIGHT
+    assert pressed_zone(world, q, radius, h, 0.0) is None  # at rest, or turning on the spot
+    assert pressed_zone(world, q, radius, h, -0.1) is None  # backing off
     for deg in (0.0, -10.0):  # turned along the wall, or a little away from it
         along = Pose2D(q.x, q.y, math.radians(deg))
-        assert contact_bearing(world, along, radius) is not None
-        assert pressed_zone(world, along, radius, 0.2) is None
+        assert contact_bearing(world, along, radius, COLLISION_HEIGHT) is not None
+        assert pressed_zone(world, along, radius, COLLISION_HEIGHT, 0.2) is None
     into = Pose2D(q.x, q.y, math.radians(10.0))  # a little into it: the side zone
-    assert pressed_zone(world, into, radius, 0.2) == "bump_left"
+    assert pressed_zone(world, into, radius, COLLISION_HEIGHT, 0.2) == "bump_left"
 
 
 def test_a_body_a_centimetre_clear_touches_nothing(world, at_the_wall):
     q, radius = at_the_wall
-    assert contact_bearing(world, Pose2D(q.x, q.y - 0.01, q.yaw), radius) is None
+    assert contact_bearing(world, Pose2D(q.x, q.y - 0.01, q.yaw), radius, COLLISION_HEIGHT) is None
