@@ -14,11 +14,11 @@ body without one, the rim straight ahead (it was driving forward into it).
 Backing off (``BackOff``): a round body turns in place without touching anything, so it
 first turns to face the contact (within ``FACE_WITHIN``), and then reverses straight away
 from it, ``BACK_OFF_M``: that much clear of it, as far as the contact goes. It reverses
-only where nothing is known behind: the Create 3 itself reverses only over floor it has
-just driven forward over (its backup buffer, ``pmnav_bt.backup_limit``), refusing more
-(the body reports BLOCKED: the back-off ends there), and the local costmap (what depth
-showed before the robot turned, and earlier bumps) must show nothing within the body's
-reach behind (``behind_clear``).
+only as far as nothing is known behind: the Create 3 itself reverses only over floor it
+has just driven forward over (its backup buffer, ``pmnav_bt.backup_limit``), refusing
+more (the body reports BLOCKED: the back-off ends there), and the local costmap (what
+depth showed before the robot turned, and earlier bumps) must show nothing within the
+body's reach behind (``behind_free``).
 
 What a bump tells (``felt_item``): something stands at the contact point, and beyond it,
 away from the body: the bumper feels an item's near face, not its size. It is taken to
@@ -82,26 +82,27 @@ def felt_contact(base, now: float) -> Contact:
 Clearance = Callable[[float, float], float]  # metres from an odometry point to what is known
 
 
-def behind_clear(pose: Pose2D, distance: float, clearance: Clearance | None) -> bool:
-    """Whether the body at ``pose`` (odometry) may reverse ``distance`` m: nothing known
-    (``clearance``: the local costmap's) within its radius on the way."""
+def behind_free(pose: Pose2D, distance: float, clearance: Clearance | None) -> float:
+    """How far (m, at most ``distance``) the body at ``pose`` (odometry) may reverse: the
+    way behind keeps its radius and ``WAY_PAD_M`` from what ``clearance`` (the local
+    costmap) knows."""
     if clearance is None:
-        return True
+        return distance
     steps = max(1, int(math.ceil(distance / BEHIND_PROBE_M)))
     for i in range(1, steps + 1):
-        s = -distance * i / steps
-        x, y = pose.x + s * math.cos(pose.yaw), pose.y + s * math.sin(pose.yaw)
-        if clearance(x, y) < CREATE3_RADIUS_M:
-            return False
-    return True
+        s = distance * i / steps
+        x, y = pose.x - s * math.cos(pose.yaw), pose.y - s * math.sin(pose.yaw)
+        if clearance(x, y) < CREATE3_RADIUS_M + WAY_PAD_M:
+            return distance * (i - 1) / steps
+    return distance
 
 
 class BackOff:
     """Turn to face ``contact`` (odometry), then reverse straight off it ``distance`` m;
-    ``command(pose, blocked, now)`` gives (v, w, done) each tick. Done when covered, when
-    the body refuses to reverse further (``blocked``: its backup buffer is empty, or it
-    touched something behind), when ``clearance`` (the local costmap) shows something
-    behind, or after ``BACK_OFF_TIME_S``."""
+    ``command(pose, blocked, now)`` gives (v, w, done) each tick. Done when covered (as
+    far as ``clearance``, the local costmap, shows the way behind free), when the body
+    refuses to reverse further (``blocked``: its backup buffer is empty, or it touched
+    something behind), or after ``BACK_OFF_TIME_S``."""
 
     def __init__(
         self,
@@ -128,7 +129,8 @@ class BackOff:
             if abs(e) > FACE_WITHIN:
                 return 0.0, max(-1.9, min(1.9, 3.0 * e)), False
             self._from = (pose.x, pose.y)
-            if not behind_clear(pose, self.distance, self.clearance):
+            self.distance = behind_free(pose, self.distance, self.clearance)
+            if self.distance < 0.01:
                 return self._done("something behind")
             return -BACK_OFF_SPEED, 0.0, False
         self.moved = math.dist(self._from, (pose.x, pose.y))
