@@ -9,9 +9,11 @@ import math
 import pytest
 
 from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.hazards import HazardKind
 from pmnav_bt.seams import MotionStatus, Pose2D
 from pmnav_bt.sim.bumper import contact_bearing, pressed_zone
 from pmnav_bt.sim.clock import SimClock
+from pmnav_bt.sim.odometry import NoisyOdometry
 from pmnav_bt.sim.robot import COLLISION_HEIGHT, SimBase
 
 
@@ -66,3 +68,47 @@ def test_the_bumper_is_pressed_only_driving_into_what_it_touches(world, at_the_w
 def test_a_body_a_centimetre_clear_touches_nothing(world, at_the_wall):
     q, radius = at_the_wall
     assert contact_bearing(world, Pose2D(q.x, q.y - 0.01, q.yaw), radius, COLLISION_HEIGHT) is None
+
+
+def test_the_body_feels_what_cut_its_motion_until_it_moves_again(world):
+    """``SimBase`` is a body with a bumper: driven at the wall 36 deg off square, the cut
+    motion is one bump, front right, on its rim (odometry; through drifting odometry in
+    that frame); a new motion lets go of it, and backing off feels nothing."""
+    clock = SimClock()
+    start = Pose2D(47.0, 20.7, math.radians(90.0 + 36.0))
+    body = SimBase(world, clock, pose=start, depth=False, segmentation=False)
+    try:
+        body.set_velocity(0.3, 0.0)
+        for _ in range(100):
+            clock.wait(0.05)
+            if body.motion_status() == MotionStatus.BLOCKED:
+                break
+        (bump,) = body.hazards()
+        assert bump.kind == HazardKind.BUMP and bump.frame == "bump_front_right"
+        q = body.pose()
+        assert math.dist(bump.point, (q.x, q.y)) == pytest.approx(body.radius)
+        assert body.blocked_by() == bump
+        assert body.hazards(since=bump.stamp + 0.01) == []
+        body.set_velocity(0.3, 0.0)  # pushing on: the same bump, not another
+        clock.wait(0.05)
+        assert body.hazards() == [bump]
+        assert (body.blocked_by().frame, body.blocked_by().point) == (bump.frame, bump.point)
+        body.set_velocity(-0.1, 0.0)
+        clock.wait(0.5)
+        assert body.blocked_by() is None and body.hazards() == [bump]
+    finally:
+        body.close()
+    drifting = NoisyOdometry(SimBase(world, SimClock(), pose=start, depth=False,
+                                     segmentation=False), noise=0.05, seed=3)  # fmt: skip
+    try:
+        drifting.set_velocity(0.3, 0.0)
+        for _ in range(100):
+            drifting.clock.wait(0.05)
+            if drifting.motion_status() == MotionStatus.BLOCKED:
+                break
+        (bump,) = drifting.hazards()
+        o = drifting.pose()  # the point is where the drifting frame has the body's rim
+        assert math.dist(bump.point, (o.x, o.y)) == pytest.approx(drifting.inner.radius)
+        assert drifting.blocked_by() == bump
+    finally:
+        drifting.inner.close()
