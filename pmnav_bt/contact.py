@@ -111,10 +111,12 @@ class BackOff:
         now: float,
         distance: float = BACK_OFF_M,
         clearance: Clearance | None = None,
+        timeout_s: float = BACK_OFF_TIME_S,
     ) -> None:
         self.contact = contact
         self.distance = min(distance, CREATE3_BACKUP_LIMIT_M)
         self.clearance = clearance
+        self.timeout_s = timeout_s
         self._t0 = now
         self._from: tuple[float, float] | None = None  # where reversing began
         self._face = heading((start.x, start.y), contact)
@@ -122,7 +124,7 @@ class BackOff:
         self.why = ""
 
     def command(self, pose: Pose2D, blocked: bool, now: float) -> tuple[float, float, bool]:
-        if now - self._t0 > BACK_OFF_TIME_S:
+        if now - self._t0 > self.timeout_s:
             return self._done("out of time")
         if self._from is None:
             e = wrap_angle(self._face - pose.yaw)
