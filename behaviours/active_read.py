@@ -15,9 +15,13 @@ a person walks up to it. So does the tree:
    a reading pose (``perception.reading_pose``): square to it,
    within the range a plate with text that size is read from at the camera's width
    (``read_range.plate_read_range``, the sign benchmark's table), inside the map's
-   corridors and on floor depth showed free. Something standing before the plate is no
-   reason to drive: the tree looks again later (``hidden_sign.SignHidden``, next in the
-   tree), so the leaf fails.
+   corridors and on floor depth showed free: the search views' depth, as a local costmap
+   (``local_planner.costmap``), shows nothing within the body's radius and
+   ``SPOT_PAD_M`` of the spot, nor within its radius and ``WAY_PAD_M`` of the straight
+   way there (clutter by the wall, beside a plate, is where reading poses fall). A
+   pose inside or touching something is not taken; the nearest free one is. Something
+   standing before the plate is no reason to drive: the tree looks again later
+   (``hidden_sign.SignHidden``, next in the tree), so the leaf fails.
 2. ``DriveToReadingPose``: drive there (a ``DriveTo``: it stops for what is in the way,
    goes round it, waits for people).
 3. ``ReadAgain``: face the plate and ground the target in a fresh frame; FAILURE when the
@@ -41,7 +45,9 @@ from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.hidden_sign import BAND_M, HIDDEN_MARGIN_M, MIN_SLANT
 from pmnav_bt.behaviours.motion import DriveTo
 from pmnav_bt.behaviours.search import VERIFY_TOLERANCE, FaceAndGround, target_entity
+from pmnav_bt.contact import way_clear
 from pmnav_bt.geometry import heading, se2_apply, wrap_angle
+from pmnav_bt.local_planner.costmap import LocalCostmap
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.perception.read_range import plate_read_range
 from pmnav_bt.perception.reading_pose import ReadingPose, reading_pose, view_standoff
@@ -54,6 +60,9 @@ from pmnav_bt.seams import CAMERA_HEIGHT_M, CREATE3_RADIUS_M, Entity, Observatio
 SIGN_REACH_M = 1.5
 # A reading pose lies this far inside the map's corridors: the body and a margin.
 WALL_MARGIN_M = CREATE3_RADIUS_M + 0.15
+# A reading pose keeps the body's radius and this from what depth showed standing: the
+# robot turns there to face the plate, on a pose estimate good to a few centimetres.
+SPOT_PAD_M = 0.1
 VIEW_MARGIN = math.radians(5.0)  # a spot this near the view's border is not judged by it
 
 
@@ -181,6 +190,9 @@ class _Planner:
         self.ctx, self.tf, self.reach, self.robot = ctx, tf, reach, robot
         self.sign = np.asarray(entity_position(ctx.pm, entity), float)
         self.frames = {v.observation.stamp: v.observation for v in views}
+        self.seen = LocalCostmap()  # what the views' depth showed standing round here
+        for v in views:
+            self.seen.add_depth(v.observation, v.observation.stamp)
 
     def __call__(
         self, plates: list[UnreadPlate], read: UnreadPlate | None = None
@@ -217,9 +229,18 @@ class _Planner:
         vfov = 2.0 * math.atan(k.height / 2.0 / k.fy) if k is not None else math.radians(45.0)
         height = obs.camera_height if obs is not None else CAMERA_HEIGHT_M
 
+        grid = self.seen.snapshot()
+
+        def clearance(x: float, y: float) -> float:
+            return float(grid.clearance(np.array([x]), np.array([y]))[0])
+
         def free(spot: tuple[float, float]) -> bool:
             m = se2_apply(self.tf, spot)
             if clear is not None and not clear((float(m[0]), float(m[1])), WALL_MARGIN_M):
+                return False
+            if clearance(*spot) < CREATE3_RADIUS_M + SPOT_PAD_M:
+                return False  # inside or touching what depth showed standing there
+            if not way_clear(self.robot, spot, clearance):
                 return False
             return obs is None or floor_free(obs, spot)
 

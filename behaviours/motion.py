@@ -7,7 +7,10 @@ sees something in its way stops and holds (``pmnav_bt/way_ahead.py``): it goes o
 the way clears, drives round what stood still with open floor beside it (a pillar, a
 trolley on the centre line; ``detour``), waits for what moves (a person) up to a
 patience and passes it where there is room, and gives up only on what keeps the way
-shut, saying where in the building's words (``pmnav_bt/map/wording.py``).
+shut, saying where in the building's words (``pmnav_bt/map/wording.py``). A drive that
+touches something (what the camera, 1.6 m up, no longer sees near the body) stops
+pushing, marks it, backs off away from it and goes round it (``pmnav_bt/contact.py``);
+each touch counts once, however long the body reports BLOCKED.
 """
 
 from __future__ import annotations
@@ -21,21 +24,30 @@ from py_trees.common import Status
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose
 from pmnav_bt.behaviours.pose import axis_correction, keep_on_axis, measure_walls
+from pmnav_bt.contact import BackOff, Contact, felt_contact, round_contact
 from pmnav_bt.failures import FailureCode
-from pmnav_bt.geometry import Action, heading, point_towards, wrap_angle
-from pmnav_bt.hazards import body_hazards
+from pmnav_bt.geometry import (
+    Action,
+    heading,
+    point_towards,
+    se2_apply,
+    se2_inverse,
+    wrap_angle,
+)
+from pmnav_bt.hazards import Hazard, HazardKind, body_hazards
 from pmnav_bt.map.wording import shut_way_words
 from pmnav_bt.perception.corner import band_reach, is_corner, is_open_way, mask_ratios
 from pmnav_bt.perception.geometry import free_distance
 from pmnav_bt.perception.movers import moved
 from pmnav_bt.pose.visibility import Visibility
-from pmnav_bt.seams import MotionStatus
+from pmnav_bt.seams import CREATE3_RADIUS_M, MotionStatus
 from pmnav_bt.tree_variants import DetourCheck
 from pmnav_bt.way_ahead import Hold, Verdict, WayShut, judge
 
 NO_PROGRESS_S = 10.0  # clock seconds without getting 0.1 m closer -> blocked
 WATCH_PERIOD_S = 1.0  # clock seconds between obstacle checks from depth
-MAX_BUMPS = 3  # collisions before a drive gives up as blocked
+MAX_CONTACTS = 3  # touches (events, each backed off from) before a drive gives up
+ROUND_WALL_MARGIN_M = CREATE3_RADIUS_M + 0.1  # a step aside keeps this off the map's walls
 # A waypoint with a wall just past it is reached when depth shows that wall within half a
 # corridor width and this margin, the estimate at most this far from the waypoint.
 WALL_ARRIVAL_MARGIN_M = 0.4
@@ -72,9 +84,11 @@ class DriveTo(PmNavBehaviour):
     the corridor true (``keep_on_axis``). Something in the way closer than the goal
     stops the drive and holds it (``way_ahead.judge``: go on, go round, wait, give up).
     Reads ``map_T_odom``, ``target``; writes ``map_T_odom``, ``pose_tracker``,
-    ``way_shut`` (a ``WayShut`` when it gave up on a shut way, else None). FAILURE:
-    BLOCKED on repeated collisions, no progress, or a way that stayed shut for the
-    patience; DOOR_CLOSED when what shut it stands where the map has a fire door.
+    ``way_shut`` (a ``WayShut`` when it gave up on a shut way, else None). A touch
+    (the base reports BLOCKED) is one contact: the drive stops, marks it, backs off from
+    it and goes round it. FAILURE: BLOCKED on the ``MAX_CONTACTS``-th contact, no
+    progress, or a way that stayed shut for the patience; DOOR_CLOSED when what shut it
+    stands where the map has a fire door.
     """
 
     READS = ("map_T_odom", "target", "plan", "pose_tracker")
@@ -100,7 +114,8 @@ class DriveTo(PmNavBehaviour):
     def initialise(self) -> None:
         self._goal = self.goal()
         self._progress_afresh()
-        self._bumps = 0
+        self._contacts = 0
+        self._backing: tuple[BackOff, Contact] | None = None  # backing off a contact
         self._watch_job = None
         self._watch_t = -math.inf
         self._felt_t = -math.inf  # hazards the body felt since then go to the steering
@@ -114,7 +129,7 @@ class DriveTo(PmNavBehaviour):
         """Drive to ``goal`` from here on, progress watched afresh (a route's next leg)."""
         self._goal = goal
         self._progress_afresh()
-        self._bumps = 0
+        self._contacts = 0
 
     def _progress_afresh(self) -> None:
         """Watch the progress towards a new aim from now on (``NO_PROGRESS_S``)."""
@@ -132,11 +147,10 @@ class DriveTo(PmNavBehaviour):
         st = base.motion_status()
         if st == MotionStatus.FAULT:
             return self.fail(FailureCode.BASE_FAULT, "the base reports a fault")
+        if self._backing is not None:
+            return self._back_off(now, st == MotionStatus.BLOCKED)
         if st == MotionStatus.BLOCKED:
-            self._bumps += 1
-            if self._bumps >= MAX_BUMPS:
-                base.stop()
-                return self.fail(FailureCode.BLOCKED, f"{self._bumps} collisions on the way")
+            return self._touched(now)
         watched = self._poll_watch(now)
         if watched is not None:
             base.stop()
@@ -165,6 +179,55 @@ class DriveTo(PmNavBehaviour):
         self.feedback_message = f"{dist:.1f} m to go" + (
             " round an obstacle" if self._detour else ""
         )
+        return Status.RUNNING
+
+    def _touched(self, now: float) -> Status:
+        """The body touched something: one contact. Stop, mark it for the steering, and
+        back off from it (FAILURE, BLOCKED, on the ``MAX_CONTACTS``-th)."""
+        base, steer = self.ctx.base, self.ctx.steering
+        base.stop()
+        contact = felt_contact(base, now)
+        self._contacts += 1
+        self.ctx.log("contact", "", x=contact.point[0], y=contact.point[1], n=self._contacts)
+        if self._contacts >= MAX_CONTACTS:
+            return self.fail(FailureCode.BLOCKED, f"{self._contacts} collisions on the way")
+        pose = base.pose()
+        steer.feel([Hazard(HazardKind.BUMP, "", contact.point, now)], pose, now)  # the item
+        self._backing = (BackOff(contact.point, pose, now, clearance=steer.clearance), contact)
+        self._hold = None
+        self.feedback_message = f"backing off: {contact.words}"
+        return Status.RUNNING
+
+    def _back_off(self, now: float, blocked: bool) -> Status:
+        """Back off the contact; then go round it (``round_contact``: inside what the
+        variant knows of the walls, its way clear of what the steering's costmap holds),
+        or on as before where there is no way round (the next touch counts)."""
+        base, steer = self.ctx.base, self.ctx.steering
+        backing, contact = self._backing
+        v, w, done = backing.command(base.pose(), blocked, now)
+        if not done:
+            base.set_velocity(v, w)
+            return Status.RUNNING
+        base.stop()
+        self._backing = None
+        odom = base.pose()
+        tf = self.get("map_T_odom") or (0.0, 0.0, 0.0)
+        goal = tuple(se2_apply(se2_inverse(tf), self._goal))
+        walls = self.ctx.detour_check
+
+        def inside(p: tuple[float, float]) -> bool:
+            m = se2_apply(tf, p)
+            return walls is None or walls((float(m[0]), float(m[1])), ROUND_WALL_MARGIN_M)
+
+        point = round_contact(odom, contact.point, goal, steer.clearance, inside)
+        self.ctx.log(
+            "backed_off", "", moved=backing.moved, why=backing.why,
+            round=None if point is None else list(point),
+        )  # fmt: skip
+        if point is not None:
+            m = se2_apply(tf, point)
+            self._detour = (float(m[0]), float(m[1]))
+        self._progress_afresh()
         return Status.RUNNING
 
     def _poll_watch(self, now: float) -> Status | None:

@@ -6,7 +6,7 @@ import math
 
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.motion import MAX_BUMPS, Approach, DriveTo
+from pmnav_bt.behaviours.motion import MAX_CONTACTS, Approach, DriveTo
 from pmnav_bt.behaviours.search import target_entity
 from pmnav_bt.eval.task import SUCCESS_RADIUS_M
 from pmnav_bt.failures import FailureCode
@@ -87,7 +87,7 @@ class PolicyApproach(Approach):
             if st == MotionStatus.BLOCKED:
                 base.stop()  # acknowledged: IDLE again
                 self._policy_bumps += 1
-                if self._policy_bumps >= MAX_BUMPS:
+                if self._policy_bumps >= MAX_CONTACTS:
                     return self._blocked()
             if self._steps >= self.ctx.refiner.max_steps:
                 self._closed_loop = False

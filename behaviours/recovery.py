@@ -16,12 +16,13 @@ from py_trees.common import Status
 
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, map_pose
+from pmnav_bt.contact import BackOff
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.hazards import body_blocked_by
 from pmnav_bt.seams import CREATE3_BACKUP_LIMIT_M, MotionStatus
 
 BACKUP_LIMIT_M = CREATE3_BACKUP_LIMIT_M  # the most a recovery reverses
-BACKUP_SPEED = 0.1  # m/s
 BACKUP_TIME_S = 8.0  # clock seconds before a backup that does not move gives up (default)
 
 
@@ -44,9 +45,12 @@ class FailureIs(PmNavBehaviour):
 
 
 class BackUp(PmNavBehaviour):
-    """Reverse ``distance`` metres (at most BACKUP_LIMIT_M) straight back, off a wall or
-    an obstacle. SUCCESS when covered, or when the body cannot reverse further: it refuses
-    (BLOCKED) or has not covered it after ``timeout_s`` clock seconds (best effort).
+    """Reverse ``distance`` metres (at most BACKUP_LIMIT_M) off a wall or an obstacle:
+    away from the bump the body felt when one stopped it (turned to face it first,
+    ``contact.BackOff``), else straight back; never into what the steering's costmap
+    holds behind. SUCCESS when covered, or when the body cannot reverse further: it
+    refuses (BLOCKED) or has not covered it after ``timeout_s`` clock seconds (best
+    effort).
     """
 
     STOPS_BASE = True
@@ -63,26 +67,26 @@ class BackUp(PmNavBehaviour):
         self.timeout_s = timeout_s
 
     def initialise(self) -> None:
-        p = self.ctx.base.pose()
-        self._start = (p.x, p.y)
-        self._t0 = self.ctx.now()
+        base, now = self.ctx.base, self.ctx.now()
+        p = base.pose()
+        bump = body_blocked_by(base)
+        ahead = (p.x + math.cos(p.yaw), p.y + math.sin(p.yaw))  # none felt: straight back
+        self._backing = BackOff(
+            ahead if bump is None else bump.point, p, now, self.distance,
+            self.ctx.steering.clearance, self.timeout_s,
+        )  # fmt: skip
         self._sent = False  # BLOCKED before the first command is the failure that led here
 
     def update(self) -> Status:
         base = self.ctx.base
-        p = base.pose()
-        moved = math.hypot(p.x - self._start[0], p.y - self._start[1])
-        if moved >= self.distance - 0.01:
-            base.set_velocity(0.0, 0.0)
-            self.feedback_message = f"backed up {moved:.2f} m"
-            return Status.SUCCESS
-        if (
-            self._sent and base.motion_status() == MotionStatus.BLOCKED
-        ) or self.ctx.now() - self._t0 > self.timeout_s:
+        blocked = self._sent and base.motion_status() == MotionStatus.BLOCKED
+        v, w, done = self._backing.command(base.pose(), blocked, self.ctx.now())
+        if done:
             base.stop()
-            self.feedback_message = f"backed up {moved:.2f} m (could not reverse further)"
+            moved, why = self._backing.moved, self._backing.why
+            self.feedback_message = f"backed up {moved:.2f} m" + (f" ({why})" if why else "")
             return Status.SUCCESS
-        base.set_velocity(-BACKUP_SPEED, 0.0)
+        base.set_velocity(v, w)
         self._sent = True
         return Status.RUNNING
 

@@ -271,13 +271,14 @@ class SimCreate3:
         from pmnav_bt.hardware.hazards import BACKUP_LIMIT_CODE, TYPE_CODES, vector_message
         from pmnav_bt.hazards import HazardKind
         from pmnav_bt.sim.bumper import pressed_zone
+        from pmnav_bt.sim.robot import COLLISION_HEIGHT
 
         with self._lock:
             self._physics_locked()
             now = self.clock.now()
             true = self.inner.pose()
             driving = self._wanted[0] if self._commanded() else 0.0
-            zone = pressed_zone(self.world, true, self.inner.radius, driving)
+            zone = pressed_zone(self.world, true, self.inner.radius, COLLISION_HEIGHT, driving)
             stalled = self._stalled(true, now)
             refused = not self.backup.allows(self._wanted[0])
         found = []

@@ -19,7 +19,6 @@ import math
 from pmnav_bt.geometry import wrap_angle
 from pmnav_bt.hazards import bump_zone
 from pmnav_bt.seams import Pose2D
-from pmnav_bt.sim.robot import COLLISION_HEIGHT
 from pmnav_bt.sim.world import SimWorld
 
 TOUCH_M = 0.002  # clearer than this is not touching (a stopped body rests 0.1 mm off)
@@ -29,11 +28,12 @@ PROBE_M = 0.01  # the gradient's step, well inside what the clearance resolves
 PRESS_WITHIN = math.radians(85.0)
 
 
-def contact_bearing(world: SimWorld, pose: Pose2D, radius: float) -> float | None:
+def contact_bearing(world: SimWorld, pose: Pose2D, radius: float, height: float) -> float | None:
     """The bearing (rad, counter-clockwise from the heading) of what the body's cylinder
-    at ``pose`` touches, or None when it touches nothing."""
+    (``radius``, ``height``: the body with its mast) at ``pose`` touches, or None when it
+    touches nothing."""
     def clear(dx: float, dy: float) -> float:
-        return world.clearance(pose.x + dx, pose.y + dy, radius, COLLISION_HEIGHT)
+        return world.clearance(pose.x + dx, pose.y + dy, radius, height)
 
     if clear(0.0, 0.0) > TOUCH_M:
         return None
@@ -44,12 +44,14 @@ def contact_bearing(world: SimWorld, pose: Pose2D, radius: float) -> float | Non
     return wrap_angle(math.atan2(-gy, -gx) - pose.yaw)
 
 
-def pressed_zone(world: SimWorld, pose: Pose2D, radius: float, linear: float) -> str | None:
+def pressed_zone(
+    world: SimWorld, pose: Pose2D, radius: float, height: float, linear: float
+) -> str | None:
     """The bumper zone (its frame, "bump_front_left") pressed by driving at ``linear`` m/s
-    at ``pose``, or None."""
+    at ``pose`` (the body's ``radius`` and ``height``), or None."""
     if linear <= 0.0:
         return None
-    bearing = contact_bearing(world, pose, radius)
+    bearing = contact_bearing(world, pose, radius, height)
     if bearing is None or abs(bearing) > PRESS_WITHIN:
         return None
     return bump_zone(bearing)

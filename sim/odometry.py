@@ -4,7 +4,8 @@ Real odometry drifts; a tree that never corrects itself with landmarks would loo
 fine on perfect odometry and fail on a robot. ``NoisyOdometry`` wraps a SimBase and
 reports an odometry pose integrated from the true motion with a seeded relative
 error on every increment (scale on distance, and heading error growing with distance
-and rotation). It is itself a ``Base``; ``true_pose()`` gives the ground truth.
+and rotation). It is itself a ``Base``; ``true_pose()`` gives the ground truth. What the
+body's bumper felt is reported in the drifting frame (``hazards``), as the robot's is.
 """
 
 from __future__ import annotations
@@ -14,7 +15,8 @@ import random
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
+from pmnav_bt.hazards import Hazard
 from pmnav_bt.seams import Base, Observation, Pose2D
 from pmnav_bt.sim.robot import SimBase
 from pmnav_bt.wrapped_base import WrappedBase
@@ -94,6 +96,20 @@ class NoisyOdometry(WrappedBase):
 
     def true_pose(self) -> Pose2D:
         return self.inner.pose()
+
+    def hazards(self, since: float = -math.inf) -> list[Hazard]:
+        """What the body felt since ``since``, in this odometry frame (mapped with the
+        drift of now: the body stops at what it bumps, so it is read where it was felt)."""
+        return [h.moved(self._odom_T_true()) for h in self.inner.hazards(since)]
+
+    def blocked_by(self) -> Hazard | None:
+        """The bump that cut the body's latest motion, in this odometry frame."""
+        hazard = self.inner.blocked_by()
+        return None if hazard is None else hazard.moved(self._odom_T_true())
+
+    def _odom_T_true(self) -> tuple[float, float, float]:
+        o, t = self.pose(), self.inner.pose()
+        return se2_compose((o.x, o.y, o.yaw), se2_inverse((t.x, t.y, t.yaw)))
 
     def observe(self) -> Observation:
         obs = self.inner.observe()

@@ -9,18 +9,26 @@ touches something; it ends when the body is 1 cm clear again. Turning in place n
 collides (the body is a round cylinder). Like the Create 3 (``safety_override: none``)
 it reverses only within its backup buffer (``pmnav_bt.backup_limit``): at most 0.15 m
 over floor it has just driven forward over; a reverse beyond it stops as BLOCKED.
+
+It has the Create 3's bumper (``pmnav_bt.hazards.FeelsHazards``): a motion cut at a
+contact in front of the wheels is felt as a bump in the zone that touched
+(``sim/bumper.py``), a point in its odometry frame; it is what stopped that motion
+(``blocked_by``) until the next motion is accepted. A contact behind the wheels (backing
+into something) presses no bumper, as on the robot.
 """
 
 from __future__ import annotations
 
 import math
 import threading
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
 
 from pmnav_bt.backup_limit import BACKUP_LIMIT_M, BackupBuffer
 from pmnav_bt.geometry import wrap_angle
+from pmnav_bt.hazards import Hazard, HazardKind, bump_zone, place
 from pmnav_bt.seams import (
     CAMERA_HEIGHT_M,
     CREATE3_MAX_ANGULAR,
@@ -35,6 +43,7 @@ from pmnav_bt.seams import (
     Pose2D,
 )
 from pmnav_bt.sim._pybullet import p
+from pmnav_bt.sim.bumper import contact_bearing
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.render import render_camera
 from pmnav_bt.sim.scene.camera_effects import CameraEffects
@@ -47,6 +56,7 @@ COLLISION_HEIGHT = 1.7  # the body with its camera mast, for collisions
 CAMERA_HEIGHT = CAMERA_HEIGHT_M  # m (paper)
 HFOV = math.radians(60.0)  # horizontal field of view (paper)
 CONTACT_CLEAR = 0.01  # a collision event ends once the body is this far from everything
+FELT_KEPT = 64  # bumps kept for ``hazards`` (the costmap takes them within a second)
 _BISECT_TOL = 1e-4
 
 
@@ -177,6 +187,8 @@ class SimBase:
         self._remaining = 0.0
         self._cmd = (0.0, 0.0)
         self._in_contact = False
+        self._felt: deque[Hazard] = deque(maxlen=FELT_KEPT)  # bumps, oldest first
+        self._blocked_by: Hazard | None = None  # the bump that cut the latest motion
         with world.lock:
             vis = p.createVisualShape(
                 p.GEOM_CYLINDER,
@@ -214,6 +226,7 @@ class SimBase:
             self._step = action
             self._remaining = FORWARD_STEP_M if action == DiscreteAction.FORWARD else TURN_STEP_RAD
             self._status = MotionStatus.MOVING
+            self._blocked_by = None
 
     def set_velocity(self, linear: float, angular: float) -> None:
         """Command a body velocity, clipped to the limits; it holds until changed or blocked."""
@@ -224,9 +237,12 @@ class SimBase:
             if v < 0.0 and self.backup is not None and self.backup.left <= 0.0:
                 self._cmd = (0.0, 0.0)  # refused, as the robot refuses it (BACKUP_LIMIT)
                 self._status = MotionStatus.BLOCKED
+                self._blocked_by = None
                 return
             self._cmd = (v, w)
             self._status = MotionStatus.MOVING if (v or w) else MotionStatus.IDLE
+            if v or w:
+                self._blocked_by = None
 
     def motion_status(self) -> MotionStatus:
         return self._status
@@ -236,6 +252,17 @@ class SimBase:
             self._step = None
             self._cmd = (0.0, 0.0)
             self._status = MotionStatus.IDLE
+
+    # -- the bumper (pmnav_bt.hazards.FeelsHazards) ----------------------------------------
+
+    def hazards(self, since: float = -math.inf) -> list[Hazard]:
+        """The bumps felt from ``since`` (the clock's seconds) on, oldest first."""
+        with self.world.lock:
+            return [h for h in self._felt if h.stamp >= since]
+
+    def blocked_by(self) -> Hazard | None:
+        """The bump that cut the latest motion (None: none, or a motion accepted since)."""
+        return self._blocked_by
 
     # -- helpers for runners, tests and the oracle ------------------------------------------
 
@@ -431,7 +458,23 @@ class SimBase:
             self.stats.path_length += abs(moved)
             if frac == 1.0 and d_new > CONTACT_CLEAR:
                 self._in_contact = False
+        if frac < 1.0:
+            self._bump()
         return moved
+
+    def _bump(self) -> None:
+        """Feel the contact that cut the motion with the bumper, where it has one."""
+        pose = self._pose
+        bearing = contact_bearing(self.world, pose, self.radius, COLLISION_HEIGHT)
+        zone = None if bearing is None else bump_zone(bearing)
+        if zone is None:  # behind the wheels: no bumper there
+            self._blocked_by = None
+            return
+        hazard = place(HazardKind.BUMP, zone, pose, self.clock.now())
+        last = self._felt[-1] if self._felt else None
+        if last is None or (last.frame, last.point) != (hazard.frame, hazard.point):
+            self._felt.append(hazard)
+        self._blocked_by = hazard
 
     def _sync_body(self) -> None:
         q = self._pose

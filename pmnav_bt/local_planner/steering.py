@@ -9,11 +9,18 @@ A drive (``behaviours/motion.py`` ``DriveTo``) asks its ``Steering`` three thing
 - ``way_shut(...)``, in the worker, after that: is the way shut, so that the drive must
   stop and hold (``way_ahead``: wait for a person, give up on a shut way)? The free
   distance ahead when it is, else None;
-- ``command(...)``, in the tick: the velocity command (v, w, done) for this period.
+- ``command(...)``, in the tick: the velocity command (v, w, done) for this period;
+- ``clearance(x, y)``: how far an odometry point is from what the steering knows stands
+  on the floor (its local costmap: depth, and what the body felt, ``feel``): where a
+  drive that touched something may back off to and go round it (``pmnav_bt/contact.py``).
+
+Both keep a local costmap (``costmap.LocalCostmap``) of what depth showed and the bumper
+felt; ``direct`` steers without it and reads it only for ``clearance``.
 
 ``direct`` (``DirectSteering``): what the drive always did: steer straight at the goal
 (``control.goto_command``); anything closer than the goal on that line holds the drive
-(and the hold goes round clutter by a detour point, ``motion.detour``).
+(and the hold goes round clutter by a detour point, ``motion.detour``). Its costmap
+remembers what the camera saw and the bumper felt, for backing off and going round.
 
 ``dwa`` (``LocalPlannerSteering``): a rolling local costmap from depth
 (``costmap.LocalCostmap``) and the dynamic window approach (``dwa.choose``) within the
@@ -35,6 +42,7 @@ from typing import Protocol
 
 import numpy as np
 
+from pmnav_bt.contact import felt_item
 from pmnav_bt.control import Limits, goto_command
 from pmnav_bt.geometry import se2_apply, se2_inverse
 from pmnav_bt.hazards import Hazard, HazardKind
@@ -51,7 +59,6 @@ STILL_M = 0.02  # frames this near each other were taken standing still
 SHUT_PROBE_M = 3.0  # how far along the way a shut way's distance is looked for
 
 Transform = tuple[float, float, float] | None  # map_T_odom (None: identity)
-MARKED_HAZARDS = frozenset({HazardKind.BUMP, HazardKind.CLIFF})  # felt where the thing is
 
 
 class Steering(Protocol):
@@ -73,15 +80,38 @@ class Steering(Protocol):
         limits: Limits, now: float,
     ) -> tuple[float, float, bool]: ...  # fmt: skip
 
+    def clearance(self, x: float, y: float) -> float: ...
 
-class DirectSteering:
-    """Straight at the goal; whatever stands closer than the goal holds the drive."""
+
+class _Remembers:
+    """A local costmap of what depth showed and the body felt (both steerings keep one)."""
+
+    def __init__(self, costmap: LocalCostmap | None = None) -> None:
+        self.costmap = costmap if costmap is not None else LocalCostmap()
 
     def sense(self, obs: Observation, now: float) -> None:
-        return None
+        self.costmap.add_depth(obs, now)
 
     def feel(self, hazards: Sequence[Hazard], pose: Pose2D, now: float) -> None:
-        return None  # the body stops at a bump itself; nothing to remember
+        """Mark the item the bumper touched (``contact.felt_item``: a disc of clutter
+        behind the contact) and where a cliff sensor found the floor's end (a wheel stall
+        is felt at the wheels, not where the obstacle is), the window round the robot's
+        odometry ``pose`` (a body may feel with no depth frame)."""
+        points = [h.point for h in hazards if h.kind == HazardKind.CLIFF]
+        for h in hazards:
+            if h.kind == HazardKind.BUMP:
+                points += felt_item(pose, h.point)
+        if points:
+            self.costmap.recentre(pose.x, pose.y)
+            self.costmap.mark(points, now)
+
+    def clearance(self, x: float, y: float) -> float:
+        """Metres from odometry (x, y) to the nearest marked cell (inf: none known)."""
+        return float(self.costmap.snapshot().clearance(np.array([x]), np.array([y]))[0])
+
+
+class DirectSteering(_Remembers):
+    """Straight at the goal; whatever stands closer than the goal holds the drive."""
 
     def movers(self, before: Observation, after: Observation) -> bool:
         return True  # the drive stops at the first frame that shows something in the way
@@ -93,30 +123,18 @@ class DirectSteering:
         return goto_command(est, *aim, limits)
 
 
-class LocalPlannerSteering:
+class LocalPlannerSteering(_Remembers):
     """A local costmap and the DWA (see the module's docstring). ``costmap``: the one to
     mark (None: a fresh 10 m window); the hazards of a robot may ``mark`` it too."""
 
     def __init__(self, costmap: LocalCostmap | None = None) -> None:
-        self.costmap = costmap if costmap is not None else LocalCostmap()
+        super().__init__(costmap)
         # The navigation function for an aim (odometry) and the cells passable, made in the
         # worker with each frame, read in the tick.
         self._nav: tuple = ((math.nan, math.nan), None, None)
         self._last = (0.0, 0.0, -math.inf)  # the command in force and when it was sent
         self._line: tuple[tuple[float, float], tuple[float, float]] | None = None
         self._lock = threading.Lock()
-
-    def sense(self, obs: Observation, now: float) -> None:
-        self.costmap.add_depth(obs, now)
-
-    def feel(self, hazards: Sequence[Hazard], pose: Pose2D, now: float) -> None:
-        """Mark where the bumper touched something or a cliff sensor found the floor's
-        end (a wheel stall is felt at the wheels, not where the obstacle is), the window
-        round the robot's odometry ``pose`` (a body may feel with no depth frame)."""
-        points = [h.point for h in hazards if h.kind in MARKED_HAZARDS]
-        if points:
-            self.costmap.recentre(pose.x, pose.y)
-            self.costmap.mark(points, now)
 
     def movers(self, before: Observation, after: Observation) -> bool:
         """Only between frames from where the robot stood still (held, or stopped with no

@@ -15,6 +15,7 @@ from pmnav_bt.behaviours.decorators import ClockTimeout
 from pmnav_bt.behaviours.planning import MakePlan, NoteFailure
 from pmnav_bt.behaviours.recovery import BACKUP_LIMIT_M, BackUp
 from pmnav_bt.failures import Failure, FailureCode, root_cause
+from pmnav_bt.hazards import HazardKind, place
 from pmnav_bt.seams import Pose2D
 from pmnav_bt.trees.recovery import WAIT_S, recovery_subtree
 
@@ -121,3 +122,18 @@ def test_the_root_cause_is_kept_through_recoveries_until_a_new_plan(make_rig):
     assert rig.get("recovering_from") is None
     rig.ticks(timeout(), [RUNNING] * 11 + [FAILURE])
     assert rig.failure.code == FailureCode.TIMEOUT and rig.failure.cause is None
+
+
+def test_blocked_by_a_bump_at_the_side_backs_off_away_from_it(make_rig):
+    """The body felt a bump on its left (bump_left, 72 deg off ahead): the back-off turns
+    to face it and reverses straight off it, not back along its heading."""
+    rig = make_rig(ASKEW)
+    bump = place(HazardKind.BUMP, "bump_left", rig.true_pose(), rig.ctx.now())
+    rig.body.hazards = lambda since=-math.inf: [bump]
+    rig.body.blocked_by = lambda: bump
+    rig.expect(rig.run(BackUp("BackUp", rig.ctx), max_ticks=300), SUCCESS)
+    p = rig.true_pose()
+    assert math.dist((p.x, p.y), bump.point) == pytest.approx(
+        math.dist((ASKEW.x, ASKEW.y), bump.point) + BACKUP_LIMIT_M, abs=0.015
+    )
+    assert rig.stopped()
