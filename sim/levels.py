@@ -16,10 +16,12 @@ estimate on arrival and localizes again on the new level's map.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import replace
 
 from pmnav_bt.geometry import se2_compose, se2_inverse
+from pmnav_bt.hazards import Hazard
 from pmnav_bt.seams import DiscreteAction, MotionStatus, Observation, Pose2D
 from pmnav_bt.sim.clock import SimClock
 from pmnav_bt.sim.robot import MotionStats, SimBase
@@ -114,6 +116,18 @@ class LevelBody:
     @property
     def velocity_command(self) -> tuple[float, float]:
         return self.body.velocity_command
+
+    # -- the bumper (pmnav_bt.hazards.FeelsHazards) --------------------------------------------
+
+    def hazards(self, since: float = -math.inf) -> list[Hazard]:
+        """What the body felt on the level it is on since ``since``, in the odometry frame
+        (what it felt on another floor is no obstacle here)."""
+        return [h.moved(self._odom_T_world) for h in self.body.hazards(since)]
+
+    def blocked_by(self) -> Hazard | None:
+        """The bump that cut the body's latest motion, in the odometry frame."""
+        hazard = self.body.blocked_by()
+        return None if hazard is None else hazard.moved(self._odom_T_world)
 
     def close(self) -> None:
         """Detach every level's body from the clock (the worlds are closed by their owner)."""

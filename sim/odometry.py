@@ -16,7 +16,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from pmnav_bt.geometry import se2_compose, se2_inverse, wrap_angle
-from pmnav_bt.hazards import Hazard
+from pmnav_bt.hazards import Hazard, body_blocked_by, body_hazards
 from pmnav_bt.seams import Base, Observation, Pose2D
 from pmnav_bt.sim.robot import SimBase
 from pmnav_bt.wrapped_base import WrappedBase
@@ -100,11 +100,11 @@ class NoisyOdometry(WrappedBase):
     def hazards(self, since: float = -math.inf) -> list[Hazard]:
         """What the body felt since ``since``, in this odometry frame (mapped with the
         drift of now: the body stops at what it bumps, so it is read where it was felt)."""
-        return [h.moved(self._odom_T_true()) for h in self.inner.hazards(since)]
+        return [h.moved(self._odom_T_true()) for h in body_hazards(self.inner, since)]
 
     def blocked_by(self) -> Hazard | None:
         """The bump that cut the body's latest motion, in this odometry frame."""
-        hazard = self.inner.blocked_by()
+        hazard = body_blocked_by(self.inner)
         return None if hazard is None else hazard.moved(self._odom_T_true())
 
     def _odom_T_true(self) -> tuple[float, float, float]:

@@ -23,7 +23,7 @@ from pmnav_bt.config import load_config
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.lift_doorway import DOORWAY_WALL_M, doorway
 from pmnav_bt.map.priori_map import parse_building
-from pmnav_bt.seams import LiftDoor, Pose2D
+from pmnav_bt.seams import LiftDoor, MotionStatus, Pose2D
 from pmnav_bt.sim.levels import LevelBody
 from pmnav_bt.sim.lift import SimLift
 from pmnav_bt.sim.scene.appearance import WALL_THICKNESS
@@ -190,3 +190,32 @@ def test_one_ride_takes_the_robot_in_on_one_level_and_out_on_the_next(worlds, le
         for w in worlds.values():
             w.cabins["elevator1"].set_door(False)
             w.cabins["elevator1"].empty()
+
+
+def test_the_bumper_rides_along_and_reports_in_the_odometry_frame(worlds):
+    """After a ride (the odometry frame no longer the new level's map frame), a body driven
+    into the corridor's wall feels one bump on its rim in the odometry frame, through the
+    drifting odometry the evaluations wrap it in too."""
+    from pmnav_bt.hazards import HazardKind
+    from pmnav_bt.sim.odometry import NoisyOdometry
+
+    body = LevelBody(worlds, "L3", Pose2D(6.0, 0.2, math.pi / 2), width=160, height=120)
+    drifting = NoisyOdometry(body, noise=0.05, seed=3)
+    try:
+        body.carry("L4", Pose2D(9.0, 0.2, math.pi / 2))  # 3 m on: odometry stays at x = 6
+        drifting.set_velocity(0.3, 0.0)
+        for _ in range(200):
+            body.clock.wait(0.05)
+            if drifting.motion_status() == MotionStatus.BLOCKED:
+                break
+        (bump,) = body.hazards()
+        assert bump.kind == HazardKind.BUMP
+        o = body.pose()
+        assert o.x == pytest.approx(6.0, abs=0.05)
+        assert math.dist(bump.point, (o.x, o.y)) == pytest.approx(body.body.radius)
+        assert body.blocked_by() == bump
+        (felt,) = drifting.hazards()
+        d = drifting.pose()
+        assert math.dist(felt.point, (d.x, d.y)) == pytest.approx(body.body.radius)
+    finally:
+        body.close()
