@@ -50,13 +50,9 @@ from pmnav_bt.map.signage import PlateStyle
 from pmnav_bt.perception.pictograms import CLASSES, plate_patch
 from pmnav_bt.perception.signs import MIN_LINE_PX, SignReader
 from pmnav_bt.seams import CameraIntrinsics
-from pmnav_bt.sim.render import render_camera
-from pmnav_bt.sim.robot import CAMERA_HEIGHT, HFOV, RADIUS
 from pmnav_bt.sim.scene import scene_rng
 from pmnav_bt.sim.scene.camera_effects import CameraEffects
 from pmnav_bt.sim.scene.signage import COLOUR_SCHEMES, resolve_signage
-from pmnav_bt.sim.sign_views import view_pose
-from pmnav_bt.sim.world import SimWorld
 
 KINDS = ("hospital", "school", "office")
 DEV_BUILDING_SEEDS = range(1, 400)  # development seeds (catalogue.DEV_SEEDS: 0-999)
@@ -98,6 +94,11 @@ def world_views(
 ) -> tuple[list[np.ndarray], list[int], list[tuple]]:
     """Labelled patches of ``views`` views of building ``name`` in its realistic world
     ``world_seed``: (patches, class indices, metadata rows)."""
+    from pmnav_bt.sim.render import render_camera  # pybullet: only when rendering
+    from pmnav_bt.sim.robot import CAMERA_HEIGHT, HFOV, RADIUS
+    from pmnav_bt.sim.sign_views import view_pose
+    from pmnav_bt.sim.world import SimWorld
+
     scene = WorldConfig(preset="realistic")
     world = SimWorld(name, scene=scene, seed=world_seed)
     try:
@@ -165,6 +166,7 @@ def synthetic_patch(rng: np.random.Generator, toilet: bool, skip_colours: tuple[
     0-75 deg off its normal by a 640 px camera: foreshortened, on a wall, dimmed or
     brightened, noisy, sometimes smeared; the candidate box around it off by up to a
     tenth. A toilet pictogram, or a room plate of text."""
+    from pmnav_bt.sim.robot import HFOV  # pybullet: only when drawing
     from pmnav_bt.sim.scene.plates import make_plate
     from pmnav_bt.sim.scene.signage import draw_style
 

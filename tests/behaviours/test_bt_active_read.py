@@ -81,7 +81,7 @@ def test_a_reading_pose_is_not_taken_touching_clutter(make_rig, world):
     n = np.asarray(sign.normal, float)
     robot = (SEEN_FROM.x, SEEN_FROM.y)
     plate = UnreadPlate(
-        xy=tuple(sign.centre), normal=tuple(n), z=1.5, line_height=0.03, width=0.3,
+        xy=tuple(sign.centre), normal=tuple(n), z=1.5, top=1.52, line_height=0.03, width=0.3,
         stamp=0.0, seen_from=robot,
     )  # fmt: skip
     rng = plate_read_range(rig.ctx.config, plate.line_height)
