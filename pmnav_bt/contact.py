@@ -38,6 +38,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from pmnav_bt.control import Limits, rotate_command
 from pmnav_bt.geometry import heading, wrap_angle
 from pmnav_bt.hazards import body_blocked_by
 from pmnav_bt.seams import CREATE3_BACKUP_LIMIT_M, CREATE3_RADIUS_M, Pose2D
@@ -127,9 +128,9 @@ class BackOff:
         if now - self._t0 > self.timeout_s:
             return self._done("out of time")
         if self._from is None:
-            e = wrap_angle(self._face - pose.yaw)
-            if abs(e) > FACE_WITHIN:
-                return 0.0, max(-1.9, min(1.9, 3.0 * e)), False
+            v, w, facing = rotate_command(pose, self._face, Limits(), tol=FACE_WITHIN)
+            if not facing:
+                return v, w, False
             self._from = (pose.x, pose.y)
             self.distance = behind_free(pose, self.distance, self.clearance)
             if self.distance < 0.01:
