@@ -189,14 +189,15 @@ class _Planner:
     def __init__(self, ctx, entity: Entity, tf, reach: float, views, robot):
         self.ctx, self.tf, self.reach, self.robot = ctx, tf, reach, robot
         self.sign = np.asarray(entity_position(ctx.pm, entity), float)
+        self.views = views
         self.frames = {v.observation.stamp: v.observation for v in views}
-        self.seen = LocalCostmap()  # what the views' depth showed standing round here
-        for v in views:
-            self.seen.add_depth(v.observation, v.observation.stamp)
 
     def __call__(
         self, plates: list[UnreadPlate], read: UnreadPlate | None = None
     ) -> tuple[ReadingPlan | None, str]:
+        self.seen = LocalCostmap()  # what the views' depth showed standing round here
+        for v in self.views:  # projected here, in the worker, not on the tick
+            self.seen.add_depth(v.observation, v.observation.stamp)
         near = sorted((self.off(p), i, p) for i, p in enumerate(plates))
         near = [p for d, _, p in near if d <= self.reach]
         if not near:
