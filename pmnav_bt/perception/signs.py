@@ -230,14 +230,15 @@ def _quad_crop(img: np.ndarray, quad: np.ndarray) -> np.ndarray:
     )
 
 
+def scale_box(b: Box, f: float) -> Box:
+    """Box ``b`` scaled by ``f`` (from one image size to another)."""
+    return (b[0] * f, b[1] * f, b[2] * f, b[3] * f)
+
+
 def scale_sign(sign: SignText, f: float) -> SignText:
     """``sign`` with its boxes scaled by ``f`` (from one image size to another)."""
-
-    def box(b: Box) -> Box:
-        return (b[0] * f, b[1] * f, b[2] * f, b[3] * f)
-
-    lines = tuple(replace(ln, box=box(ln.box)) for ln in sign.lines)
-    return SignText(lines, box(sign.box))
+    lines = tuple(replace(ln, box=scale_box(ln.box, f)) for ln in sign.lines)
+    return SignText(lines, scale_box(sign.box, f))
 
 
 class SignReader:

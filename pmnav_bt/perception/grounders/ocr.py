@@ -45,7 +45,14 @@ from pmnav_bt.perception.doors import DoorLayout
 from pmnav_bt.perception.grounders.plate_memory import PlateMemory
 from pmnav_bt.perception.pictograms import PictogramRead, PictogramReader
 from pmnav_bt.perception.sign_match import Evidence, Match, SignMatcher, decide
-from pmnav_bt.perception.signs import MIN_LINE_PX, Box, SignReader, SignText, scale_sign
+from pmnav_bt.perception.signs import (
+    MIN_LINE_PX,
+    Box,
+    SignReader,
+    SignText,
+    scale_box,
+    scale_sign,
+)
 from pmnav_bt.perception.unread_plates import (
     UnreadPlate,
     UnreadPlates,
@@ -208,11 +215,8 @@ class OcrGrounder:
         the reading view where there is one; None where not read (no reader, too small)."""
         if self.pictograms is None or not boxes:
             return [None] * len(boxes)
-        r = obs.reading
-        w = obs.rgb.shape[1]
-        src = obs.rgb if r is None or r.width <= w else r
-        s = 1.0 if src is obs.rgb else r.width / w  # type: ignore[union-attr]
-        scaled = [(b[0] * s, b[1] * s, b[2] * s, b[3] * s) for b in boxes]
+        src, s = _reading_source(obs)
+        scaled = [scale_box(b, s) for b in boxes]
         reads = {pr.box: pr for pr in self.pictograms.read(src, scaled)}
         return [reads.get(b) for b in scaled]
 
@@ -257,16 +261,14 @@ class OcrGrounder:
         (``obs.reading``), plates are looked for in the frame as the reader looks for them
         in that view (scaled lines as low), and only their crops of the view are made and
         read."""
-        r = obs.reading
-        w = obs.rgb.shape[1]
-        if r is None or r.width <= w:
+        r, s = _reading_source(obs)
+        if r is obs.rgb:
             found = self.reader.candidates(obs.rgb)
             return _by_candidate(found, self.reader.read(obs.rgb, found))
-        s = r.width / w
         found = self.reader.candidates(obs.rgb, min_line_px=MIN_LINE_PX / s)
         if not found:
             return []
-        cands = [((b[0] * s, b[1] * s, b[2] * s, b[3] * s), lh * s) for b, lh in found]
+        cands = [(scale_box(b, s), lh * s) for b, lh in found]
         return _by_candidate(found, [scale_sign(t, 1.0 / s) for t in self.reader.read(r, cands)])
 
     def _door(self, obs: Observation, sign: Detection, plate: depth_geom.PlatePose) -> Detection:
@@ -286,6 +288,15 @@ class OcrGrounder:
             point=tuple(float(v) for v in door.centre),  # type: ignore[arg-type]
         )
 
+
+def _reading_source(obs: Observation):
+    """Where plates are read: the body's wider reading view (``obs.reading``) where it
+    offers one wider than the frame, else the frame; with the scale from frame pixels to
+    its pixels."""
+    r, w = obs.reading, obs.rgb.shape[1]
+    if r is None or r.width <= w:
+        return obs.rgb, 1.0
+    return r, r.width / w
 
 def _by_candidate(
     found: list[tuple[Box, float]], read: list[SignText]
