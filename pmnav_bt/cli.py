@@ -189,7 +189,7 @@ def map_draft(
     ),
     link_max: float | None = typer.Option(None, help="Longest link joining a part (m)."),
     wall_min: float | None = typer.Option(
-        None, help="A dead end with less of its border wall (not unknown) is a laser fan (0-1)."
+        None, help="A dead end walled (not fading into unknown) along less of it goes (0-1)."
     ),
     lined_min: float | None = typer.Option(
         None, help="A loop or dead end with less of its sides lined by parallel walls goes (0-1)."

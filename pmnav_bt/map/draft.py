@@ -14,8 +14,9 @@ The steps (each a function, so a person can look at every stage; run
    ``spur_m`` are pruned and straight-through nodes merged. Dead ends that widen
    behind their mouth, or that branch off a corridor and are less than
    ``corridor_ratio`` times longer than wide (a room seen through a wide opening), go;
-   so do dead ends whose border is less than ``wall_min`` wall, the rest never seen
-   (laser fans through open doors).
+   so do dead ends walled on both sides (by cells the scanner saw, not space never
+   seen) along less than ``wall_min`` of their length (laser fans through open doors,
+   rooms seen through their doorways).
 4. **Open areas**: skeleton stretches wider than ``open_width_m`` (a lobby, a hall)
    are cut out; each area becomes one waypoint at its most open point with a
    straight corridor to each of its exits, not a lattice round its pillars.
@@ -56,10 +57,16 @@ from pmnav_bt.map.building import (
     building_from_data,
 )
 from pmnav_bt.map.corridor_space import SpaceParams, corridor_space
-from pmnav_bt.map.corridor_walls import cut_unlined_loops, edge_share
+from pmnav_bt.map.corridor_walls import cut_unlined_loops, edge_share, edge_walled
 from pmnav_bt.map.draft_links import free_along, hall_hubs, link_parts
 from pmnav_bt.map.floorplan import FloorPlanImage, load_ros_map, save_ros_map
-from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask, seen_mask
+from pmnav_bt.map.grid import (
+    centre_line_width,
+    distance_map,
+    free_mask,
+    seen_mask,
+    unseen_mask,
+)
 
 ROOM_SPUR_M = 8.0  # a dead end longer than this is a corridor, whatever lies at its end
 
@@ -97,8 +104,10 @@ class DraftParams:
     link_max_m: float = 6.0  # join a part apart by a straight corridor up to this long
     pillar_m: float = 2.0  # a hole in the corridor space this small is run past, not round
     room_widening: float = 1.5  # a dead end this many times wider behind its mouth is a room
-    # A dead end with less of its border wall (the rest never seen) is a laser fan.
-    wall_min: float = 0.3
+    # A dead end walled on both sides (by what the scanner saw) along less than this share
+    # of its length is a laser fan or a room seen through its doorway: a corridor has
+    # walls along most of it (corridor_walls.walled_share).
+    wall_min: float = 0.5
     # A corridor on a loop, or a dead end, with less of its sides lined by walls parallel
     # to it is a way through a room or a fan, not a corridor (corridor_walls.py).
     lined_min: float = 0.5
@@ -450,22 +459,45 @@ def _prune_dead_ends(h: nx.Graph, goes: Callable[[list, np.ndarray], bool]) -> i
 
 
 def prune_fans(
-    h: nx.Graph, dist: np.ndarray, seen: np.ndarray, free: np.ndarray, wall_min: float
+    h: nx.Graph, free: np.ndarray, unseen: np.ndarray, dist: np.ndarray, res: float, wall_min: float
 ) -> int:
-    """Remove dead ends whose border is mostly space never seen: laser fans, not corridors.
+    """Remove dead ends whose sides fade into space never seen: laser fans, and rooms seen
+    only through their doorways, not corridors.
 
-    A corridor is lined with walls the laser saw; the rays a scanner threw through an
-    open door fan out into space it never mapped, so most of a fan's border is unknown,
-    not wall. Around each dead end's centre line (its median half width and two pixels
-    more) the non-free pixels are counted; the dead end goes when less than
-    ``wall_min`` of them are seen (``grid.seen_mask``). Repeated until none goes (the
-    stem of a fan is a dead end once its arms went); returns how many went. A map with
-    no wall at all (free space drawn on unknown) cannot tell a fan from a corridor:
-    nothing goes.
+    A corridor runs between walls the laser saw; the rays a scanner threw through an open
+    door fan out into space it never mapped, and a room seen only through its doorway is
+    free space fading into unknown on at least one side. From each dead end's tip, the
+    longest stretch of its corridors that is walled (neither side fading into space never
+    seen, ``corridor_walls.walled_share``) along less than ``wall_min`` of its length
+    goes. Judged by its sides, not by what lies at its far end: a long walled corridor
+    that ends in fans is a corridor, and keeps its length.
+    Repeated until none goes (the stem of a fan is a dead end once its arms went);
+    returns how many went. (A map with no wall at all, free space drawn on unknown,
+    cannot tell a fan from a corridor: ``draft_from_plan`` does not ask it.)
     """
-    if not seen.any():
-        return 0
-    return _prune_dead_ends(h, lambda _nodes, path: _wall_share(path, dist, seen, free) < wall_min)
+
+    gone = 0
+    changed = True
+    while changed:
+        changed = False
+        for end in [n for n in h.nodes if h.degree(n) == 1]:
+            chain = _dead_end_chain(h, end) if end in h and h.degree(end) == 1 else None
+            if chain is None:
+                continue
+            nodes = chain[0]
+            junction = next(m for m in h.neighbors(nodes[-1]) if m not in nodes)
+            edges = list(zip(nodes, [*nodes[1:], junction], strict=True))
+            lengths = np.array([len(h.edges[e]["path"]) for e in edges], float)
+            shares = np.array([edge_walled(h, a, b, free, unseen, dist, res) for a, b in edges])
+            # The longest stretch from the tip that is walled along less than wall_min of
+            # it goes: a walled corridor keeps its length when rays fan out at its end.
+            walled = np.cumsum(shares * lengths) / np.cumsum(lengths)
+            fading = np.flatnonzero(walled < wall_min)
+            if len(fading):
+                h.remove_nodes_from(nodes[: fading[-1] + 1])
+                gone += 1
+                changed = True
+    return gone
 
 
 def prune_unlined(
@@ -488,22 +520,6 @@ def prune_unlined(
         return float(np.average(shares, weights=lengths)) < lined_min
 
     return gone + _prune_dead_ends(h, goes)
-
-
-def _wall_share(path: np.ndarray, dist: np.ndarray, seen: np.ndarray, free: np.ndarray) -> float:
-    """The share of seen cells among the non-free cells bordering a centre line's space."""
-    rc = np.clip(path.round().astype(int), 0, np.array(dist.shape) - 1)
-    reach = float(np.median(dist[rc[:, 0], rc[:, 1]])) + 2.0
-    pad = int(np.ceil(reach)) + 1
-    lo = np.maximum(rc.min(axis=0) - pad, 0)
-    hi = np.minimum(rc.max(axis=0) + pad + 1, np.array(dist.shape))
-    line = np.ones((hi - lo).tolist(), np.uint8)
-    line[rc[:, 0] - lo[0], rc[:, 1] - lo[1]] = 0
-    near = cv2.distanceTransform(line, cv2.DIST_L2, 5) <= reach
-    box = np.s_[lo[0] : hi[0], lo[1] : hi[1]]
-    border = near & ~free[box]
-    n = int(border.sum())
-    return float((border & seen[box]).sum()) / n if n else 1.0
 
 
 def _faces_an_end(h: nx.Graph, nodes: list, path: np.ndarray, reach_px: float) -> bool:
@@ -692,11 +708,14 @@ def draft_from_plan(plan: FloorPlanImage, params: DraftParams = DraftParams()) -
     h.remove_edges_from(nx.selfloop_edges(h))
     prune_room_spurs(h, dist, res, params.room_widening)
     prune_alcoves(h, dist, params.corridor_ratio)
-    seen = seen_mask(plan)
+    unseen = unseen_mask(plan)
+    walls_seen = bool(seen_mask(plan).any())
+
+    def fans() -> int:
+        return prune_fans(h, free, unseen, dist, res, params.wall_min) if walls_seen else 0
+
     # A loop the lined rule cuts leaves dead ends; the fan rule judges those too.
-    while prune_fans(h, dist, seen, free, params.wall_min) + prune_unlined(
-        h, corridor, dist, res, params.lined_min
-    ):
+    while fans() + prune_unlined(h, corridor, dist, res, params.lined_min):
         pass
     hall_hubs(h, open_mask, free, dist)
     warnings = []
@@ -895,7 +914,9 @@ def draft_source(
             unit = " of metres" if k.endswith("_m") else ""
             raise DraftError(f"{option} must be a positive number{unit}, not {v!r}")
     if (knobs or {}).get("wall_min", 0.0) > 1.0:
-        raise DraftError(f"--wall-min is a share of a border, 0 to 1, not {knobs['wall_min']!r}")
+        raise DraftError(
+            f"--wall-min is a share of a dead end's length, 0 to 1, not {knobs['wall_min']!r}"
+        )
     if (knobs or {}).get("lined_min", 0.0) > 1.0:
         raise DraftError(
             f"--lined-min is a share of a corridor's sides, 0 to 1, not {knobs['lined_min']!r}"

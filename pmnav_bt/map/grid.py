@@ -85,6 +85,12 @@ def seen_mask(plan: FloorPlanImage) -> np.ndarray:
     return other & (grey != never)
 
 
+def unseen_mask(plan: FloorPlanImage) -> np.ndarray:
+    """The cells a sensor never saw: non-free cells not ``seen_mask`` (map_saver's grey),
+    and that grey where a loose ``free_thresh`` reads it free (``never_seen_free``)."""
+    return ((plan.occupancy() != 0) & ~seen_mask(plan)) | never_seen_free(plan)
+
+
 def largest_component(mask: np.ndarray) -> np.ndarray:
     n, lab, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=4)
     if n <= 1:

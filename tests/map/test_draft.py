@@ -238,6 +238,49 @@ def test_a_dead_end_bordered_by_unseen_space_is_a_laser_fan(tmp_path):
     assert not any(w.pos[1] > 6.0 and w.pos[0] > 20 for w in b.waypoints)
 
 
+def _seen_grid(tmp_path, free_rects, wall_rects, size=(34.0, 16.0), res=0.05):
+    """Never-seen grey with the free rectangles (x0, y0, x1, y1), and walls (black) drawn
+    only as the ``wall_rects``: what a scanner saw."""
+    w, h = round(size[0] / res), round(size[1] / res)
+    img = np.full((h, w), 205, np.uint8)
+
+    def cells(x0, y0, x1, y1):
+        return np.s_[h - round(y1 / res) : h - round(y0 / res), round(x0 / res) : round(x1 / res)]
+
+    for r in wall_rects:
+        img[cells(*r)] = 0
+    for r in free_rects:
+        img[cells(*r)] = 254
+    return save_ros_map(FloorPlanImage(img, res, (0.0, 0.0, 0.0)), tmp_path / "s.yaml")
+
+
+def test_a_walled_dead_end_that_ends_in_fans_is_a_corridor(tmp_path):
+    # A walled 28 m corridor, and off it north a walled corridor 3 m wide and 9 m long
+    # whose far end opens into a wide fan of rays with no wall seen round it (Stata's
+    # north corridor). Most of the dead end's border, counted round its end, is space
+    # never seen; its sides are walls: it is a corridor, and only the fan goes.
+    free = [(2, 2, 30, 4.4), (10, 4.4, 13, 13.4), (5, 13.4, 18, 15.6)]
+    walls = [(1.8, 1.8, 30.2, 2), (1.8, 4.4, 10, 4.6), (13, 4.4, 30.2, 4.6),
+             (1.8, 1.8, 2, 4.6), (30, 1.8, 30.2, 4.6),
+             (9.8, 4.4, 10, 13.4), (13, 4.4, 13.2, 13.4)]
+    b, _, _ = draft_building(_seen_grid(tmp_path, free, walls), tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert any(w.pos[1] > 10.0 and 10 < w.pos[0] < 13 for w in b.waypoints), b.waypoints
+    assert not any(w.pos[1] > 13.0 and not 10 < w.pos[0] < 13 for w in b.waypoints)
+
+
+def test_a_dead_end_walled_on_one_side_only_is_a_room_seen_through_its_doorway(tmp_path):
+    # Off a walled corridor, a dead end 1.6 m wide and 7 m long whose west side is a wall
+    # and whose east side fades into space never seen (a room the scanner saw only through
+    # its doorway). Half its border is wall, but no wall stands on its east side anywhere.
+    free = [(2, 2, 30, 4.4), (8, 4.4, 9.6, 11.4)]
+    walls = [(1.8, 1.8, 30.2, 2), (1.8, 4.4, 8, 4.6), (9.6, 4.4, 30.2, 4.6),
+             (1.8, 1.8, 2, 4.6), (30, 1.8, 30.2, 4.6), (7.8, 4.4, 8, 11.6), (7.8, 11.4, 9.6, 11.6)]
+    b, _, _ = draft_building(_seen_grid(tmp_path, free, walls), tmp_path / "b.yaml")
+    assert _near(b, (2.5, 3.2)) and _near(b, (29.5, 3.2))
+    assert not any(w.pos[1] > 6.0 for w in b.waypoints), b.waypoints
+
+
 def test_a_fan_whose_rays_close_a_loop_is_a_fan_once_the_loop_is_cut(tmp_path):
     # Off a walled corridor, rays with no wall seen round them: a strip north, a band
     # across its top and a wedge widening from a second opening up to the band (Willow's
@@ -285,7 +328,10 @@ def test_walls_saved_as_grey_likelihoods_are_seen_and_unknown_is_not():
 
 @pytest.mark.parametrize(
     "option, says",
-    [("--wall-min", "a share of a border, 0 to 1"), ("--lined-min", "a share of a corridor's")],
+    [
+        ("--wall-min", "a share of a dead end's length, 0 to 1"),
+        ("--lined-min", "a share of a corridor's"),
+    ],
 )
 def test_map_draft_shares_are_shares(tmp_path, capsys, option, says):
     from pmnav_bt.cli import main
