@@ -2,7 +2,8 @@
 
 Free cells are the level's floor polygons (or, for a level without floors, what the
 lanes reach without crossing a wall); walls and **closed doors** are occupied lines
-``WALL_M`` thick; everything else is unknown. Closing the doors keeps rooms out of the
+``WALL_M`` thick, and so is a ring round the free space (a floor ends at a wall, drawn in
+the file or not); everything else is unknown. Closing the doors keeps rooms out of the
 corridors' free space: the corridor network is the largest free part, and the
 simulator cuts each room's door opening through the grid's wall where it hangs the door.
 """
@@ -69,7 +70,12 @@ def level_grid(level: RmfLevel, open_doors: frozenset[int] = frozenset()) -> Flo
             if 0 <= r < h and 0 <= c < w and not walls[r, c] and not inside[r, c]:
                 cv2.floodFill(inside, mask, (c, r), 1, flags=4 | (1 << 8))
     plan.image[inside.astype(bool)] = FREE
-    plan.image[walls.astype(bool)] = OCCUPIED
+    # A floor ends at a wall, drawn in the file or not: a wall's thickness off its edge is
+    # occupied, not unknown (a grid's unknown beside free space is where a scanner
+    # stopped seeing, which a draft reads as a laser fan).
+    ring = np.ones((2 * thick + 1, 2 * thick + 1), np.uint8)
+    edge = cv2.dilate(inside, ring).astype(bool) & ~inside.astype(bool)
+    plan.image[edge | walls.astype(bool)] = OCCUPIED
     return plan
 
 

@@ -143,6 +143,23 @@ def test_the_written_files_validate_and_the_grid_has_the_walls(example, tmp_path
     assert code == 0, err
 
 
+def test_the_grid_has_a_wall_wherever_the_floor_ends(tmp_path):
+    # The example with no wall drawn along its corridor's south side, where its floor
+    # ends: the grid still has one there. Free space beside unknown is where a scanner
+    # stopped seeing, which the draft reads as a laser fan, not as the building's edge.
+    import cv2
+
+    data = example_rmf()
+    lvl = data["levels"]["L1"]
+    lvl["walls"] = [w for w in lvl["walls"] if w[:2] != [4, 5]]
+    out = tmp_path / "out.yaml"
+    write_import(import_rmf(write_example_rmf(tmp_path, data), out), out)
+    plan = load_floor_plan(read_building_file(out), tmp_path)
+    occ = plan.occupancy()
+    beside_free = cv2.dilate((occ == 0).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    assert not (beside_free & (occ == -1)).any()
+
+
 def test_a_level_that_is_not_there_names_the_levels(example, tmp_path, capsys):
     code, _, err = run_pmnav(capsys, "map", "import-rmf", example, "--level", "L9", "-o",
                              tmp_path / "o.yaml")
