@@ -246,8 +246,7 @@ class DriveTo(PmNavBehaviour):
                 moving = self._hold is not None and self._hold.moving
 
                 def watch(cancelled):
-                    obs = base.observe()
-                    steer.sense(obs, now)
+                    obs = base.observe()  # into the steering's costmap (Context)
                     steer.feel(body_hazards(base, since=felt_since), obs.pose, now)
                     est = map_pose(tf, obs.pose)
                     found = self.inspect(obs, est, target)

@@ -14,13 +14,15 @@ A drive (``behaviours/motion.py`` ``DriveTo``) asks its ``Steering`` three thing
   on the floor (its local costmap: depth, and what the body felt, ``feel``): where a
   drive that touched something may back off to and go round it (``pmnav_bt/contact.py``).
 
-Both keep a local costmap (``costmap.LocalCostmap``) of what depth showed and the bumper
-felt; ``direct`` steers without it and reads it only for ``clearance``.
+Both keep a local costmap (``costmap.LocalCostmap``) of what every frame the body took
+showed (``Context`` hands each to ``sense``: the drive's watch frames, panoramas, looks)
+and what the bumper felt.
 
-``direct`` (``DirectSteering``): what the drive always did: steer straight at the goal
-(``control.goto_command``); anything closer than the goal on that line holds the drive
-(and the hold goes round clutter by a detour point, ``motion.detour``). Its costmap
-remembers what the camera saw and the bumper felt, for backing off and going round.
+``direct`` (``DirectSteering``): steer straight at the goal (``control.goto_command``),
+by way of a point round what its costmap remembers on that line (``clear_way``: what
+the camera saw from afar and no longer sees up close, what the bumper felt); anything
+depth shows closer than the goal on that line holds the drive (and the hold goes round
+clutter by a detour point, ``motion.detour``).
 
 ``dwa`` (``LocalPlannerSteering``): a rolling local costmap from depth
 (``costmap.LocalCostmap``) and the dynamic window approach (``dwa.choose``) within the
@@ -46,6 +48,7 @@ from pmnav_bt.contact import felt_item
 from pmnav_bt.control import Limits, goto_command
 from pmnav_bt.geometry import se2_apply, se2_inverse
 from pmnav_bt.hazards import Hazard, HazardKind
+from pmnav_bt.local_planner.clear_way import blocked_at, way_round
 from pmnav_bt.local_planner.costmap import LocalCostmap
 from pmnav_bt.local_planner.dwa import Dynamics, Navigation, choose, navigation, passable
 from pmnav_bt.registry import Named
@@ -57,6 +60,9 @@ RECENT_COMMAND_S = 0.5  # a command older than this: the body has stopped since
 FINAL_APPROACH_M = 0.5  # this near the goal, with a clear straight way, drive straight in
 STILL_M = 0.02  # frames this near each other were taken standing still
 SHUT_PROBE_M = 3.0  # how far along the way a shut way's distance is looked for
+# The direct drive judges this much of its straight way against its costmap each watch
+# frame: a second's drive and the 2.5 m more in which the camera loses a low box.
+JUDGE_M = 3.0
 
 Transform = tuple[float, float, float] | None  # map_T_odom (None: identity)
 
@@ -111,16 +117,54 @@ class _Remembers:
 
 
 class DirectSteering(_Remembers):
-    """Straight at the goal; whatever stands closer than the goal holds the drive."""
+    """Straight at the goal, the body kept clear of what its costmap remembers: where the
+    straight way (``JUDGE_M`` of it) comes within the lethal distance of something marked,
+    by way of a point round it first (``clear_way``; worked out with each watch frame, in
+    the worker). Whatever depth shows closer than the goal holds the drive."""
+
+    def __init__(self, costmap: LocalCostmap | None = None) -> None:
+        super().__init__(costmap)
+        self._round: tuple[tuple[float, float], tuple[float, float]] | None = None  # aim, via
+        self._lock = threading.Lock()
 
     def movers(self, before: Observation, after: Observation) -> bool:
         return True  # the drive stops at the first frame that shows something in the way
 
     def way_shut(self, obs, tf, goal, ahead, moving) -> float | None:
+        """Depth's ``ahead`` (the drive holds for it); with the way open to depth, the
+        point round what the costmap holds on the straight way, if anything."""
+        g = _to_odom(tf, goal)
+        via = None if ahead is not None else round_marks(self.costmap.snapshot(), obs.pose, g)
+        with self._lock:
+            self._round = None if via is None else (g, via)
         return ahead
 
     def command(self, est, odom, aim, tf, limits, now) -> tuple[float, float, bool]:
+        g = _to_odom(tf, aim)
+        with self._lock:
+            r = self._round
+        if r is not None and math.dist(r[0], g) <= AIM_SAME_M:
+            if math.hypot(r[1][0] - odom.x, r[1][1] - odom.y) > GOAL_TOLERANCE_M:
+                v, w, _ = goto_command(odom, *r[1], limits)
+                return v, w, False
+            with self._lock:  # round it: straight on, till the next frame judges again
+                self._round = None
         return goto_command(est, *aim, limits)
+
+
+def round_marks(grid, pose: Pose2D, goal: tuple[float, float]) -> tuple[float, float] | None:
+    """A point (odometry) round what ``grid`` marks on the straight way from ``pose`` to
+    ``goal`` (its first ``JUDGE_M``), or None: the way is clear, or marks leave no way
+    round in the window (the drive goes on as depth and the bumper say)."""
+    here = (pose.x, pose.y)
+    d = math.dist(here, goal)
+    if d == 0.0:
+        return None
+    k = min(1.0, JUDGE_M / d)
+    end = (here[0] + k * (goal[0] - here[0]), here[1] + k * (goal[1] - here[1]))
+    if blocked_at(grid, here, end) is None:
+        return None
+    return way_round(grid, here, goal)
 
 
 class LocalPlannerSteering(_Remembers):
