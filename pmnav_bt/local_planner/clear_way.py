@@ -12,21 +12,24 @@ here whether its body's footprint, swept along the straight way, keeps clear of 
   None when the way is clear. Where the body already stands that near (beside what it
   touched, or a mark made as it passed), the way is judged from where it leaves that
   nearness: moving off is always allowed.
-- ``way_round``: where it is not, a point to drive to first: along the shortest way
+- ``point_round``: where it is not, a point to drive to first: along the shortest way
   round through cells that keep the lethal distance (the navigation function of
   ``dwa.navigation``, fast marching over the window, unknown floor counted free as
   Nav2's local costmap does), the farthest point of that way, within ``ROUND_REACH_M``,
   to which the straight way from the robot is clear. None when marks cut every way
-  round in the window: the caller keeps its own rule for a shut way (the depth check,
-  and a touch backed off from).
+  round in the window, or the way round leaves the caller's walls (the map's corridors:
+  the costmap knows only the walls the camera saw, and unknown floor beyond a wall is
+  no way): the caller keeps its own rule for a shut way (the depth check, and a touch
+  backed off from).
 
-Cheap enough for the tick (``blocked_at``: a few dozen look-ups); ``way_round`` makes a
+Cheap enough for the tick (``blocked_at``: a few dozen look-ups); ``point_round`` makes a
 navigation function (about 10 ms) and belongs in the worker.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -38,6 +41,7 @@ PROBE_M = 0.05  # a way is sampled this finely (a cell)
 # window's floor nearer than that was seen, and the robot looks again every second.
 ROUND_REACH_M = 2.0
 DESCENT_STEP_M = 0.05  # the way round follows the navigation function's slope in these steps
+OWN_M = 0.3  # where the body stands, beside a wall, the walls' margin is not asked
 
 
 def blocked_at(
@@ -65,11 +69,19 @@ def blocked_at(
     return None if len(hit) == 0 else float(s[k + hit[0]])
 
 
-def way_round(
-    grid: CostGrid, start: tuple[float, float], goal: tuple[float, float]
+Inside = Callable[[tuple[float, float]], bool]  # whether an odometry point is in the walls
+
+
+def point_round(
+    grid: CostGrid,
+    start: tuple[float, float],
+    goal: tuple[float, float],
+    inside: Inside | None = None,
 ) -> tuple[float, float] | None:
     """A point (odometry) to drive to first on the way from ``start`` to ``goal`` round what
-    the costmap marks (see the module); None when there is no way round in the window."""
+    the costmap marks (see the module); None when there is no way round in the window, or
+    when the way round leaves what ``inside`` allows (the map's corridors: the costmap
+    knows only the walls the camera saw) within ``ROUND_REACH_M``."""
     nav = navigation(grid, start[0], start[1], goal)
     here = float(nav.at(np.array([start[0]]), np.array([start[1]]))[0])
     if not math.isfinite(here):
@@ -81,8 +93,8 @@ def way_round(
     best = None
     walked = 0.0
     while walked < ROUND_REACH_M:
-        i, j, inside = grid.cells(np.array([p[0]]), np.array([p[1]]))
-        if not inside[0]:
+        i, j, in_window = grid.cells(np.array([p[0]]), np.array([p[1]]))
+        if not in_window[0]:
             break
         i, j = int(i[0]), int(j[0])
         lo_i, hi_i, lo_j, hi_j = max(i - 1, 0), min(i + 2, n), max(j - 1, 0), min(j + 2, n)
@@ -97,6 +109,8 @@ def way_round(
         nxt = np.array([grid.origin[0] + (nj + 0.5) * r, grid.origin[1] + (ni + 0.5) * r])
         walked += float(np.linalg.norm(nxt - p))
         p = nxt
+        if inside is not None and walked > OWN_M and not inside((float(p[0]), float(p[1]))):
+            return None
         if blocked_at(grid, start, (float(p[0]), float(p[1]))) is None:
             best = (float(p[0]), float(p[1]))
     if best is None or math.dist(best, start) < DESCENT_STEP_M:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from pmnav_bt.local_planner.clear_way import blocked_at, way_round
+from pmnav_bt.local_planner.clear_way import blocked_at, point_round
 from pmnav_bt.local_planner.costmap import LocalCostmap
 
 
@@ -41,7 +41,7 @@ def test_the_way_round_keeps_the_body_clear_and_leaves_on_the_open_side():
     wall = [(float(x), 0.8) for x in np.arange(-1.0, 5.0, 0.05)]
     cm.mark(disc(2.0, 0.1, 0.2) + wall, now=0.0)
     grid = cm.snapshot()
-    via = way_round(grid, (0.0, 0.0), (4.0, 0.0))
+    via = point_round(grid, (0.0, 0.0), (4.0, 0.0))
     assert via is not None
     assert via[1] < -0.2  # the right, away from the wall
     assert blocked_at(grid, (0.0, 0.0), via) is None
@@ -50,7 +50,7 @@ def test_the_way_round_keeps_the_body_clear_and_leaves_on_the_open_side():
 def test_no_way_round_a_way_marked_shut():
     cm = LocalCostmap()
     cm.mark([(2.0, float(y)) for y in np.arange(-5.0, 5.0, 0.05)], now=0.0)  # wall to wall
-    assert way_round(cm.snapshot(), (0.0, 0.0), (4.0, 0.0)) is None
+    assert point_round(cm.snapshot(), (0.0, 0.0), (4.0, 0.0)) is None
 
 
 def test_standing_beside_a_mark_the_way_off_it_is_open():
