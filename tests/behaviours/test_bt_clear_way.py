@@ -10,6 +10,8 @@ import math
 import pytest
 from py_trees.common import Status
 
+from pmnav_bt.behaviours.belief import DriveEnd
+from pmnav_bt.behaviours.follow_lead import CorridorDrive, DriveAlongCorridor
 from pmnav_bt.behaviours.motion import Approach
 from pmnav_bt.seams import Pose2D
 
@@ -49,3 +51,19 @@ def test_a_look_marks_the_costmap(make_rig):
     assert rig.ctx.steering.clearance(*BOX) == math.inf
     rig.ctx.base.observe()
     assert rig.ctx.steering.clearance(BOX[0], BOX[1] + 0.2) < 0.1
+
+
+def test_the_localization_drive_goes_round_a_box_seen_from_afar(make_rig, monkeypatch):
+    """The drive along the corridor (``follow_lead``) steers by the walls and goes round
+    what the costmap holds on its way: the low box seen 4.3 m ahead, below the view from
+    2.9 m on, is passed without a touch. Before, it drove along its heading into it."""
+    rig = make_rig(Pose2D(0.0, 29.5, SOUTH), width=320, height=240)
+    rig.add_obstacle(*BOX, size=BOX_SIZE, height=BOX_HEIGHT)
+    monkeypatch.setattr(rig.ctx.grounder, "read_signs", lambda obs: [])  # no sign stop
+    drive = CorridorDrive((0.0, 29.5), 6.0, SOUTH, 5.5, last_ray=(0.0, 29.5))
+    rig.set(belief=None, corridor_drive=drive, drive_end=None)
+    seen = rig.run(DriveAlongCorridor("Drive", rig.ctx), max_ticks=600)
+    rig.expect(seen, Status.SUCCESS)
+    assert rig.get("drive_end") == DriveEnd.COVERED
+    assert rig.body.stats.collisions == 0
+    assert rig.true_pose().y < 24.5  # past the box
