@@ -69,6 +69,10 @@ DETOUR_MARGIN_M = 0.3
 DETOUR_HALF_WIDTH_M = 0.25  # the floor kept free either side of a detour's line
 DETOUR_VIEW_MARGIN = math.radians(5.0)  # a bearing this close to the image border is not seen
 MAX_DETOURS = 2
+# A goal where the body would stand this near what the costmap holds (its radius and a
+# costmap cell) is reached this far short of it: stop there rather than push on.
+GOAL_TAKEN_M = CREATE3_RADIUS_M + 0.05
+STOP_SHORT_M = 0.3
 MOVER_REACH_M = 0.5  # what moved this far beyond the thing in the way counts (it stepped back)
 # Something that moves (a person) is passed this much wider and farther than clutter: a
 # person steps and turns (0.3 m of personal space), and is never brushed past.
@@ -84,7 +88,10 @@ class DriveTo(PmNavBehaviour):
     the corridor true (``keep_on_axis``). Something in the way closer than the goal
     stops the drive and holds it (``way_ahead.judge``: go on, go round, wait, give up).
     Reads ``map_T_odom``, ``target``; writes ``map_T_odom``, ``pose_tracker``,
-    ``way_shut`` (a ``WayShut`` when it gave up on a shut way, else None). A touch
+    ``way_shut`` (a ``WayShut`` when it gave up on a shut way, else None). The way is
+    kept clear of what the steering's costmap holds (a point round it,
+    ``Steering.way_round``); a goal that stands against it is reached ``STOP_SHORT_M``
+    short. A touch
     (the base reports BLOCKED) is one contact: the drive stops, marks it, backs off from
     it and goes round it. FAILURE: BLOCKED on the ``MAX_CONTACTS``-th contact, no
     progress, or a way that stayed shut for the patience; DOOR_CLOSED when what shut it
@@ -162,6 +169,11 @@ class DriveTo(PmNavBehaviour):
         est = self.estimate()
         aim = self._aim()
         dist = math.hypot(aim[0] - est.x, aim[1] - est.y)
+        if self._detour is None and dist <= STOP_SHORT_M and self._goal_taken(aim):
+            base.set_velocity(0.0, 0.0)
+            self.ctx.log("stopped_short", "", to_go=dist)
+            self.feedback_message = f"stopped {dist:.2f} m short: something stands at the goal"
+            return Status.SUCCESS
         if dist < self._best - 0.1:
             self._best, self._best_t = dist, now
         elif now - self._best_t > NO_PROGRESS_S:
@@ -181,6 +193,14 @@ class DriveTo(PmNavBehaviour):
             " round an obstacle" if self._detour else ""
         )
         return Status.RUNNING
+
+    def _goal_taken(self, aim: tuple[float, float]) -> bool:
+        """Whether the body at ``aim`` (map) would stand within the lethal distance of what
+        the steering's costmap holds (the goal drawn against a wall or an item the map
+        does not know, or placed there by a pose estimate off by that much)."""
+        tf = self.get("map_T_odom") or (0.0, 0.0, 0.0)
+        p = se2_apply(se2_inverse(tf), aim)
+        return self.ctx.steering.clearance(float(p[0]), float(p[1])) < GOAL_TAKEN_M
 
     def _touched(self, now: float) -> Status:
         """The body touched something: one contact. Stop, mark it for the steering, and
@@ -264,7 +284,7 @@ class DriveTo(PmNavBehaviour):
                     if blocked is not None:
                         space = PERSON_SPACE_M if mover else 0.0
                         found["detour"] = detour(obs, est, goal, blocked, clear, space)
-                    else:
+                    elif not steer.plans_round:
                         g = se2_apply(se2_inverse(tf or (0.0, 0.0, 0.0)), toward)
                         g = (float(g[0]), float(g[1]))
                         found["round"] = keep_round(steer, obs.pose, g, inside, round_from)

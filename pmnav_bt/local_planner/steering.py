@@ -50,7 +50,7 @@ import numpy as np
 
 from pmnav_bt.contact import felt_item
 from pmnav_bt.control import Limits, goto_command
-from pmnav_bt.geometry import se2_apply, se2_inverse
+from pmnav_bt.geometry import se2_apply, se2_inverse, wrap_angle
 from pmnav_bt.hazards import Hazard, HazardKind
 from pmnav_bt.local_planner.clear_way import Inside, blocked_at, point_round
 from pmnav_bt.local_planner.costmap import LocalCostmap
@@ -63,6 +63,7 @@ AIM_SAME_M = 0.05  # a navigation function made for a goal this near serves this
 RECENT_COMMAND_S = 0.5  # a command older than this: the body has stopped since
 FINAL_APPROACH_M = 0.5  # this near the goal, with a clear straight way, drive straight in
 STILL_M = 0.02  # frames this near each other were taken standing still
+SAME_HEADING = math.radians(5.0)  # frames this near in heading were taken on one straight way
 SHUT_PROBE_M = 3.0  # how far along the way a shut way's distance is looked for
 # A drive judges this much of its straight way against the costmap each watch frame: a
 # second's drive and the 2.5 m more in which the camera loses a low box.
@@ -72,7 +73,11 @@ Transform = tuple[float, float, float] | None  # map_T_odom (None: identity)
 
 
 class Steering(Protocol):
-    """The seam between a drive's goal and its wheels (see the module's docstring)."""
+    """The seam between a drive's goal and its wheels (see the module's docstring).
+    ``plans_round``: whether it goes round what its costmap holds by itself (the DWA);
+    else a drive takes a point round it first (``way_round``)."""
+
+    plans_round: bool
 
     def sense(self, obs: Observation, now: float) -> None: ...
 
@@ -147,8 +152,14 @@ class DirectSteering(_Remembers):
     """Straight at the goal; whatever depth shows closer than the goal holds the drive. The
     drive itself goes round what the costmap remembers on the way (``way_round``)."""
 
+    plans_round = False
+
     def movers(self, before: Observation, after: Observation) -> bool:
-        return True  # the drive stops at the first frame that shows something in the way
+        """Between frames facing the same way (a straight drive stops at the first frame
+        that shows something in the way; from frames a turn apart, onto a point round
+        clutter, what stands still would read as moved)."""
+        turned = abs(wrap_angle(after.pose.yaw - before.pose.yaw))
+        return turned < SAME_HEADING
 
     def way_shut(self, obs, tf, goal, ahead, moving) -> float | None:
         return ahead
@@ -160,6 +171,8 @@ class DirectSteering(_Remembers):
 class LocalPlannerSteering(_Remembers):
     """A local costmap and the DWA (see the module's docstring). ``costmap``: the one to
     mark (None: a fresh 10 m window); the hazards of a robot may ``mark`` it too."""
+
+    plans_round = True
 
     def __init__(self, costmap: LocalCostmap | None = None) -> None:
         super().__init__(costmap)

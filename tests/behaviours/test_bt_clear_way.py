@@ -67,3 +67,16 @@ def test_the_localization_drive_goes_round_a_box_seen_from_afar(make_rig, monkey
     assert rig.get("drive_end") == DriveEnd.COVERED
     assert rig.body.stats.collisions == 0
     assert rig.true_pose().y < 24.5  # past the box
+
+
+def test_a_goal_with_a_box_on_it_is_reached_short_of_the_box(make_rig):
+    """A box stands where the drive's goal is (the corridor's node abeam room4): the drive
+    stops short of it, as near as the body may stand, instead of pushing into it."""
+    rig = make_rig(Pose2D(0.0, 29.5, SOUTH), width=320, height=240)
+    rig.add_obstacle(0.0, 21.9, size=0.4, height=1.0)
+    rig.set(target=room4_step(rig))
+    seen = rig.run(Approach("Approach", rig.ctx), max_ticks=900)
+    rig.expect(seen, Status.SUCCESS)
+    assert rig.body.stats.collisions == 0
+    assert "stopped_short" in [e.kind for e in rig.ctx.trace]
+    assert 22.1 + 0.17 < rig.true_pose().y < 22.1 + 0.17 + 0.4
