@@ -63,7 +63,7 @@ AIM_SAME_M = 0.05  # a navigation function made for a goal this near serves this
 RECENT_COMMAND_S = 0.5  # a command older than this: the body has stopped since
 FINAL_APPROACH_M = 0.5  # this near the goal, with a clear straight way, drive straight in
 STILL_M = 0.02  # frames this near each other were taken standing still
-SAME_HEADING = math.radians(5.0)  # frames this near in heading were taken on one straight way
+SAME_HEADING = math.radians(15.0)  # frames this near in heading were taken on one straight way
 SHUT_PROBE_M = 3.0  # how far along the way a shut way's distance is looked for
 # A drive judges this much of its straight way against the costmap each watch frame: a
 # second's drive and the 2.5 m more in which the camera loses a low box.
