@@ -3,10 +3,10 @@
 What it models: a careful driver's glance along the way before each stretch. The
 camera, 1.6 m up, sees a box 0.4 m high only from 2.9 m off and a 1 m plant only from
 1.45 m: once the robot comes nearer, what it saw is below its view. The local costmap
-(``costmap.LocalCostmap``) remembers it; a drive that steers straight at its goal (``behaviours/motion.py``
-``DriveTo`` with the direct steering, the localization drive ``behaviours/follow_lead.py``)
-asks here, through ``Steering.way_round``, whether its body's footprint, swept along the
-straight way, keeps clear of it:
+(``costmap.LocalCostmap``) remembers it; a drive that steers straight at its goal
+(``behaviours/motion.py`` ``DriveTo`` with the direct steering, the localization drive
+``behaviours/follow_lead.py``) asks here, through ``Steering.way_round``, whether its
+body's footprint, swept along the straight way, keeps clear of it:
 
 - ``blocked_at``: metres along the straight way to the first point where the body would
   come within the costmap's lethal distance (its radius and a pad) of something marked;
