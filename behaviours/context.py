@@ -88,6 +88,9 @@ class Context:
         self.base.on_distance = lambda scale, gain: self.log(
             "calibrate", "", distance_scale=scale, distance_gain=gain
         )
+        # Every frame the body takes (a drive's watch, a panorama, a look) goes into the
+        # drives' local costmap: what it showed is remembered when it is out of view.
+        self.base.on_frame = lambda obs: self.steering.sense(obs, self.now())
 
     @classmethod
     def wired(

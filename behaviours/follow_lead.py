@@ -24,13 +24,15 @@ how it ended is ``drive_end`` (``belief.DriveEnd``), which the next look reads.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.belief import DriveEnd, doors_in_odom, wall_mask
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context
+from pmnav_bt.contact import felt_contact, way_clear
+from pmnav_bt.hazards import Hazard, HazardKind
 from pmnav_bt.perception.geometry import free_distance, target_point
 from pmnav_bt.pose.belief import CorridorBelief
 from pmnav_bt.pose.odometry import TRACK_FREE_M, CalibratedBase
@@ -62,6 +64,14 @@ SLIDE_BEARINGS = tuple(math.radians(b) for b in (25.0, 40.0, 55.0))  # either si
 SLIDE_OPEN_M = 2.0  # floor this long along a bearing beside the wall: open
 SLIDE_ACROSS_M = 0.5
 SLIDE_GIVE_UP_S = NO_PROGRESS_S + 5.0  # clock seconds after the corner was met
+# Clutter the local costmap holds on the way ahead (seen from afar, lost from view up
+# close: ``local_planner/clear_way.py``) is driven round by a point beside it; the way is
+# judged this far ahead at each wall look, the point is reached this near, and a turn
+# larger than this onto it is made on the spot (a round body turns without touching).
+ROUND_JUDGE_M = 3.0
+ROUND_REACHED_M = 0.15
+ROUND_TURN_FIRST = math.radians(45.0)
+SLIDE_PROBE_M = 0.4  # a slide past a corner stops where the costmap holds something this near
 
 
 @dataclass
@@ -84,6 +94,7 @@ class CorridorDrive:
     measure_extended: bool = False  # driven on to measure the distance at a wall
     slid: bool = False  # slid past a corner already (once a drive)
     corner: tuple[float, float, float, float] | None = None  # (open yaw, x, y, clock) met
+    round: tuple[float, float] | None = None  # odometry: driving round clutter by this point
 
 
 @dataclass(frozen=True)
@@ -92,7 +103,9 @@ class WallLook:
     no wall seen), the way to the centre line between two walls (``centre_between``), how
     far ahead each sign read is, the free floor straight ahead (None: no depth), the open
     bearing beside a wall ahead (``open_beside``; only with a wall within
-    ``STOP_BEFORE_M``) and the doors along the walls (odometry; None: not looked for)."""
+    ``STOP_BEFORE_M``), the doors along the walls (odometry; None: not looked for) and,
+    for a drive, a point round what the local costmap holds on its way ahead (``round``:
+    ``Steering.way_round``; None: the way is clear)."""
 
     seen_from: Pose2D
     angle: float | None
@@ -101,6 +114,7 @@ class WallLook:
     free: float | None
     open_beside: float | None
     doors: tuple[tuple[float, float], ...] | None
+    round: tuple[float, float] | None = None  # odometry: a point round clutter ahead
 
 
 def look_at_walls(ctx: Context) -> WallLook:
@@ -131,6 +145,7 @@ def steer(drive: CorridorDrive, look: WallLook) -> float | None:
     ``ALONG_WALL_MAX`` is not the corridor's. Keeps what the look saw ahead. The walls'
     axis (odometry yaw), or None."""
     drive.open_beside = look.open_beside
+    drive.round = look.round
     yaw, axis = look.seen_from.yaw, None
     if look.centre is not None and abs(look.centre[0]) < ALONG_WALL_MAX:
         axis = yaw + look.centre[0]
@@ -162,6 +177,15 @@ def open_beside(obs: Observation) -> float | None:
         if left:
             return None
     return None
+
+
+def mark_contact(ctx: Context, pose: Pose2D) -> None:
+    """The body touched something: the steering's costmap marks it (``felt_item``), so the
+    next drive goes round it (the tree backs off it, ``BackUp``)."""
+    now = ctx.now()
+    contact = felt_contact(ctx.base, now)
+    ctx.log("contact", "", x=contact.point[0], y=contact.point[1], n=1)
+    ctx.steering.feel([Hazard(HazardKind.BUMP, "", contact.point, now)], pose, now)
 
 
 class ChooseLead(PmNavBehaviour):
@@ -243,8 +267,16 @@ class _LooksAtWalls(PmNavBehaviour):
         self._look = None
 
     def _look_again(self) -> None:
-        ctx = self.ctx
-        self._look = ctx.worker.submit(lambda c: look_at_walls(ctx))
+        ctx, heading = self.ctx, self.drive.heading
+
+        def look(cancelled) -> WallLook:
+            seen = look_at_walls(ctx)  # its frame is in the costmap now (Context)
+            p = seen.seen_from
+            reach = ROUND_JUDGE_M
+            ahead = (p.x + reach * math.cos(heading), p.y + reach * math.sin(heading))
+            return replace(seen, round=ctx.steering.way_round(p, ahead))
+
+        self._look = ctx.worker.submit(look)
         self.drive.checked_at = ctx.now()
 
     def _take_look(self) -> tuple[WallLook, float | None] | None:
@@ -348,18 +380,31 @@ class DriveAlongCorridor(_LooksAtWalls):
             self._note_blocked()
             self.feedback_message = f"a wall ahead after {done_m:.1f} m: the corridor ends"
             return self._end(DriveEnd.WALL)
-        if base.motion_status() == MotionStatus.BLOCKED or stuck:
+        touched = base.motion_status() == MotionStatus.BLOCKED
+        if touched or stuck:
             base.stop()
+            if touched:
+                mark_contact(self.ctx, pose)
             if done_m >= MIN_BLOCKED_DRIVE_M:
                 self._note_blocked()  # not just a brush with a side wall
             self.feedback_message = f"blocked after {done_m:.1f} m: the corridor ends or turns"
             return self._end_after_rest(DriveEnd.BLOCKED)
         if self._look is None and now - drive.checked_at > WALL_CHECK_S:
             self._look_again()
-        err = math.atan2(math.sin(drive.heading - pose.yaw), math.cos(drive.heading - pose.yaw))
+        want = drive.heading
+        if drive.round is not None:  # round clutter the costmap holds on the way
+            if math.hypot(drive.round[0] - pose.x, drive.round[1] - pose.y) <= ROUND_REACHED_M:
+                drive.round = None
+            else:
+                want = math.atan2(drive.round[1] - pose.y, drive.round[0] - pose.x)
+        err = math.atan2(math.sin(want - pose.yaw), math.cos(want - pose.yaw))
         lim = self.ctx.limits
+        if abs(err) > ROUND_TURN_FIRST:  # turn onto the way round before driving on
+            base.set_velocity(0.0, max(-lim.angular, min(lim.angular, 3.0 * err)))
+            return Status.RUNNING
         base.set_velocity(lim.linear, max(-lim.angular, min(lim.angular, 2.0 * err)))
         return Status.RUNNING
+
 
     def _end(self, end: DriveEnd) -> Status:
         """End the drive (the body stopped): SUCCESS, or while a drive ray is still being
@@ -488,7 +533,8 @@ class DriveAlongCorridor(_LooksAtWalls):
 class SlidePastCorner(PmNavBehaviour):
     """Slide past the corner the drive met (``CorridorDrive.corner``): face the open
     bearing beside it and drive until ``SLIDE_ACROSS_M`` across the drive's heading
-    (or blocked, or ``SLIDE_GIVE_UP_S`` after the corner was met). SUCCESS then, with the
+    (or blocked: touched, or what the local costmap holds within ``SLIDE_PROBE_M`` ahead;
+    or ``SLIDE_GIVE_UP_S`` after the corner was met). SUCCESS then, with the
     body stopped (the drive faces its heading and looks at the walls again).
 
     Reads and writes ``corridor_drive`` (the corner cleared)."""
@@ -505,6 +551,14 @@ class SlidePastCorner(PmNavBehaviour):
             return Status.RUNNING
         across = abs(math.sin(heading - drive.heading)) * math.hypot(pose.x - x, pose.y - y)
         blocked = base.motion_status() == MotionStatus.BLOCKED
+        if blocked:
+            mark_contact(self.ctx, pose)
+        ahead = (
+            pose.x + SLIDE_PROBE_M * math.cos(pose.yaw),
+            pose.y + SLIDE_PROBE_M * math.sin(pose.yaw),
+        )
+        if not way_clear((pose.x, pose.y), ahead, self.ctx.steering.clearance):
+            blocked = True  # what the costmap holds stands in the slide's way: slide no further
         if across >= SLIDE_ACROSS_M or blocked or self.ctx.now() - t > SLIDE_GIVE_UP_S:
             base.set_velocity(0.0, 0.0)
             drive.corner = None

@@ -24,7 +24,7 @@ from py_trees.common import Status
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose
 from pmnav_bt.behaviours.pose import axis_correction, keep_on_axis, measure_walls
-from pmnav_bt.contact import BackOff, Contact, felt_contact, round_contact
+from pmnav_bt.contact import BackOff, Contact, felt_contact, round_contact, way_clear
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import (
     Action,
@@ -69,6 +69,10 @@ DETOUR_MARGIN_M = 0.3
 DETOUR_HALF_WIDTH_M = 0.25  # the floor kept free either side of a detour's line
 DETOUR_VIEW_MARGIN = math.radians(5.0)  # a bearing this close to the image border is not seen
 MAX_DETOURS = 2
+# A goal where the body would stand this near what the costmap holds (its radius and a
+# costmap cell) is reached this far short of it: stop there rather than push on.
+GOAL_TAKEN_M = CREATE3_RADIUS_M + 0.05
+STOP_SHORT_M = 0.3
 MOVER_REACH_M = 0.5  # what moved this far beyond the thing in the way counts (it stepped back)
 # Something that moves (a person) is passed this much wider and farther than clutter: a
 # person steps and turns (0.3 m of personal space), and is never brushed past.
@@ -84,7 +88,10 @@ class DriveTo(PmNavBehaviour):
     the corridor true (``keep_on_axis``). Something in the way closer than the goal
     stops the drive and holds it (``way_ahead.judge``: go on, go round, wait, give up).
     Reads ``map_T_odom``, ``target``; writes ``map_T_odom``, ``pose_tracker``,
-    ``way_shut`` (a ``WayShut`` when it gave up on a shut way, else None). A touch
+    ``way_shut`` (a ``WayShut`` when it gave up on a shut way, else None). The way is
+    kept clear of what the steering's costmap holds (a point round it,
+    ``Steering.way_round``); a goal that stands against it is reached ``STOP_SHORT_M``
+    short. A touch
     (the base reports BLOCKED) is one contact: the drive stops, marks it, backs off from
     it and goes round it. FAILURE: BLOCKED on the ``MAX_CONTACTS``-th contact, no
     progress, or a way that stayed shut for the patience; DOOR_CLOSED when what shut it
@@ -121,6 +128,7 @@ class DriveTo(PmNavBehaviour):
         self._felt_t = -math.inf  # hazards the body felt since then go to the steering
         self._detour: tuple[float, float] | None = None  # a point round an obstacle
         self._detours = 0
+        self._round: tuple[float, float] | None = None  # odometry: round what the costmap holds
         self._hold: Hold | None = None  # stopped for something in the way
         self._last_frame = None  # the last watch frame (what moved since)
         self.bb.set("way_shut", None)
@@ -161,6 +169,11 @@ class DriveTo(PmNavBehaviour):
         est = self.estimate()
         aim = self._aim()
         dist = math.hypot(aim[0] - est.x, aim[1] - est.y)
+        if self._detour is None and dist <= STOP_SHORT_M and self._goal_taken(aim):
+            base.set_velocity(0.0, 0.0)
+            self.ctx.log("stopped_short", "", to_go=dist)
+            self.feedback_message = f"stopped {dist:.2f} m short: something stands at the goal"
+            return Status.SUCCESS
         if dist < self._best - 0.1:
             self._best, self._best_t = dist, now
         elif now - self._best_t > NO_PROGRESS_S:
@@ -169,7 +182,7 @@ class DriveTo(PmNavBehaviour):
         tf, limits = self.get("map_T_odom"), self.ctx.limits
         v, w, done = self.ctx.steering.command(est, base.pose(), aim, tf, limits, now)
         if done and self._detour is not None:  # past the obstacle: on to the goal
-            self._detour = None
+            self._detour = self._round = None
             self._progress_afresh()
             return Status.RUNNING
         if done:
@@ -180,6 +193,14 @@ class DriveTo(PmNavBehaviour):
             " round an obstacle" if self._detour else ""
         )
         return Status.RUNNING
+
+    def _goal_taken(self, aim: tuple[float, float]) -> bool:
+        """Whether the body at ``aim`` (map) would stand within the lethal distance of what
+        the steering's costmap holds (the goal drawn against a wall or an item the map
+        does not know, or placed there by a pose estimate off by that much)."""
+        tf = self.get("map_T_odom") or (0.0, 0.0, 0.0)
+        p = se2_apply(se2_inverse(tf), aim)
+        return self.ctx.steering.clearance(float(p[0]), float(p[1])) < GOAL_TAKEN_M
 
     def _touched(self, now: float) -> Status:
         """The body touched something: one contact. Stop, mark it for the steering, and
@@ -213,12 +234,7 @@ class DriveTo(PmNavBehaviour):
         odom = base.pose()
         tf = self.get("map_T_odom") or (0.0, 0.0, 0.0)
         goal = tuple(se2_apply(se2_inverse(tf), self._goal))
-        walls = self.ctx.detour_check
-
-        def inside(p: tuple[float, float]) -> bool:
-            m = se2_apply(tf, p)
-            return walls is None or walls((float(m[0]), float(m[1])), ROUND_WALL_MARGIN_M)
-
+        inside = inside_walls(tf, self.ctx.detour_check)
         point = round_contact(odom, contact.point, goal, steer.clearance, inside)
         self.ctx.log(
             "backed_off", "", moved=backing.moved, why=backing.why,
@@ -226,7 +242,7 @@ class DriveTo(PmNavBehaviour):
         )  # fmt: skip
         if point is not None:
             m = se2_apply(tf, point)
-            self._detour = (float(m[0]), float(m[1]))
+            self._detour, self._round = (float(m[0]), float(m[1])), None
         self._progress_afresh()
         return Status.RUNNING
 
@@ -244,10 +260,13 @@ class DriveTo(PmNavBehaviour):
                 before, felt_since = self._last_frame, self._felt_t
                 self._felt_t = now
                 moving = self._hold is not None and self._hold.moving
+                # A way round what the costmap holds is judged towards the goal (or a
+                # depth detour in force), keeping the one in force while it serves.
+                toward = self._goal if self._round is not None else goal
+                round_from, inside = self._round, inside_walls(tf, clear)
 
                 def watch(cancelled):
-                    obs = base.observe()
-                    steer.sense(obs, now)
+                    obs = base.observe()  # into the steering's costmap (Context)
                     steer.feel(body_hazards(base, since=felt_since), obs.pose, now)
                     est = map_pose(tf, obs.pose)
                     found = self.inspect(obs, est, target)
@@ -265,6 +284,10 @@ class DriveTo(PmNavBehaviour):
                     if blocked is not None:
                         space = PERSON_SPACE_M if mover else 0.0
                         found["detour"] = detour(obs, est, goal, blocked, clear, space)
+                    elif not steer.plans_round:
+                        g = se2_apply(se2_inverse(tf or (0.0, 0.0, 0.0)), toward)
+                        g = (float(g[0]), float(g[1]))
+                        found["round"] = keep_round(steer, obs.pose, g, inside, round_from)
                     return obs, blocked, found
 
                 self._watch_job = self.ctx.worker.submit(watch)
@@ -285,6 +308,7 @@ class DriveTo(PmNavBehaviour):
             self.feedback_message = f"at the wall beyond the waypoint ({ahead:.1f} m ahead)"
             return Status.SUCCESS
         if free is None:
+            self._take_round(found.get("round"))
             if self._hold is not None:
                 held = self._hold.held_for(now)
                 self.ctx.log("way_clear", "", waited=held)
@@ -292,6 +316,22 @@ class DriveTo(PmNavBehaviour):
                 self._progress_afresh()
             return None
         return self._held_up(now, obs, free, found)
+
+    def _take_round(self, point: tuple[float, float] | None) -> None:
+        """Drive by ``point`` (odometry), round what the costmap holds on the way; None:
+        the way is clear again (or has no way round): drop the round in force."""
+        if point is None:
+            if self._round is not None:
+                self._round = self._detour = None
+                self._progress_afresh()  # on to the goal: progress is measured to it
+            return
+        if point != self._round:
+            tf = self.get("map_T_odom") or (0.0, 0.0, 0.0)
+            m = se2_apply(tf, point)
+            self._detour = (float(m[0]), float(m[1]))
+            self._progress_afresh()
+            self.ctx.log("round", "", x=self._detour[0], y=self._detour[1])
+        self._round = point
 
     def _held_up(self, now: float, obs, free: float, found: dict) -> Status | None:
         """Something ``free`` m ahead in the way: hold, and judge what to do
@@ -314,6 +354,7 @@ class DriveTo(PmNavBehaviour):
             return None
         if verdict == Verdict.GO_ROUND:
             self._hold = None
+            self._round = None
             self._detour, self._detours = point, self._detours + 1
             self._progress_afresh()
             self.ctx.log("detour", "", x=point[0], y=point[1], obstacle=free, moving=hold.moving)
@@ -344,6 +385,31 @@ class DriveTo(PmNavBehaviour):
             FailureCode.BLOCKED,
             f"{where} blocked for {seconds:.0f} s ({hold.free:.1f} m ahead)",
         )
+
+
+def inside_walls(tf, walls: DetourCheck | None) -> Callable[[tuple[float, float]], bool]:
+    """Whether an odometry point lies inside what the tree variant knows of the walls
+    (``walls``, PM-Nav: the map's corridors; None: anywhere), ``ROUND_WALL_MARGIN_M`` off
+    them, ``tf`` (map_T_odom) placing it on the map."""
+    tf = tf or (0.0, 0.0, 0.0)
+
+    def inside(p: tuple[float, float]) -> bool:
+        m = se2_apply(tf, p)
+        return walls is None or walls((float(m[0]), float(m[1])), ROUND_WALL_MARGIN_M)
+
+    return inside
+
+
+def keep_round(steer, pose, goal, inside, current) -> tuple[float, float] | None:
+    """The point (odometry) to drive by round what the steering's costmap holds on the
+    straight way from ``pose`` to ``goal`` (``Steering.way_round``): ``current``, the one
+    in force, while the straight way to it stays clear (a way round chosen anew each
+    frame would swing from side to side as the robot turns), else a new one; None when
+    the way is clear or has no way round inside the walls."""
+    point = steer.way_round(pose, goal, inside)
+    if point is None or current is None:
+        return point
+    return current if way_clear((pose.x, pose.y), current, steer.clearance) else point
 
 
 def detour(

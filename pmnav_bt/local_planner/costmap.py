@@ -14,9 +14,16 @@ robot moves with it; each cell is free or occupied, with the time it was last ma
   (the 3.7 m under and before the camera, everything beside and behind) keep what they
   were: a box seen 4 m ahead is remembered as the robot passes it. Cells never seen free
   are unknown (``CostGrid.seen``): a planner leaves its straight line only onto floor seen.
+- **Seen gone**: each mark keeps the height of the highest point that made it. A
+  frame whose rays pass through a cell's column, nearer than the first thing they hit,
+  from the cell's floor up to where its lowest ray crosses it, shows that nothing as high
+  as that ray stands there: a mark that reached higher (a person who walked on) is
+  cleared; a low one below the view (a box passed up close) is kept. Nav2's voxel layer
+  clears in 3-D for the same reason.
 - **Decay**: a mark not seen again for ``DECAY_S`` is forgotten (someone who walked
   off where the camera no longer looks).
-- **Other sources**: ``mark(points)``: odometry points of a bumper or IR hit.
+- **Other sources**: ``mark(points)``: odometry points of a bumper or IR hit (of no
+  known height: kept until they decay).
 - **Inflation**: ``snapshot()`` gives each cell's distance to the nearest occupied cell
   (a Euclidean distance transform), from which a planner reads lethal cells (closer than
   the body's radius and ``LETHAL_PAD_M``) and a cost falling off to ``INFLATION_M`` beyond
@@ -51,6 +58,9 @@ DECAY_S = 30.0  # a mark unseen this long is forgotten (a person who walked on)
 LETHAL_PAD_M = 0.05  # lethal: within the body's radius and this (a cell's diagonal and more)
 INFLATION_M = 0.25  # cost falls off over this much beyond the lethal distance
 PIXEL_STRIDE = 2  # every second row and column of the depth image (4x fewer points)
+# A mark is seen gone where the frame's lowest ray through its cell passes this much
+# below the mark's top (depth noise, and a cell 5 cm across seen slantwise).
+SEEN_GONE_MARGIN_M = 0.1
 
 
 @dataclass(frozen=True)
@@ -105,6 +115,7 @@ class LocalCostmap:
         self._origin = (-size / 2.0, -size / 2.0)
         self._marked = np.full((self.n, self.n), -math.inf)  # time last marked; -inf: free
         self._seen = np.zeros((self.n, self.n), bool)  # floor seen free (else unknown)
+        self._top = np.zeros((self.n, self.n))  # how high the points that marked a cell stood
         self._lock = threading.Lock()
         self._grid = self._inflate()
 
@@ -135,7 +146,7 @@ class LocalCostmap:
         with self._lock:
             self._recentre(pose.x, pose.y)
             self._clear_seen_floor(pose, obs, scan)
-            self._mark_xy(scan.obstacles(pose), now)
+            self._mark_xy(scan.obstacles(pose), now, scan.heights)
             self._marked[self._marked < now - self.decay_s] = -math.inf
             self._grid = self._inflate()
 
@@ -162,6 +173,7 @@ class LocalCostmap:
         if di == 0 and dj == 0:
             return
         moved = np.full_like(self._marked, -math.inf)
+        top = np.zeros_like(self._top)
         n = self.n
         src_i, dst_i = slice(max(di, 0), n + min(di, 0)), slice(max(-di, 0), n + min(-di, 0))
         src_j, dst_j = slice(max(dj, 0), n + min(dj, 0)), slice(max(-dj, 0), n + min(-dj, 0))
@@ -169,17 +181,25 @@ class LocalCostmap:
         if abs(di) < n and abs(dj) < n:
             moved[dst_i, dst_j] = self._marked[src_i, src_j]
             seen[dst_i, dst_j] = self._seen[src_i, src_j]
-        self._marked, self._seen = moved, seen
+            top[dst_i, dst_j] = self._top[src_i, src_j]
+        self._marked, self._seen, self._top = moved, seen, top
         self._origin = (ox, oy)
 
-    def _mark_xy(self, pts: np.ndarray, now: float) -> None:
+    def _mark_xy(self, pts: np.ndarray, now: float, heights: np.ndarray | None = None) -> None:
+        """Mark odometry points; ``heights``: how high each stood (None: unknown, kept
+        until it decays)."""
         if len(pts) == 0:
             return
         j = np.floor((pts[:, 0] - self._origin[0]) / self.resolution).astype(int)
         i = np.floor((pts[:, 1] - self._origin[1]) / self.resolution).astype(int)
         keep = (i >= 0) & (i < self.n) & (j >= 0) & (j < self.n)
-        self._marked[i[keep], j[keep]] = now
-        self._seen[i[keep], j[keep]] = False
+        i, j = i[keep], j[keep]
+        fresh = ~np.isfinite(self._marked[i, j])
+        self._top[i[fresh], j[fresh]] = 0.0
+        h = np.zeros(len(i)) if heights is None else np.asarray(heights)[keep]
+        np.maximum.at(self._top, (i, j), h)
+        self._marked[i, j] = now
+        self._seen[i, j] = False
 
     def _clear_seen_floor(self, pose, obs: Observation, scan: _Scan) -> None:
         """Free every cell whose floor the frame shows (``_Scan``: per image column, the
@@ -200,6 +220,12 @@ class LocalCostmap:
         seen = in_view & (rng >= scan.near[col]) & (rng <= np.minimum(far, CLEAR_RANGE_M))
         self._marked[seen] = -math.inf
         self._seen |= seen
+        # Marks that stood higher than the lowest ray through their column, with nothing
+        # hit before them along it: seen gone.
+        lowest = obs.camera_height - rng * (k.height - 1 - k.cy) / k.fy
+        through = in_view & (rng < scan.first_obstacle[col] - r) & (rng <= CLEAR_RANGE_M)
+        gone = through & (self._top > np.maximum(lowest, 0.0) + SEEN_GONE_MARGIN_M)
+        self._marked[gone & np.isfinite(self._marked)] = -math.inf
 
     def _inflate(self) -> CostGrid:
         occ = np.isfinite(self._marked)
@@ -222,6 +248,7 @@ class _Scan:
     far: np.ndarray
     first_obstacle: np.ndarray
     points: np.ndarray
+    heights: np.ndarray  # how high above the floor each obstacle point stands
 
     def obstacles(self, pose) -> np.ndarray:
         """The obstacle points in the odometry frame."""
@@ -246,4 +273,4 @@ def _depth_scan(obs: Observation) -> _Scan:
     first = np.where(standing, rng, math.inf).min(axis=0)
     marks = standing & (rng <= MARK_RANGE_M)
     points = np.column_stack((depth[marks], left[marks]))
-    return _Scan(near, far, first, points)
+    return _Scan(near, far, first, points, height[marks])

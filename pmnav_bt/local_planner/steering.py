@@ -2,7 +2,8 @@
 
 A drive (``behaviours/motion.py`` ``DriveTo``) asks its ``Steering`` three things:
 
-- ``sense(obs, now)``, in the worker, with every watch frame: take in what the frame shows;
+- ``sense(obs, now)``, in the worker, with every frame the body takes (``Context``):
+  take in what the frame shows;
 - ``movers(before, after)``: whether what moved between two watch frames is to be asked
   (``perception/movers.py`` tells a mover by where things stand on the floor; a thing the
   robot drives up to leaves the bottom of its view and would read as gone);
@@ -12,15 +13,20 @@ A drive (``behaviours/motion.py`` ``DriveTo``) asks its ``Steering`` three thing
 - ``command(...)``, in the tick: the velocity command (v, w, done) for this period;
 - ``clearance(x, y)``: how far an odometry point is from what the steering knows stands
   on the floor (its local costmap: depth, and what the body felt, ``feel``): where a
-  drive that touched something may back off to and go round it (``pmnav_bt/contact.py``).
+  drive that touched something may back off to and go round it (``pmnav_bt/contact.py``);
+- ``way_round(pose, goal)``, in the worker: a point round what the costmap holds on the
+  straight way (``clear_way``), for a drive that steers itself (the localization drive,
+  ``behaviours/follow_lead.py``) as for the direct steering.
 
-Both keep a local costmap (``costmap.LocalCostmap``) of what depth showed and the bumper
-felt; ``direct`` steers without it and reads it only for ``clearance``.
+Both keep a local costmap (``costmap.LocalCostmap``) of what every frame the body took
+showed (``Context`` hands each to ``sense``: the drive's watch frames, panoramas, looks)
+and what the bumper felt.
 
-``direct`` (``DirectSteering``): what the drive always did: steer straight at the goal
-(``control.goto_command``); anything closer than the goal on that line holds the drive
-(and the hold goes round clutter by a detour point, ``motion.detour``). Its costmap
-remembers what the camera saw and the bumper felt, for backing off and going round.
+``direct`` (``DirectSteering``): steer straight at the goal (``control.goto_command``);
+the drive takes a point round what the costmap remembers on that line first
+(``way_round``: what the camera saw from afar and no longer sees up close, what the
+bumper felt); anything depth shows closer than the goal on that line holds the drive
+(and the hold goes round clutter by a detour point, ``motion.detour``).
 
 ``dwa`` (``LocalPlannerSteering``): a rolling local costmap from depth
 (``costmap.LocalCostmap``) and the dynamic window approach (``dwa.choose``) within the
@@ -44,8 +50,9 @@ import numpy as np
 
 from pmnav_bt.contact import felt_item
 from pmnav_bt.control import Limits, goto_command
-from pmnav_bt.geometry import se2_apply, se2_inverse
+from pmnav_bt.geometry import se2_apply, se2_inverse, wrap_angle
 from pmnav_bt.hazards import Hazard, HazardKind
+from pmnav_bt.local_planner.clear_way import Inside, blocked_at, point_round
 from pmnav_bt.local_planner.costmap import LocalCostmap
 from pmnav_bt.local_planner.dwa import Dynamics, Navigation, choose, navigation, passable
 from pmnav_bt.registry import Named
@@ -56,13 +63,21 @@ AIM_SAME_M = 0.05  # a navigation function made for a goal this near serves this
 RECENT_COMMAND_S = 0.5  # a command older than this: the body has stopped since
 FINAL_APPROACH_M = 0.5  # this near the goal, with a clear straight way, drive straight in
 STILL_M = 0.02  # frames this near each other were taken standing still
+SAME_HEADING = math.radians(15.0)  # frames this near in heading were taken on one straight way
 SHUT_PROBE_M = 3.0  # how far along the way a shut way's distance is looked for
+# A drive judges this much of its straight way against the costmap each watch frame: a
+# second's drive and the 2.5 m more in which the camera loses a low box.
+JUDGE_M = 3.0
 
 Transform = tuple[float, float, float] | None  # map_T_odom (None: identity)
 
 
 class Steering(Protocol):
-    """The seam between a drive's goal and its wheels (see the module's docstring)."""
+    """The seam between a drive's goal and its wheels (see the module's docstring).
+    ``plans_round``: whether it goes round what its costmap holds by itself (the DWA);
+    else a drive takes a point round it first (``way_round``)."""
+
+    plans_round: bool
 
     def sense(self, obs: Observation, now: float) -> None: ...
 
@@ -81,6 +96,10 @@ class Steering(Protocol):
     ) -> tuple[float, float, bool]: ...  # fmt: skip
 
     def clearance(self, x: float, y: float) -> float: ...
+
+    def way_round(
+        self, pose: Pose2D, goal: tuple[float, float], inside: Inside | None = None
+    ) -> tuple[float, float] | None: ...  # fmt: skip
 
 
 class _Remembers:
@@ -109,12 +128,38 @@ class _Remembers:
         """Metres from odometry (x, y) to the nearest marked cell (inf: none known)."""
         return float(self.costmap.snapshot().clearance(np.array([x]), np.array([y]))[0])
 
+    def way_round(
+        self, pose: Pose2D, goal: tuple[float, float], inside: Inside | None = None
+    ) -> tuple[float, float] | None:
+        """A point (odometry) to drive to first on the straight way from ``pose`` to
+        ``goal`` (odometry), round what the costmap holds on its first ``JUDGE_M``; None
+        when that way is clear, or when marks leave no way round in the window that
+        stays ``inside`` (the caller's walls; the drive then goes on as depth and the
+        bumper say). Worker only (``clear_way``)."""
+        grid = self.costmap.snapshot()
+        here = (pose.x, pose.y)
+        d = math.dist(here, goal)
+        if d == 0.0:
+            return None
+        k = min(1.0, JUDGE_M / d)
+        end = (here[0] + k * (goal[0] - here[0]), here[1] + k * (goal[1] - here[1]))
+        if blocked_at(grid, here, end) is None:
+            return None
+        return point_round(grid, here, goal, inside)
+
 
 class DirectSteering(_Remembers):
-    """Straight at the goal; whatever stands closer than the goal holds the drive."""
+    """Straight at the goal; whatever depth shows closer than the goal holds the drive. The
+    drive itself goes round what the costmap remembers on the way (``way_round``)."""
+
+    plans_round = False
 
     def movers(self, before: Observation, after: Observation) -> bool:
-        return True  # the drive stops at the first frame that shows something in the way
+        """Between frames facing the same way (a straight drive stops at the first frame
+        that shows something in the way; from frames a turn apart, onto a point round
+        clutter, what stands still would read as moved)."""
+        turned = abs(wrap_angle(after.pose.yaw - before.pose.yaw))
+        return turned < SAME_HEADING
 
     def way_shut(self, obs, tf, goal, ahead, moving) -> float | None:
         return ahead
@@ -126,6 +171,8 @@ class DirectSteering(_Remembers):
 class LocalPlannerSteering(_Remembers):
     """A local costmap and the DWA (see the module's docstring). ``costmap``: the one to
     mark (None: a fresh 10 m window); the hazards of a robot may ``mark`` it too."""
+
+    plans_round = True
 
     def __init__(self, costmap: LocalCostmap | None = None) -> None:
         super().__init__(costmap)

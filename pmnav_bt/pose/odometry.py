@@ -114,7 +114,9 @@ class CalibratedBase(WrappedBase):
     extends the current straight-drive track (raw odometry, free floor ahead); a frame
     that turned from it ends the track, whose ``distance_scale`` joins the distance
     gain (the mean of all tracks' scales, weighted by how far each drove).
-    ``on_distance(scale, gain)`` is told each one. Everything else passes through.
+    ``on_distance(scale, gain)`` is told each one; ``on_frame(obs)`` each observation, as
+    corrected (the local costmap remembers what every frame shows). Everything else passes
+    through.
     """
 
     def __init__(self, inner: Base) -> None:
@@ -122,6 +124,7 @@ class CalibratedBase(WrappedBase):
         self.gain = 1.0
         self.distance_gain = 1.0
         self.on_distance = None  # called with (scale, new distance gain) per track
+        self.on_frame = None  # called with each observation, its pose corrected
         self._asked: list[float] = []  # the gain each measurement asked for
         self._scales: list[tuple[float, float]] = []  # (scale, metres) per track
         self._track: list[tuple[float, float]] = []
@@ -243,9 +246,11 @@ class CalibratedBase(WrappedBase):
             self._update(self.inner.pose())
             if free is not None:
                 self._extend_track(obs.pose, free)
-            if self._corr == self._raw:
-                return obs
-            corr_T_raw = self._corr_T_raw()
-        q = obs.pose
-        x, y, yaw = se2_compose(corr_T_raw, (q.x, q.y, q.yaw))
-        return replace(obs, pose=Pose2D(x, y, wrap_angle(yaw)))
+            corr_T_raw = None if self._corr == self._raw else self._corr_T_raw()
+        if corr_T_raw is not None:
+            q = obs.pose
+            x, y, yaw = se2_compose(corr_T_raw, (q.x, q.y, q.yaw))
+            obs = replace(obs, pose=Pose2D(x, y, wrap_angle(yaw)))
+        if self.on_frame is not None:
+            self.on_frame(obs)
+        return obs

@@ -88,21 +88,19 @@ def test_approach_drives_on_the_estimated_pose(make_rig):
     assert p.y == pytest.approx(est.y - 0.5)
 
 
-def test_approach_with_an_obstacle_in_the_way_fails_blocked(make_rig):
+def test_approach_goes_round_a_box_it_saw_and_then_lost_from_view(make_rig):
+    """A 1 m box leaves the camera's view (1.6 m up, 47 deg vertical field) 1.4 m before
+    it; the first frames mark it in the costmap, and the drive goes round it through the
+    0.7 m beside it (the body is 0.34 m across) without a touch. Before, it drove on
+    into it and failed BLOCKED. See the tall box below for what stays in view."""
     rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
     rig.add_obstacle(0.1, 24.0, size=0.8)
     rig.set(target=room4_step(rig))
     seen = rig.run(Approach("Approach", rig.ctx), max_ticks=400)
-    rig.expect(seen, Status.FAILURE)
-    # A 1 m box leaves the camera's view (1.6 m up, 47 deg vertical field) 1.4 m before
-    # it; the depth watch (once a second) or the bumper (MAX_BUMPS ticks of BLOCKED)
-    # finds it. See the tall box below for depth alone.
-    assert rig.failure.code == FailureCode.BLOCKED
-    assert rig.stopped()
-    p = rig.true_pose()
-    assert p.y > 24.4 + 0.17 - 1e-6  # short of the box
-    rig.base.clock.wait(1.0)
-    assert rig.true_pose() == p  # and it stays there
+    rig.expect(seen, Status.SUCCESS)
+    assert rig.body.stats.collisions == 0
+    assert "round" in [e.kind for e in rig.ctx.trace]
+    assert rig.true_pose().y < 22.2
 
 
 @pytest.mark.parametrize("size", [0.4, 1.6])
@@ -129,7 +127,8 @@ def test_approach_drives_round_a_pillar_but_not_round_a_shut_corridor(make_rig, 
 
 def test_approach_stops_before_a_tall_obstacle_seen_in_depth(make_rig):
     rig = make_rig(Pose2D(0.0, 26.5, SOUTH))
-    rig.add_obstacle(0.1, 24.0, size=0.8, height=1.9)  # a cabinet: in view up close
+    # a cabinet: in view up close, 0.35 m beside it (the body is 0.34 m across)
+    rig.add_obstacle(0.1, 24.0, size=1.5, height=1.9)
     rig.set(target=room4_step(rig))
     seen = rig.run(Approach("Approach", rig.ctx), max_ticks=400)
     rig.expect(seen, Status.FAILURE)

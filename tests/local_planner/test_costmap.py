@@ -83,3 +83,27 @@ def test_inflation_by_the_body_radius_and_a_falling_cost_beyond():
 def test_a_costmap_that_is_not_sensible_is_refused():
     with pytest.raises(ValueError, match="not sensible"):
         LocalCostmap(size=6.0, resolution=0.0)
+
+
+@pytest.mark.world
+def test_a_person_seen_gone_up_close_is_cleared_a_low_box_below_the_view_is_kept(make_rig):
+    """Within 3.7 m the camera sees no floor, so only the height of a mark tells: a
+    person-high mark 1.75 m ahead whose column the next frame's rays pass through is seen
+    gone; a low box seen from afar and now below the view stays marked as the robot
+    comes near."""
+    rig = make_rig(Pose2D(0.0, 29.5, SOUTH), width=320, height=240)
+    person = rig.add_obstacle(0.0, 27.5, size=0.5, height=1.7)
+    rig.add_obstacle(0.6, 24.0, size=0.4, height=0.4)  # low, beside the way, 5.3 m off
+    cm = LocalCostmap()
+    cm.add_depth(rig.base.observe(), now=0.0)
+    assert occupied_near(cm, 0.0, 27.75, 0.3) >= 3
+    rig.world.remove_obstacle(person)
+    rig.obstacles.remove(person)
+    cm.add_depth(rig.base.observe(), now=1.0)
+    assert occupied_near(cm, 0.0, 27.75, 0.3) == 0  # walked on: the rays pass through
+    rig.body.set_pose(Pose2D(0.0, 28.2, SOUTH))  # the low box 4 m off: seen
+    cm.add_depth(rig.base.observe(), now=2.0)
+    assert occupied_near(cm, 0.6, 24.2, 0.3) >= 3
+    rig.body.set_pose(Pose2D(0.0, 26.0, SOUTH))  # 1.8 m off: below the view
+    cm.add_depth(rig.base.observe(), now=3.0)
+    assert occupied_near(cm, 0.6, 24.2, 0.3) >= 3
