@@ -272,7 +272,9 @@ class DriveTo(PmNavBehaviour):
                     found = self.inspect(obs, est, target)
                     found["walls"] = line = measure_walls(self.ctx.grounder, obs)
                     if line is not None and tf is not None:
-                        found["axis"] = axis_correction(self.ctx.pm, tf, obs.pose, line)
+                        found["axis"] = axis_correction(
+                            self.ctx.pm, tf, obs.pose, line, self.ctx.walls.field
+                        )
                     found["ahead"] = ahead = _toward_goal(obs, est, goal)
                     found["wall_across"] = _wall_across(obs, est, goal, ahead)
                     blocked = _closer_than_goal(ahead, est, goal)

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
+import numpy as np
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.belief import wall_mask
@@ -23,6 +25,9 @@ from pmnav_bt.pose.walls import (
     wall_points,
 )
 from pmnav_bt.seams import Pose2D
+
+if TYPE_CHECKING:
+    from pmnav_bt.pose.evidence.likelihood_field import LikelihoodField
 
 MAX_WALL_CORRECTION = math.radians(15.0)  # larger: a side corridor's wall, not drift
 
@@ -126,6 +131,12 @@ AXIS_MAX_TURN = math.radians(10.0)  # a wall more oblique than this is not the c
 AXIS_GAIN = 0.5  # share of the measured heading and lateral error removed per frame
 MIN_WALL_LENGTH_M = 1.5  # a wall line this long, not a door frame or a pillar
 MAX_SHIFT_M = 0.5  # the most one frame moves the estimate across the corridor
+# With a grid: a wall seen up to this far away is weighed (a wall farther is seen at a
+# slant too flat to place it across), and it is the grid's when the grid has a wall within
+# this of where it was seen, from the estimate (the estimate's error across a corridor is
+# under a metre between fixes; more is another wall).
+GRID_REACH_M = 4.0
+GRID_MATCH_M = 1.0
 
 
 def measure_walls(grounder, obs) -> WallLine | None:
@@ -146,34 +157,63 @@ class AxisCorrection:
     words: str | None
 
 
-def axis_correction(pm, map_T_odom, odom: Pose2D, line: WallLine) -> AxisCorrection:
+def axis_correction(
+    pm, map_T_odom, odom: Pose2D, line: WallLine, grid: LikelihoodField | None = None
+) -> AxisCorrection:
     """The correction a corridor wall ``line`` seen from odometry pose ``odom`` makes to
     ``map_T_odom``: its direction gives the heading relative to the corridor axis, its
     distance the position across the corridor (``AXIS_GAIN`` of each). Worked out in the
     worker beside the wall's measurement (``measure_walls``): finding the corridor on the
-    map is most of a drive's slowest ticks (issue 37)."""
+    map is most of a drive's slowest ticks (issue 37).
+
+    Where the wall is across the corridor comes from ``grid`` where the building has one
+    (the wall model the belief weighs depth against, ``Context.walls.field``): the grid's
+    wall on the side the wall was seen, looked for straight across the corridor from the
+    estimate (``grid_lateral``). Without a grid, the corridor's rectangle: its side at half
+    its width. A real corridor is not its rectangle: an imported corridor's line runs off
+    the middle of a corridor whose walls are not abreast (the office's lane past the
+    pantry), and a rectangle about it put the far wall where there is none, so every wall
+    seen there pulled the estimate towards that wall by the difference."""
     est = map_pose(map_T_odom, odom)
     seg = pm.locate(est.x, est.y).segment
     turn = heading_correction(odom.yaw + line.angle, map_T_odom[2], seg.heading)
-    if abs(turn) > AXIS_MAX_TURN or not 0.1 < abs(line.offset) < seg.width:
+    reach = GRID_REACH_M if grid is not None else seg.width
+    if abs(turn) > AXIS_MAX_TURN or not 0.1 < abs(line.offset) < reach:
         return AxisCorrection(map_T_odom, None, None)
     turned = rotated(map_T_odom, AXIS_GAIN * turn, (odom.x, odom.y))
     est = map_pose(turned, odom)
-    a = pm.node_xy(seg.a)
     u = (math.cos(seg.heading), math.sin(seg.heading))
     n = (-u[1], u[0])  # the corridor's left
-    lateral = n[0] * (est.x - a[0]) + n[1] * (est.y - a[1])
     # The line's left normal (body) is the corridor's left, or its right.
     side = 1.0 if math.cos(est.yaw + line.angle - seg.heading) >= 0.0 else -1.0
     wall = side * line.offset  # the wall relative to the robot, across the corridor
-    true_lateral = (seg.width / 2.0 if wall > 0.0 else -seg.width / 2.0) - wall
-    shift = max(-MAX_SHIFT_M, min(MAX_SHIFT_M, AXIS_GAIN * (true_lateral - lateral)))
+    if grid is not None:
+        error = grid_lateral(grid, (est.x, est.y), n, wall)
+        if error is None:
+            return AxisCorrection(map_T_odom, None, None)
+    else:
+        a = pm.node_xy(seg.a)
+        lateral = n[0] * (est.x - a[0]) + n[1] * (est.y - a[1])
+        error = (seg.width / 2.0 if wall > 0.0 else -seg.width / 2.0) - wall - lateral
+    shift = max(-MAX_SHIFT_M, min(MAX_SHIFT_M, AXIS_GAIN * error))
     x, y, yaw = turned
     return AxisCorrection(
         map_T_odom,
         (x + shift * n[0], y + shift * n[1], yaw),
         f"walls: heading {math.degrees(AXIS_GAIN * turn):+.1f} deg, across {shift:+.2f} m",
     )
+
+
+def grid_lateral(grid: LikelihoodField, xy, n, wall: float) -> float | None:
+    """How far (m, along the corridor's left ``n``) the estimate at map point ``xy`` must
+    move for the grid's wall on that side to be where depth saw it (``wall``: signed, m
+    across the corridor from the robot); None when the grid has no wall within
+    ``GRID_MATCH_M`` of that distance there (a doorway, a junction, another wall seen)."""
+    way = np.array([[n[0], n[1]]]) * math.copysign(1.0, wall)
+    found, _ = grid.march(np.array([xy], float), way, abs(wall) + GRID_MATCH_M)
+    if not math.isfinite(float(found[0])) or abs(float(found[0]) - abs(wall)) > GRID_MATCH_M:
+        return None
+    return math.copysign(float(found[0]) - abs(wall), wall)
 
 
 def keep_on_axis(
@@ -189,7 +229,7 @@ def keep_on_axis(
     tracker = tracker_of(b)
     fix = worked
     if fix is None or fix.before != tracker.map_T_odom:
-        fix = axis_correction(b.ctx.pm, tracker.map_T_odom, odom, line)
+        fix = axis_correction(b.ctx.pm, tracker.map_T_odom, odom, line, b.ctx.walls.field)
     if fix.after is None:
         return None
     tracker.map_T_odom = fix.after

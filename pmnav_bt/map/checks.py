@@ -27,9 +27,10 @@ import numpy as np
 from pmnav_bt.errors import Problem
 from pmnav_bt.geometry import project_points_to_segments
 from pmnav_bt.map.building import Building, WaypointKind
+from pmnav_bt.map.corridor_band import free_band
 from pmnav_bt.map.floorplan import DOOR_WIDTH_M, FloorPlanImage, door_frames, load_floor_plan
 from pmnav_bt.map.free_space import free_space_polygon, free_space_rings
-from pmnav_bt.map.grid import centre_line_width, distance_map, free_mask
+from pmnav_bt.map.grid import free_mask
 from pmnav_bt.map.landmark_kinds import landmark_shape
 from pmnav_bt.map.wall_items import wall_item_warnings
 from pmnav_bt.map.wall_surface import SEARCH_M, RealWalls, nearest_boundary_point
@@ -176,14 +177,10 @@ def sign_warnings(b: Building, range_m: float = SIGN_RANGE_M) -> list[Problem]:
 
 def grid_warnings(b: Building, plan: FloorPlanImage) -> list[Problem]:
     """Centre lines through non-free grid cells; widths the grid disagrees with."""
-    free = free_mask(plan)  # map_server's free cells, small clutter (bins, desks) filled
-    dist = distance_map(free)  # widths: clutter does not narrow a corridor
+    free = free_mask(plan)  # map_server's free cells, small clutter (bins, desks) filled:
+    # widths are wall to wall, the band the centre line keeps free all along (corridor_band)
     open_ = free_mask(plan, clutter_m=0.0)  # the path: clutter on the centre line blocks it
     seg_a, seg_b = _segments(b)
-    half_at = {}
-    for e in b.edges:
-        for wid in (e.a, e.b):
-            half_at[wid] = max(half_at.get(wid, 0.0), b.edge_width(e) / 2.0)
     out = []
     step = plan.resolution
     for i, e in enumerate(b.edges):
@@ -223,18 +220,17 @@ def grid_warnings(b: Building, plan: FloorPlanImage) -> list[Problem]:
                         f"({mid[0]:.2f}, {mid[1]:.2f}): {then}",
                     )
                 )
-        measured = centre_line_width(
-            plan, dist, seg_a[i], seg_b[i], half_at[e.a] + 0.2, half_at[e.b] + 0.2
-        )
-        if measured is None:
+        band = free_band(plan, free, seg_a[i], seg_b[i])
+        if band is None or not math.isfinite(band.about_line):
             continue
+        measured = band.about_line
         width = b.edge_width(e)
         if abs(measured - width) > WIDTH_TOL_M:
             out.append(
                 Problem(
                     f"edges[{i}]",
                     f"{e.a}-{e.b} is annotated {width:.2f} m wide but the grid shows about "
-                    f"{measured:.2f} m (measured from the centre line): set width: "
+                    f"{measured:.2f} m (the band free all along the centre line): set width: "
                     f"{measured:.2f} or move the centre line",
                 )
             )

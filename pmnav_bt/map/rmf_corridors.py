@@ -11,9 +11,10 @@ their centre lines, and they also lead into rooms and to parking spots. The step
    nodes that only continue a straight line are dropped; the largest connected part is
    kept, the others are listed as skipped.
 3. **Centred and measured**: across each corridor, rays out to ``CAP_M`` on both sides
-   find the walls, and each side's clearance is what it keeps over every stretch of
-   ``NARROW_RUN_M`` (a corridor is one rectangle about its centre line, so its width is
-   what is free all along, not a median over a lane that passes a gap). Where both sides
+   find the walls, and each side's clearance is what it keeps all along
+   (``corridor_band``, the measure ``pmnav validate`` checks widths by: a corridor is one
+   rectangle about its centre line, so its width is what is free all along, not a median
+   over a lane that passes a gap). Where both sides
    hit, the centre line moves to the middle of that band and the width is its breadth
    (unless the middle runs into more obstacles than the lane, a hall's pillars: then the
    lane and twice its nearer clearance); where one side is open (a hall), the line stays
@@ -22,7 +23,8 @@ their centre lines, and they also lead into rooms and to parking spots. The step
    is carried on along its corridor while walls stand on both sides ahead (a lane that
    stops at a parking spot half way down a corridor).
 4. **Key waypoints** at the least-squares crossing of their corridors' centre lines, so
-   every waypoint is on every centre line that meets there.
+   every waypoint is on every centre line that meets there; each corridor's width is then
+   measured again about its placed line (the measure ``pmnav validate`` checks).
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
+from pmnav_bt.map.corridor_band import REACH_M, WALLED, free_band
 from pmnav_bt.map.floorplan import FloorPlanImage
 from pmnav_bt.map.grid import free_mask
 from pmnav_bt.map.rmf_read import RmfLevel
@@ -40,15 +43,13 @@ from pmnav_bt.map.rmf_read import RmfLevel
 MERGE_M = 0.3  # lane ends closer than this are one node
 SPUR_M = 1.5  # dead-end corridors shorter than this are stubs, not corridors
 STRAIGHT_DEG = 12.0  # a node whose two corridors bend less than this is dropped
-CAP_M = 5.0  # rays look this far for a wall on each side
+CAP_M = REACH_M  # rays look this far for a wall on each side
 WALL_GAP_M = 0.15  # a cut lane stops this far short of the wall it meets
 MIN_EDGE_M = 0.8  # waypoints closer than this after centring are merged
 MIN_WIDTH_M = 0.6
 OPEN_WIDTH_M = 3.0  # the width of a lane across a hall with no wall within CAP_M either side
 EXTEND_M = 30.0  # a dead end is carried on at most this far
-WALLED = 0.5  # a stretch is corridor-shaped where this share has walls on both sides
 CROSSING_DEG = 20.0  # corridors meeting at more than this fix their waypoint by crossing
-NARROW_RUN_M = 0.5  # a narrowing at least this long sets a corridor's width
 
 
 @dataclass
@@ -59,6 +60,9 @@ class Corridors:
     edges: list[tuple[int, int, float]]
     skipped: list[str] = field(default_factory=list)
     cuts: int = 0  # lanes cut where they left the free space
+    # edges whose width is drawn, not measured: a spur runs half its width in front of its
+    # door's wall (rmf_spurs), whatever the space across from it
+    drawn: set[frozenset] = field(default_factory=set)
 
 
 def lane_corridors(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray) -> Corridors:
@@ -85,8 +89,10 @@ def lane_corridors(level: RmfLevel, plan: FloorPlanImage, free: np.ndarray) -> C
     pos = _place(g, lines)
     g, pos = _merge_after(g, pos, widths)
     _extend_dead_ends(g, pos, widths, plan, (free, walls))
-    edges = [(u, v, round(widths[frozenset((u, v))], 2)) for u, v in g.edges]
-    return Corridors({n: pos[n] for n in g.nodes}, edges, skipped, cuts)
+    edges = [(u, v, widths[frozenset((u, v))]) for u, v in g.edges]
+    cor = Corridors({n: pos[n] for n in g.nodes}, edges, skipped, cuts)
+    measure_widths(cor, plan)
+    return cor
 
 
 # -- 1. lanes inside the free space -------------------------------------------------------
@@ -205,48 +211,20 @@ def _drop_straight(g: nx.Graph) -> None:
 def _centre(plan: FloorPlanImage, free, walls, a: np.ndarray, b: np.ndarray):
     """((point, unit direction) of the centred line, width) of the corridor along a-b.
 
-    Rays look for walls in ``walls`` (the free space with small obstacles filled in); the
-    centred line must not run into more of ``free``'s obstacles than the lane does.
+    The band is measured in ``walls`` (the free space with small obstacles filled in,
+    ``corridor_band``); the centred line must not run into more of ``free``'s obstacles
+    than the lane does.
     """
     length = float(np.linalg.norm(b - a))
     u = (b - a) / length
     n = np.array([-u[1], u[0]])
-    trim = min(0.5, length / 4.0)
-    s = np.linspace(trim, length - trim, max(3, int(length / 0.25)))
-    t = np.arange(plan.resolution / 2.0, CAP_M, plan.resolution / 2.0)
-    dist = []
-    for side in (1.0, -1.0):
-        pts = a + s[:, None, None] * u + side * t[None, :, None] * n
-        ok = plan.mask_at(walls, pts.reshape(-1, 2)).reshape(len(s), len(t))
-        hit = ~ok.all(axis=1)
-        first = np.where(hit, np.argmin(ok, axis=1), len(t) - 1)
-        dist.append(np.where(hit, t[first], np.inf))
-    left, right = dist
-    walled = (np.isfinite(left) & np.isfinite(right)).mean() >= WALLED
+    band = free_band(plan, walls, a, b)
     mid = (a + b) / 2.0
-    near_l, near_r = _narrowest(left, s), _narrowest(right, s)
-    off, width = 0.0, 2.0 * min(near_l, near_r)
-    if walled:  # the middle of what is free all along
-        off, width = (near_l - near_r) / 2.0, near_l + near_r
+    off, width = band.offset, band.width
     if off and _blocked(plan, free, a + off * n, b + off * n) > _blocked(plan, free, a, b):
-        off, width = 0.0, 2.0 * min(near_l, near_r)  # the middle runs into a pillar: the lane
+        off, width = 0.0, 2.0 * min(band.left, band.right)  # the middle runs into a pillar
     width = width if np.isfinite(width) else OPEN_WIDTH_M
     return (mid + off * n, u), max(MIN_WIDTH_M, min(width, 2.0 * CAP_M))
-
-
-def _narrowest(clear: np.ndarray, s: np.ndarray) -> float:
-    """The clearance a side keeps along the whole line: the widest that every stretch of
-    ``NARROW_RUN_M`` has (``clear`` per sample at ``s``, inf where no wall is in reach).
-
-    A corridor is one rectangle about its centre line, so its half-width is what that
-    side leaves free all along, not a median: a lane through a gap between a room's
-    corner on one side and another's on the other (walls on both sides, but never
-    abreast) has a median wall-to-wall width of the hall, and the gap's is the robot's.
-    A narrowing shorter than ``NARROW_RUN_M`` (a grid speck, a door jamb) is not it."""
-    step = float(s[1] - s[0]) if len(s) > 1 else NARROW_RUN_M
-    k = min(len(clear), max(1, math.ceil(NARROW_RUN_M / max(step, 1e-9))))
-    runs = np.lib.stride_tricks.sliding_window_view(clear, k).max(axis=1)
-    return float(runs.min())
 
 
 def _blocked(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
@@ -292,6 +270,26 @@ def _extend_dead_ends(g: nx.Graph, pos: dict, widths: dict, plan, masks) -> None
         _, w = _centre(plan, free, walls, pos[n], end)
         widths[frozenset((n, m))] = (widths[frozenset((n, m))] * la + w * reach) / (la + reach)
         pos[n] = end
+
+
+def measure_widths(cor: Corridors, plan: FloorPlanImage) -> None:
+    """Each corridor's width as its placed centre line has it: the rectangle about that
+    line free all along (``Band.about_line``, what ``pmnav validate`` checks), in the
+    plan's free cells with small clutter filled in. Placing the waypoints at their lines'
+    crossings moves a line off the band it was centred in (the office's corridor past the
+    hardware room: 5.35 m wide from its lane, its placed line 1.35 m from one wall, so
+    its rectangle ran 1.3 m into that wall, and the robot's wall corrections, which take
+    the wall seen for the corridor's at half its width, pulled it off), and a spur's foot
+    splits a corridor whose parts differ. A line with no wall in reach on either side,
+    and a drawn edge (``Corridors.drawn``), keep their widths."""
+    walls = free_mask(plan)
+    for k, (u, v, w) in enumerate(cor.edges):
+        band = None if frozenset((u, v)) in cor.drawn else free_band(
+            plan, walls, cor.pos[u], cor.pos[v]
+        )
+        if band is not None and math.isfinite(band.about_line):
+            w = max(MIN_WIDTH_M, band.about_line)
+        cor.edges[k] = (u, v, round(w, 2))
 
 
 def _place(g: nx.Graph, lines: dict) -> dict:

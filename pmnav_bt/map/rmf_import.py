@@ -39,7 +39,7 @@ from pmnav_bt.map.building import (
 )
 from pmnav_bt.map.floorplan import FloorPlanImage, load_image_plan, save_ros_map
 from pmnav_bt.map.grid import largest_component
-from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors
+from pmnav_bt.map.rmf_corridors import Corridors, lane_corridors, measure_widths
 from pmnav_bt.map.rmf_grid import level_grid, passage_doors
 from pmnav_bt.map.rmf_places import PLACE_WALL_M, plate_on_wall
 from pmnav_bt.map.rmf_read import RmfLevel, param, read_level
@@ -95,6 +95,7 @@ def import_rmf(path: str | Path, out: str | Path, level: str | None = None) -> I
     doors = _doors(lvl, passages, skipped)
     lift_doors = [(ld, np.asarray(ld.pos), ld.along) for ld in lvl.lift_doors if ld.cabin]
     spurs = _add_spurs(cor, plan, free, doors, lift_doors)
+    measure_widths(cor, plan)  # the corridors a spur's foot split, measured part by part
     ids: set[str] = set()
     names = _waypoint_names(cor, lvl, _entrances(lvl, plan), skipped, ids)
     seg_a = np.array([cor.pos[u] for u, _, _ in cor.edges])

@@ -69,7 +69,7 @@ def add_spur(
     node = _node_at(cor, k, foot)
     new = max(cor.pos) + 1
     cor.pos[new] = end
-    cor.edges.append((node, new, round(2.0 * SPUR_HALF_M, 2)))
+    _add_drawn(cor, node, new)
     return True
 
 
@@ -110,7 +110,7 @@ def turn_at_door(
     cor.pos[end] = knee
     new = max(cor.pos) + 1
     cor.pos[new] = tip
-    cor.edges.append((end, new, round(2.0 * SPUR_HALF_M, 2)))
+    _add_drawn(cor, end, new)
     return True
 
 
@@ -132,8 +132,8 @@ def _add_bent_spur(cor, plan, free, door, along, normal, past) -> bool:
         node = _node_at(cor, int(j[0]), foot)
         k1 = max(cor.pos) + 1
         cor.pos[k1], cor.pos[k1 + 1] = knee, end
-        w = round(2.0 * SPUR_HALF_M, 2)
-        cor.edges += [(node, k1, w), (k1, k1 + 1, w)]
+        cor.edges.append((node, k1, round(2.0 * SPUR_HALF_M, 2)))  # measured with the rest
+        _add_drawn(cor, k1, k1 + 1)  # along the door's wall
         return True
     return False
 
@@ -166,6 +166,12 @@ def _clear(plan: FloorPlanImage, free: np.ndarray, a: np.ndarray, b: np.ndarray)
     return bool(plan.mask_at(free, a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).all())
 
 
+def _add_drawn(cor: Corridors, u: int, v: int) -> None:
+    """A spur's piece u-v: ``2 * SPUR_HALF_M`` wide, drawn so (``Corridors.drawn``)."""
+    cor.edges.append((u, v, round(2.0 * SPUR_HALF_M, 2)))
+    cor.drawn.add(frozenset((u, v)))
+
+
 def _node_at(cor: Corridors, k: int, foot: np.ndarray) -> int:
     """The node at ``foot`` on edge ``k``: an end of the edge when near, else a new one
     that splits the edge in two."""
@@ -177,4 +183,6 @@ def _node_at(cor: Corridors, k: int, foot: np.ndarray) -> int:
     cor.pos[new] = np.asarray(foot, float)
     cor.edges[k] = (u, new, w)
     cor.edges.append((new, v, w))
+    if frozenset((u, v)) in cor.drawn:
+        cor.drawn |= {frozenset((u, new)), frozenset((new, v))}
     return new

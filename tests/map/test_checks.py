@@ -104,6 +104,20 @@ def test_width_disagreeing_with_the_grid():
     assert "annotated 4.00 m wide but the grid shows about 2.3" in w[0].message
 
 
+def test_a_width_is_checked_by_the_band_free_all_along_not_a_median():
+    # A 2.4 m corridor (2.3 m free) with a block 0.6 m deep on its south wall over 3 m of
+    # its 20: the centre line keeps about 0.6 m on that side. The median from the line
+    # still says about 2.3 m; the rectangle about the line that is free all along (the
+    # measure import-rmf sizes by) is about 1.2 m wide.
+    plan = rasterize_building(_b(_corridor()))
+    (c0, r0), (c1, r1) = plan.world_to_pixel([[8.5, -1.2], [11.5, -0.55]]).round().astype(int)
+    plan.image[min(r0, r1) : max(r0, r1) + 1, c0 : c1 + 1] = 0
+    wide = grid_warnings(_b(_corridor(width=2.3)), plan)
+    assert [x.field for x in wide] == ["edges[0]"]
+    assert "the grid shows about 1.2" in wide[0].message
+    assert grid_warnings(_b(_corridor(width=1.2)), plan) == []
+
+
 def test_too_few_signs():
     d = _data()
     d["rooms"] = [r for r in d["rooms"] if r["door"][0] < 20 and r["door"][1] > 0]

@@ -83,6 +83,35 @@ def test_a_corridors_width_is_what_it_leaves_free_all_along_not_a_median(tmp_pat
     assert imp.grid.mask_at(imp.grid.occupancy() == 0, pts).all()
 
 
+def test_a_placed_line_off_its_band_is_as_wide_as_it_keeps_free():
+    # A 20 m corridor 2.4 m wide (2.3 m free) whose line, as the waypoints were placed,
+    # runs 0.7 m north of its middle: the rectangle about it that is free all along is
+    # twice its 0.45 m to the north wall, not the corridor's 2.3 m.
+    from pmnav_bt.map.building import building_from_data
+    from pmnav_bt.map.floorplan import rasterize_building
+    from pmnav_bt.map.rmf_corridors import Corridors, measure_widths
+
+    b = building_from_data(
+        {
+            "schema_version": 1,
+            "name": "one",
+            "waypoints": [
+                {"id": "start", "kind": "start", "pos": [0.0, 0.0]},
+                {"id": "end1", "kind": "end", "pos": [20.0, 0.0]},
+            ],
+            "edges": [["start", "end1"]],
+        }
+    )
+    plan = rasterize_building(b)
+    cor = Corridors({0: np.array([0.0, 0.7]), 1: np.array([20.0, 0.7])}, [(0, 1, 2.3)])
+    measure_widths(cor, plan)
+    assert cor.edges[0][2] == pytest.approx(0.9, abs=0.1)
+    cor.drawn.add(frozenset((0, 1)))  # a spur's width is drawn, not measured
+    cor.edges[0] = (0, 1, 1.8)
+    measure_widths(cor, plan)
+    assert cor.edges[0][2] == 1.8
+
+
 def test_named_door_becomes_a_room_on_its_wall_and_the_charger_the_start(example, tmp_path):
     imp = import_rmf(example, tmp_path / "out.yaml")
     (room,) = imp.building.rooms
@@ -232,8 +261,13 @@ def test_real_rmf_buildings_import_and_validate(rmf_maps, tmp_path, capsys, name
     out = tmp_path / f"{name}.yaml"
     imp = import_rmf(rmf, out, level)
     write_import(imp, out)
-    code, _, err = run_pmnav(capsys, "validate", out)
+    code, out_text, err = run_pmnav(capsys, "validate", out)
     assert code == 0, err
+    # The import sizes its corridors by the measure validate checks (corridor_band), on
+    # the lines as placed: no width warning but on a spur's piece along its door's wall,
+    # whose width is drawn (1.8 m).
+    widths = [x for x in (out_text + err).splitlines() if "wide but the grid shows" in x]
+    assert [x for x in widths if "annotated 1.80 m" not in x] == []
     raw = yaml.safe_load(rmf.read_text())["levels"][imp.level.name]["doors"]
     named = {d[2]["name"][1] for d in raw}
     passages = {s.split("'")[1] for s in imp.skipped if "a passage" in s}
