@@ -6,11 +6,16 @@ recogniser needs the capitals a dozen pixels high. Such a plate is not "absent":
 robot can go where it is read (``behaviours/active_read.py``). A plate is *unread* when
 its text was not read at all, or was read and fits a room of the building as well as
 another or no better than a plate the building does not hold (``ambiguous``: below the
-matcher's confidence). A read that clearly names nothing of the map (a directional sign,
-a notice) is not unread: it was read.
+matcher's confidence), or was read unsure (``SignMatcher.unsure``: a character read at a
+confidence the OCR is often wrong at, or a code spelled as none of the building's: "79"
+where the rooms are "209"s is a plate misread, not a plate the building lacks). A read
+that surely names nothing of the map (a directional sign, a notice) is not unread: it
+was read.
 
 What the tree needs of an unread plate comes from depth (``depth.plate_pose``): its
-centre and the wall's normal in the odometry frame, the height of its centre, and its
+centre and which way its text faces in the odometry frame (the wall's normal; along the
+wall, towards where it was seen, for text read more aslant than a flat plate is read:
+a flag sign, ``text_facing``), the height of its centre, and its
 text-line height in metres (the candidate's line height in pixels at the plate's depth),
 by which the reading model says from how far a plate of that size is read
 (``read_range.plate_read_range``). Candidates that cannot be plates (off the wall's
@@ -34,7 +39,10 @@ import threading
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
+import numpy as np
+
 from pmnav_bt.perception.depth import PlatePose, plate_pose
+from pmnav_bt.perception.read_range import ANGLE_RECALL
 from pmnav_bt.perception.sign_match import Evidence
 from pmnav_bt.seams import Entity, Observation
 
@@ -45,6 +53,7 @@ MAX_PLATE_WIDTH_M = 1.2
 LINE_HEIGHT_M = (0.01, 0.2)  # a text line of a room plate: 20-80 mm capitals, as measured
 MAX_SEEN_M = 8.0  # farther than this, depth places a plate too poorly to drive to
 KEEP_S = 120.0  # an unread plate is remembered this long (clock s)
+FLAT_READ_DEG = ANGLE_RECALL[-2][0]  # (75) no flat plate is read farther off its normal
 
 
 @dataclass(frozen=True)
@@ -94,6 +103,28 @@ def hangs_like_a_plate(obs: Observation, plate: PlatePose) -> bool:
     return PLATE_Z_M[0] <= height <= PLATE_Z_M[1] and plate.width <= MAX_PLATE_WIDTH_M
 
 
+def text_facing(
+    centre: tuple[float, float], normal: tuple[float, float], read: bool
+) -> tuple[float, float]:
+    """Which way a plate's text faces (unit, camera body frame), from its ``centre`` and
+    depth's ``normal`` (towards the camera). Depth's normal is the wall's where the box
+    holds more wall than plate, as it does round a flag sign seen end-on; yet text that
+    was ``read`` faced the camera within ``FLAT_READ_DEG`` of its normal (no flat plate is
+    read beyond: ``read_range.ANGLE_RECALL``). So a plate read more aslant than that
+    projects across its wall: its text faces along the wall, towards the camera."""
+    n = np.asarray(normal, float)
+    to_camera = -np.asarray(centre, float)
+    dist = float(np.linalg.norm(to_camera))
+    if not read or dist < 1e-6:
+        return float(n[0]), float(n[1])
+    to_camera /= dist
+    if math.degrees(math.acos(float(np.clip(n @ to_camera, -1.0, 1.0)))) <= FLAT_READ_DEG:
+        return float(n[0]), float(n[1])
+    along = np.array([n[1], -n[0]])
+    along = along if float(along @ to_camera) >= 0.0 else -along
+    return float(along[0]), float(along[1])
+
+
 def unread_plate(
     obs: Observation, box: tuple[float, float, float, float], line_px: float, read: str = ""
 ) -> UnreadPlate | None:
@@ -119,7 +150,7 @@ def unread_plate(
         return None
     p = obs.pose
     c, s = math.cos(p.yaw), math.sin(p.yaw)
-    nx, ny = float(plate.normal[0]), float(plate.normal[1])
+    nx, ny = text_facing((x, y), (float(plate.normal[0]), float(plate.normal[1])), bool(read))
     return UnreadPlate(
         xy=(p.x + c * x - s * y, p.y + s * x + c * y),
         normal=(c * nx - s * ny, s * nx + c * ny),

@@ -163,8 +163,10 @@ class OcrGrounder:
             if sign is None or ev is None:
                 self._unread(obs, box, line_px, "")
                 continue
-            lines = [(ln.text, ln.score) for ln in sign.lines]
-            if ambiguous(ev) or (picto is not None and picto.ambiguous):
+            lines = [(ln.text, ln.score, ln.char_scores) for ln in sign.lines]
+            # A read that names nothing for sure is a plate to read again, not another one.
+            unsure = ambiguous(ev) or self.matcher.unsure(lines)
+            if unsure or (picto is not None and picto.ambiguous):
                 self._unread(obs, box, line_px, sign.text)
             if self._observer is not None and self.matcher.trusted(lines):
                 unmatched.append(_unmatched(obs, sign))
