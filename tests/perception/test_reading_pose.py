@@ -141,3 +141,14 @@ def test_the_shipped_table_reads_larger_plates_from_farther():
     assert sorted(t.rows) and all(len(r) >= 2 for r in t.rows.values())
     lines = [h for h, _ in t.rows[max(t.rows)]]
     assert t.read_range(640, lines[0]) <= t.read_range(640, lines[-1])
+
+
+def test_a_line_lower_than_any_plates_text_is_no_unread_plate(wall):
+    # A door's lintel or frame edge closes into a "line" of a centimetre or so; a room
+    # plate's text line is at least 1.3 x its 20 mm capitals. Same box, two line heights.
+    obs = wall.frame([], range_m=1.8)
+    k = wall.K
+    px = k.fy / 1.8
+    box = (150.0, k.cy - 0.75 * px, 170.0, k.cy - 0.65 * px)
+    assert unread_plate(obs, box, 0.015 * px) is None
+    assert unread_plate(obs, box, 0.03 * px) is not None

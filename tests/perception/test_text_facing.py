@@ -34,3 +34,14 @@ def test_text_read_beyond_the_flat_range_faces_along_the_wall_towards_the_camera
 
 def test_a_plate_nothing_was_read_of_keeps_the_walls_normal():
     assert text_facing(seen_at(85.0), WALL_NORMAL, read=False) == pytest.approx(WALL_NORMAL)
+
+
+def test_a_flag_depth_shows_across_its_wall_faces_along_it_read_or_not():
+    # Depth's normal of a flag seen end-on may be anything (here 70 deg off the view:
+    # within the flat range); the wall fit says it stands across the wall.
+    centre = seen_at(70.0)
+    wall_dir = (1.0, 0.0)  # the wall's direction (door_scene.plate_wall's ``left``)
+    for read in (True, False):
+        f = text_facing(centre, WALL_NORMAL, read=read, across=wall_dir)
+        assert abs(f[1]) == pytest.approx(0.0)
+        assert -(f[0] * centre[0] + f[1] * centre[1]) > 0.0

@@ -246,7 +246,9 @@ class OcrGrounder:
             return self.memory.read(_odom(obs, plate.centre), (p.x, p.y, p.yaw), obs.stamp, ev), ev
 
     def _unread(self, obs: Observation, box: Box, line_px: float, read: str) -> None:
-        plate = unread_plate(obs, box, line_px, read)
+        # A plate with text read: which way the text faces (a flag's along its wall) is
+        # worth depth's wall fit; a patch of nothing read is not.
+        plate = unread_plate(obs, box, line_px, read, flags=bool(read))
         if plate is not None:
             self.unread.seen(plate)
 
