@@ -149,11 +149,14 @@ def unread_plate(
     read: str = "",
     *,
     flags: bool = False,
+    text_top_px: float | None = None,
 ) -> UnreadPlate | None:
     """The plate in ``box`` (frame pixels; ``line_px`` its text-line height in them) as
     depth places it, in the odometry frame; None without depth or where it cannot be a
     plate (see the module docstring). ``flags``: ask depth whether the plate stands across
-    its wall (``door_scene.plate_wall``; tens of ms), to know which way its text faces."""
+    its wall (``door_scene.plate_wall``; tens of ms), to know which way its text faces.
+    ``text_top_px``: the row of its text's top where text was read (else the box's top,
+    which takes in the plate's border and frame)."""
     h, w = obs.rgb.shape[:2]
     if min(box[0], box[1], w - 1 - box[2], h - 1 - box[3]) < BORDER_PX:
         return None
@@ -168,7 +171,8 @@ def unread_plate(
     k = obs.intrinsics
     line = line_px * x / k.fy
     height = z + obs.camera_height
-    top = obs.camera_height + (k.cy - box[1]) * x / k.fy  # the box's top edge at its depth
+    top_row = box[1] if text_top_px is None else text_top_px
+    top = obs.camera_height + (k.cy - top_row) * x / k.fy  # the text's top at its depth
     if not (
         hangs_like_a_plate(obs, plate)
         and LINE_HEIGHT_M[0] <= line <= LINE_HEIGHT_M[1]

@@ -152,3 +152,14 @@ def test_a_line_lower_than_any_plates_text_is_no_unread_plate(wall):
     box = (150.0, k.cy - 0.75 * px, 170.0, k.cy - 0.65 * px)
     assert unread_plate(obs, box, 0.015 * px) is None
     assert unread_plate(obs, box, 0.03 * px) is not None
+
+
+def test_a_read_plates_top_is_its_texts_not_its_borders(wall):
+    # The finder's box takes in the plate's border (2.35 m); the text read inside it starts
+    # lower (2.31 m): the standoff a high plate needs is from the text's top.
+    obs = wall.frame([], range_m=1.8)
+    k = wall.K
+    px = k.fy / 1.8
+    box = (150.0, k.cy - 0.75 * px, 170.0, k.cy - 0.65 * px)
+    plate = unread_plate(obs, box, 0.08 * px, "2O9", text_top_px=k.cy - 0.71 * px)
+    assert plate is not None and plate.top == pytest.approx(2.31, abs=0.02)

@@ -167,7 +167,8 @@ class OcrGrounder:
             # A read that names nothing for sure is a plate to read again, not another one.
             unsure = ambiguous(ev) or self.matcher.unsure(lines)
             if unsure or (picto is not None and picto.ambiguous):
-                self._unread(obs, box, line_px, sign.text)
+                # its text's top where the reader found it, not the plate's border
+                self._unread(obs, box, line_px, sign.text, sign.lines[0].box[1])
             if self._observer is not None and self.matcher.trusted(lines):
                 unmatched.append(_unmatched(obs, sign))
         result = _Read(signs, doors)
@@ -245,10 +246,12 @@ class OcrGrounder:
         with self._memory_lock:
             return self.memory.read(_odom(obs, plate.centre), (p.x, p.y, p.yaw), obs.stamp, ev), ev
 
-    def _unread(self, obs: Observation, box: Box, line_px: float, read: str) -> None:
+    def _unread(
+        self, obs: Observation, box: Box, line_px: float, read: str, top_px: float | None = None
+    ) -> None:
         # A plate with text read: which way the text faces (a flag's along its wall) is
         # worth depth's wall fit; a patch of nothing read is not.
-        plate = unread_plate(obs, box, line_px, read, flags=bool(read))
+        plate = unread_plate(obs, box, line_px, read, flags=bool(read), text_top_px=top_px)
         if plate is not None:
             self.unread.seen(plate)
 
