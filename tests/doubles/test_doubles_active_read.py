@@ -63,8 +63,4 @@ def test_a_plate_never_read_is_tried_n_times_then_the_search_moves_on(make_rig, 
     assert not any(e.data["read"] for e in rig.ctx.trace if e.kind == "active_read_done")
     # each try stood nearer than where the plate was last seen unread
     assert all(e.data["distance_m"] < e.data["seen_m"] for e in reads(rig))
-    # the second try goes to the plate the first faced, seen unread from its reading pose
-    first, second = reads(rig)[:2]
-    assert second.data["seen_m"] == pytest.approx(first.data["distance_m"], abs=0.15)
-    assert second.data["distance_m"] < first.data["distance_m"]
     assert FailureCode.TARGET_NOT_FOUND in (out.failure.code, getattr(out.cause, "code", None))
