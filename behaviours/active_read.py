@@ -28,7 +28,9 @@ a person walks up to it. So does the tree:
    target is still not read there.
 
 At most ``tree.active_reads`` tries a target (each nearer than the last: a plate is never
-read again from where it was seen and not read); then the search moves on as before. A
+read again from where it was seen and not read; the plate the last try faced and did not
+read is a candidate of the next, seen from that reading pose, beside the plates of the
+search between); then the search moves on as before. A
 grounder that reads every sign it sees (the oracle) has no unread plates: the leaf fails
 at once.
 """
@@ -119,6 +121,9 @@ class PlanReadingPose(PmNavBehaviour):
     def __init__(self, name, ctx):
         super().__init__(name, ctx)
         self._tries: dict[str, int] = {}  # target landmark -> reading poses planned
+        # target landmark -> when its last reading pose was planned: a plate seen (and not
+        # read) from that pose since is a candidate again, now seen from nearer
+        self._planned: dict[str, float] = {}
 
     def initialise(self) -> None:
         self._job = None
@@ -143,7 +148,8 @@ class PlanReadingPose(PmNavBehaviour):
         read = g.plate_named(entity)
         if read is not None and not (since - KEEP_S <= read.stamp < since):
             read = None  # read in this search (not found for another reason), or long ago
-        self._job = self.ctx.worker.submit(lambda c: plan(g.unread_plates(since), read))
+        seen_since = min(since, self._planned.get(t.landmark, since))
+        self._job = self.ctx.worker.submit(lambda c: plan(g.unread_plates(seen_since), read))
 
     def update(self) -> Status:
         if self._job is None:
@@ -157,6 +163,7 @@ class PlanReadingPose(PmNavBehaviour):
             self.feedback_message = why
             return Status.FAILURE
         self._tries[t.landmark] = self._tries.get(t.landmark, 0) + 1
+        self._planned[t.landmark] = self.ctx.now()
         self.bb.set("reading_pose", plan)
         p, pose = plan.plate, plan.pose
         self.ctx.log(

@@ -117,6 +117,17 @@ class NumberingScheme:
             return False
         return any(_fits(t, s) for s in self.shapes)
 
+    def parses(self, token: str) -> bool:
+        """Whether ``token`` (casefolded) is spelled as one of this building's codes,
+        character for character (a look-alike letter still counting as a digit and the
+        other way round): "79" or "2O9x" in a building of "209"s only looks like a code,
+        one character dropped or added, and is not one as read."""
+        t = token.casefold()
+        return any(
+            len(t) == len(s) and all(c in _classes(a) for a, c in zip(t, s, strict=True))
+            for s in self.shapes
+        )
+
 
 def _classes(c: str) -> str:
     """The shape characters that ``c`` may stand for as read."""

@@ -132,7 +132,7 @@ def door_for_plate(
     """The door of the plate at ``plate`` (its image ``box``), found in the scene (see the
     module docstring); ``prior``: the building's mounting for it, where its file says."""
     pts = back_project(obs)
-    wall = _wall_of(obs, pts, plate, box)
+    wall = plate_wall(obs, pts, plate, box)
     runs = door_runs(obs, pts, wall, box)
     s = _choose(runs, plate, layout, prior)
     if s is None:
@@ -184,7 +184,7 @@ def door_runs(
     return _runs(s[ok], door)
 
 
-def _wall_of(obs: Observation, pts: np.ndarray, plate: PlatePose, box) -> WallFrame:
+def plate_wall(obs: Observation, pts: np.ndarray, plate: PlatePose, box) -> WallFrame:
     """The wall ``plate`` hangs on or projects from (step 1). The lines are fitted on the
     wall pixels near the plate outside its box; the box's own points then tell a flat
     plate (on the line) from a flag (standing out of it, ``FLAG_OUT_M``), whose points all

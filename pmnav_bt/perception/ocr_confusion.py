@@ -107,6 +107,9 @@ class ConfusionModel:
     swap: float  # log p_swap
     dele: dict[str, float]  # log p_del(t)
     chars: int  # characters in the data (n)
+    # The share of characters read wrong in each bin of CONFIDENCE_BINS, all characters
+    # pooled: how often a character read at that confidence is not what the plate shows.
+    misread: tuple[float, ...] = ()
 
     @classmethod
     def from_counts(cls, t: dict) -> ConfusionModel:
@@ -145,10 +148,18 @@ class ConfusionModel:
             seen = right.get(c, 0) + sum(subs.get(c, {}).values())
             d = t["deletions"].get(c, 0)
             dele[c] = math.log((d + 0.5) / (seen + d + 1))
-        return cls(read_as, conf_right, conf_wrong, ins, swap, dele, chars)
+        misread = tuple(
+            (w + 0.5) / (n + 1) for n, w in zip(calib["read"], calib["wrong"], strict=True)
+        )
+        return cls(read_as, conf_right, conf_wrong, ins, swap, dele, chars, misread)
 
     def _bin(self, confidence: float) -> int:
         return max(0, sum(confidence >= b for b in CONFIDENCE_BINS) - 1)
+
+    def p_misread(self, confidence: float) -> float:
+        """How often a character read with ``confidence`` was read wrong (the calibration's
+        share in its bin; 0.5 without a calibration)."""
+        return self.misread[self._bin(confidence)] if self.misread else 0.5
 
     def log_read_right(self, read: str, scores: Sequence[float]) -> float:
         """log P(``read`` | the plate shows exactly ``read``)."""

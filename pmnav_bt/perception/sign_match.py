@@ -57,6 +57,10 @@ NAME_NULL = 0.78 - 0.1
 NAME_READ = NAME_NULL + MARGIN / NAME_WEIGHT  # (0.78) the similarity a name is read at
 P_UNKNOWN = 0.02  # a code read right that the building does not hold (another floor, a sign)
 SURE_DIGITS = 0.85  # recogniser score of digits a map update trusts (map_check.py)
+# A character the confusion model's calibration finds read wrong this often at its
+# confidence (below about 0.95: one in ten, against one in 400 at 0.999) leaves the read
+# unsure: it may be a plate of the building, misread (``SignMatcher.unsure``).
+UNSURE_P = 0.1
 # A pictogram sighting (already above the reader's calibrated confidence) on a room the map
 # says is not that amenity: a plate the map has wrong, or a misread; far less likely than a
 # plate the building does not hold (P_UNKNOWN), so it never names such a room.
@@ -183,6 +187,19 @@ class SignMatcher:
         """Whether every line showing digits was read with a recogniser score of at least
         ``SURE_DIGITS``: a plate that names nothing is written as a map update only then."""
         return not any(any(c.isdigit() for c in ln[0]) and ln[1] < SURE_DIGITS for ln in lines)
+
+    def unsure(self, lines: Sequence[Line]) -> bool:
+        """Whether a read that named nothing may still be a misread plate of the building,
+        to be read again rather than taken for a plate it does not hold: a character read
+        at a confidence the confusion model finds wrong at least ``UNSURE_P`` of the time,
+        or a token that looks like one of the building's codes (within one character) but
+        is not spelled as one ("79" or "2099" where every code is like "209")."""
+        for text, scores in _tokens(lines):
+            if any(self.model.p_misread(c) >= UNSURE_P for c in scores):
+                return True
+            if self.scheme.looks_like_code(text) and not self.scheme.parses(text):
+                return True
+        return False
 
     def numbered(self, text: str) -> Entity | None:
         """The one entity whose sign carries the code ``text`` starts with, when ``text``

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from py_trees.common import Status
 
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.map.catalogue import load_building
@@ -64,3 +65,38 @@ def test_a_plate_never_read_is_tried_n_times_then_the_search_moves_on(make_rig, 
     # each try stood nearer than where the plate was last seen unread
     assert all(e.data["distance_m"] < e.data["seen_m"] for e in reads(rig))
     assert FailureCode.TARGET_NOT_FOUND in (out.failure.code, getattr(out.cause, "code", None))
+
+
+def test_the_plate_the_last_try_faced_is_a_candidate_of_the_next(make_rig, pm):
+    # The first try faced the kitchen's plate and did not read it: the grounder saw it,
+    # unread, from the reading pose. The search after it did not see it (a flag above its
+    # views, a person before it): the next try still goes to it, from nearer.
+    from pmnav_bt.behaviours.active_read import PlanReadingPose
+    from pmnav_bt.perception.unread_plates import UnreadPlate
+    from pmnav_bt.seams import View
+
+    grounder = ScriptedGrounder(pm)
+    rig = make_rig(Pose2D(45.5, 0.0, 0.0), grounder=grounder, overrides=(OCR,))
+    plan = rig.ctx.planner.plan(pm, rig.ctx.base.pose(), "room13")
+    rig.bb.set("target", plan.steps[-1])
+
+    def seen_from(x: float) -> None:  # the plate, seen unread now from (x, 0)
+        grounder.unread.seen(UnreadPlate(
+            xy=KITCHEN_DOOR, normal=(0.0, -1.0), z=1.5, top=1.55, line_height=0.05,
+            width=0.3, stamp=rig.ctx.now(), seen_from=(x, 0.0)))  # fmt: skip
+
+    def search() -> None:  # a search's views: one frame, now
+        rig.bb.set("views", [View(0.0, rig.ctx.base.observe())])
+
+    plan_pose = PlanReadingPose("UnreadPlate", rig.ctx)
+    plan_pose.setup_with_descendants()
+    seen_from(45.5)
+    search()
+    assert rig.run(plan_pose)[-1] == Status.SUCCESS
+    first = rig.get("reading_pose")
+    rig.wait(2.0)
+    seen_from(first.pose.x)  # faced from the reading pose, still not read
+    rig.wait(2.0)
+    search()  # the next search sees no plate
+    assert rig.run(plan_pose)[-1] == Status.SUCCESS, plan_pose.feedback_message
+    assert rig.get("reading_pose").pose.distance < first.pose.distance

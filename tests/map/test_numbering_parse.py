@@ -49,3 +49,14 @@ def test_codes_as_ocr_reads_them_still_look_like_codes():
     two = parse_scheme(codes_of("2.04"))
     assert two.looks_like_code("2,04") and two.looks_like_code("204")
     assert set(SCHEMES) == {parse_scheme(codes_of(k)).name for k in SCHEMES}
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_a_code_read_one_character_short_or_long_looks_like_a_code_but_does_not_parse(scheme):
+    s = parse_scheme(codes_of(scheme))
+    code = max(codes_of(scheme), key=len).casefold()
+    assert s.parses(code)
+    near = code + code[-1]  # the longest code with one character read twice
+    assert s.looks_like_code(near) and not s.parses(near), near
+    short = parse_scheme(["209", "210"])
+    assert short.looks_like_code("79") and not short.parses("79") and short.parses("2O9")

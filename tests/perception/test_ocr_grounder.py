@@ -83,3 +83,18 @@ def test_the_door_side_follows_the_image(grounder, wall):
     obs.rgb[int(wall.K.cy - 0.2 * px_per_m) :, u0 : u0 + int(px_per_m)] = (148, 97, 51)
     (door,) = grounder.detect(obs, Entity.room("room5"))
     assert door.point[1] == pytest.approx(-1.14, abs=0.1)  # right of the sign
+
+
+def test_a_misread_code_is_a_plate_to_read_again_a_code_read_sure_is_not(fig2, wall):
+    # fig2's codes are three digits ("101"): "79" is spelled as none of them, a plate
+    # misread (the tree reads it again from nearer); "188", read sure and spelled as the
+    # building's codes, is a plate the building does not hold: read, naming nothing.
+    from pmnav_bt.perception.grounders.ocr import OcrGrounder
+
+    for text, again in (("79", True), ("188", False)):
+        g = OcrGrounder(fig2)
+        assert g.read_signs(wall.frame([(text, 0.0)], range_m=1.5)) == []
+        plates = g.unread_plates(0.0)
+        assert bool(plates) == again, text
+        if again:
+            assert plates[0].read == text

@@ -141,3 +141,25 @@ def test_the_shipped_table_reads_larger_plates_from_farther():
     assert sorted(t.rows) and all(len(r) >= 2 for r in t.rows.values())
     lines = [h for h, _ in t.rows[max(t.rows)]]
     assert t.read_range(640, lines[0]) <= t.read_range(640, lines[-1])
+
+
+def test_a_line_lower_than_any_plates_text_is_no_unread_plate(wall):
+    # A door's lintel or frame edge closes into a "line" of a centimetre or so; a room
+    # plate's text line is at least 1.3 x its 20 mm capitals. Same box, two line heights.
+    obs = wall.frame([], range_m=1.8)
+    k = wall.K
+    px = k.fy / 1.8
+    box = (150.0, k.cy - 0.75 * px, 170.0, k.cy - 0.65 * px)
+    assert unread_plate(obs, box, 0.015 * px) is None
+    assert unread_plate(obs, box, 0.03 * px) is not None
+
+
+def test_a_read_plates_top_is_its_texts_not_its_borders(wall):
+    # The finder's box takes in the plate's border (2.35 m); the text read inside it starts
+    # lower (2.31 m): the standoff a high plate needs is from the text's top.
+    obs = wall.frame([], range_m=1.8)
+    k = wall.K
+    px = k.fy / 1.8
+    box = (150.0, k.cy - 0.75 * px, 170.0, k.cy - 0.65 * px)
+    plate = unread_plate(obs, box, 0.08 * px, "2O9", text_top_px=k.cy - 0.71 * px)
+    assert plate is not None and plate.top == pytest.approx(2.31, abs=0.02)

@@ -163,9 +163,12 @@ class OcrGrounder:
             if sign is None or ev is None:
                 self._unread(obs, box, line_px, "")
                 continue
-            lines = [(ln.text, ln.score) for ln in sign.lines]
-            if ambiguous(ev) or (picto is not None and picto.ambiguous):
-                self._unread(obs, box, line_px, sign.text)
+            lines = [(ln.text, ln.score, ln.char_scores) for ln in sign.lines]
+            # A read that names nothing for sure is a plate to read again, not another one.
+            unsure = ambiguous(ev) or self.matcher.unsure(lines)
+            if unsure or (picto is not None and picto.ambiguous):
+                # its text's top where the reader found it, not the plate's border
+                self._unread(obs, box, line_px, sign.text, sign.lines[0].box[1])
             if self._observer is not None and self.matcher.trusted(lines):
                 unmatched.append(_unmatched(obs, sign))
         result = _Read(signs, doors)
@@ -243,8 +246,12 @@ class OcrGrounder:
         with self._memory_lock:
             return self.memory.read(_odom(obs, plate.centre), (p.x, p.y, p.yaw), obs.stamp, ev), ev
 
-    def _unread(self, obs: Observation, box: Box, line_px: float, read: str) -> None:
-        plate = unread_plate(obs, box, line_px, read)
+    def _unread(
+        self, obs: Observation, box: Box, line_px: float, read: str, top_px: float | None = None
+    ) -> None:
+        # A plate with text read: which way the text faces (a flag's along its wall) is
+        # worth depth's wall fit; a patch of nothing read is not.
+        plate = unread_plate(obs, box, line_px, read, flags=bool(read), text_top_px=top_px)
         if plate is not None:
             self.unread.seen(plate)
 
