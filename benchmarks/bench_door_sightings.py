@@ -11,6 +11,8 @@ score the detector: it sees RGB and depth.
 Run: python benchmarks/bench_door_sightings.py [--views 200] [--seed 0]
      [--buildings all,sign_sparse_0,sign_sparse_1,sign_sparse_2] [--range 14]
      [--walls grid] [--image docs/img/door_sightings.png]  (example views, doors boxed)
+     [--world realistic]  (furnished corridors: clutter, open doors, two-tone walls; the
+     scene drawn from --seed)
 Views are 320x240 as in the tree (``sim.width``); ``--width 640 --height 480`` for more.
 Prints recall per distance band, spurious detections per view and ms per frame.
 """
