@@ -11,6 +11,8 @@ score the detector: it sees RGB and depth.
 Run: python benchmarks/bench_door_sightings.py [--views 200] [--seed 0]
      [--buildings all,sign_sparse_0,sign_sparse_1,sign_sparse_2] [--range 14]
      [--walls grid] [--image docs/img/door_sightings.png]  (example views, doors boxed)
+     [--world realistic]  (furnished corridors: clutter, open doors, two-tone walls; the
+     scene drawn from --seed)
 Views are 320x240 as in the tree (``sim.width``); ``--width 640 --height 480`` for more.
 Prints recall per distance band, spurious detections per view and ms per frame.
 """
@@ -23,6 +25,7 @@ import time
 
 import numpy as np
 
+from pmnav_bt.config import WorldConfig
 from pmnav_bt.map.catalogue import builtin_buildings, load_building, resolve_building_path
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.perception.depth import back_project, surfaces
@@ -45,6 +48,9 @@ def main() -> None:
     ap.add_argument("--width", type=int, default=320, help="camera pixels (the tree's views)")
     ap.add_argument("--height", type=int, default=240)
     ap.add_argument("--walls", default="corridors", help="corridors or grid (sim.walls)")
+    ap.add_argument(
+        "--world", default="clean", help="world preset: clean or realistic (docs/worlds.md)"
+    )
     ap.add_argument("--image", default="", help="write two example views here, doors boxed")
     ap.add_argument("--show-spurious", action="store_true", help="print each spurious one")
     args = ap.parse_args()
@@ -62,7 +68,10 @@ def main() -> None:
         building = load_building(path)
         vis = Visibility.of(parse_building(building))
         pts = vis.lattice_points
-        with SimWorld(building, walls=args.walls, base_dir=path.parent) as world:
+        scene = WorldConfig(preset=args.world)
+        with SimWorld(
+            building, walls=args.walls, base_dir=path.parent, scene=scene, seed=args.seed
+        ) as world:
             items = list(world.doors.values()) + list(world.landmarks.values())
             centres = np.array([it.centre for it in items])
             base = SimBase(world, width=args.width, height=args.height)

@@ -34,6 +34,7 @@ from pmnav_bt.map.priori_map import PrioriMap
 from pmnav_bt.pose import lead as leads
 from pmnav_bt.pose import telling
 from pmnav_bt.pose.evidence import Evidence
+from pmnav_bt.pose.evidence.doors import scene_weights
 from pmnav_bt.pose.evidence.floor_model import CORRIDORS, WallSource
 from pmnav_bt.pose.evidence.prior import P_FAR, weigh_prior
 from pmnav_bt.pose.evidence.signs import PLACE_SIGMA_M, SIGHT_SIGMA_M
@@ -99,6 +100,11 @@ class CorridorBelief:
     # tick that asks (``FixFromBelief``) reads them: on a sign-sparse building's belief a
     # fix weighs every depth ray held against the walls (tens of ms).
     _answers: dict | None = field(default=None, init=False, repr=False)
+    # Each look's doors (``Evidence.look_doors``, one per glimpse) and what they add to
+    # ``logw`` together: each weighed by ``doors.scene_weights``, which a new look changes
+    # for the looks that see the same stretch of wall.
+    _door_looks: list[np.ndarray] = field(default_factory=list, init=False, repr=False)
+    _door_sum: np.ndarray | float = field(default=0.0, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self.vis = Visibility.of(self.pm, self.read_range)
@@ -124,6 +130,7 @@ class CorridorBelief:
             list(self.rays),
             self.logw.copy(),
         )
+        other._door_looks = list(self._door_looks)
         return other
 
     # -- the hypotheses -------------------------------------------------------------------
@@ -175,6 +182,7 @@ class CorridorBelief:
         self._answers = None
         self.hyps = Hypotheses.on_lattice(self.vis, self.pm.segments, self.axis_offset)
         self.logw = np.zeros(len(self.hyps))
+        self._door_looks, self._door_sum = [], 0.0
         if self.ref is None:
             return
         if self.prior is not None:
@@ -182,8 +190,21 @@ class CorridorBelief:
         tfs = self.map_T_odoms()  # the hypotheses and the reference are fixed from here
         for g in self.glimpses:
             self.evidence.look(self.logw, g, tfs, self.ref)
+            self._door_looks.append(self.evidence.look_doors(g, tfs, self.ref))
+        self._weigh_doors()
         for r in self.rays:
             self.evidence.drive_view(self.logw, r, tfs, self.ref)
+
+    def _weigh_doors(self) -> None:
+        """Put the looks' doors into ``logw`` afresh, each look's weighed by how many
+        looks see the same wall (``doors.scene_weights``)."""
+        xy = np.array([(g.odom.x, g.odom.y) for g in self.glimpses])
+        k = scene_weights(xy)
+        total = np.zeros(len(self.hyps))
+        for w, lw in zip(k, self._door_looks, strict=True):
+            total = total + w * lw
+        self.logw = self.logw - self._door_sum + total
+        self._door_sum = total
 
     # -- updates --------------------------------------------------------------------------
 
@@ -223,7 +244,10 @@ class CorridorBelief:
             door_views=tuple(wrap_angle(y - drift) for y in glimpse.door_views),
         )
         self.glimpses.append(g)
-        self.evidence.look(self.logw, g, self.map_T_odoms(), self.ref)
+        tfs = self.map_T_odoms()
+        self.evidence.look(self.logw, g, tfs, self.ref)
+        self._door_looks.append(self.evidence.look_doors(g, tfs, self.ref))
+        self._weigh_doors()
 
     def observe_ray(
         self,

@@ -24,6 +24,12 @@ from pmnav_bt.geometry import se2_apply, se2_compose
 from pmnav_bt.map.generate import generate_sign_sparse
 from pmnav_bt.map.priori_map import parse_building
 from pmnav_bt.pose.belief import CorridorBelief
+from pmnav_bt.pose.evidence.doors import (
+    P_DOOR_SCENE,
+    P_DOOR_SPURIOUS,
+    scene_capped,
+    scene_weights,
+)
 from pmnav_bt.pose.glimpse import Glimpse
 from pmnav_bt.pose.visibility import Visibility, entity_xy
 from pmnav_bt.seams import Entity, Pose2D
@@ -273,3 +279,20 @@ def test_doors_seen_far_along_the_walls_tell_an_arm_with_doors_from_a_bare_one()
     assert odds(replace(g, door_views=views)) < 1.0 / 20.0  # two doors in view, not seen
     assert 1.0 / 20.0 < odds(g, ray_doors=()) < 0.5  # the view ahead: weaker
     assert odds(g, ray_doors=doors) > 2.0
+
+
+def test_looks_that_see_the_same_wall_share_their_doors_and_far_ones_do_not():
+    """Three looks from one spot weigh their doors as one look; a look 30 m on, which sees
+    none of the same wall, counts fully."""
+    k = scene_weights(np.array([(0.0, 0.0), (0.0, 0.0), (0.0, 0.0), (30.0, 0.0)]))
+    assert k[:3].sum() == pytest.approx(1.0)
+    assert k[3] == pytest.approx(1.0)
+
+
+def test_a_look_full_of_door_like_things_costs_a_place_at_most_one_scene():
+    """However many door-like things a look saw where a hypothesis has no door, they cost
+    it at most P_DOOR_SCENE against the hypothesis they fit best."""
+    lw = np.array([0.0, 10 * math.log(P_DOOR_SPURIOUS), math.log(P_DOOR_SPURIOUS)])
+    capped = scene_capped(lw)
+    assert capped[0] == 0.0 and capped[2] == lw[2]  # a door or two tells as before
+    assert capped[1] == pytest.approx(math.log(P_DOOR_SCENE))

@@ -11,7 +11,9 @@ calls them: the sums are kept bit for bit as they were).
   rectangles, ``floor.py``, or the building's grid as a likelihood field,
   ``likelihood_field.py``): the robot inside a wall, a drive blocked where the floor goes
   on, and the free floor along each view in depth (at a look round and along a drive).
-- ``doors``: doors seen along the walls, or map doors in view not seen.
+- ``doors``: doors seen along the walls, or map doors in view not seen; a look's doors
+  are one scene's (``look_doors``: capped, and shared with the looks that see the same
+  wall, ``doors.scene_weights``, which the belief applies over all its looks).
 - ``prior``: an earlier estimate of the pose.
 """
 
@@ -29,6 +31,7 @@ from pmnav_bt.pose.evidence.doors import (
     P_DRIVE_DOOR_MISS,
     P_DRIVE_DOOR_SPURIOUS,
     MapDoors,
+    scene_capped,
 )
 from pmnav_bt.pose.evidence.floor_model import CORRIDORS, FloorModel, WallSource
 from pmnav_bt.pose.evidence.signs import SIGHT_SIGMA_M, Recall, Signs, sight_sigma
@@ -55,23 +58,31 @@ class Evidence:
 
     def look(self, logw: np.ndarray, g: Glimpse, tfs: np.ndarray, ref: Pose2D) -> None:
         """Add a look round ``g`` (straightened odometry) to ``logw`` under each hypothesis
-        of ``tfs``: where it was (inside a wall?), a blocked drive, depth along each view,
-        the doors seen along the walls and the signs read (``ref``: the reference, from
-        which the odometry's drift grows)."""
+        of ``tfs``: where it was (inside a wall?), a blocked drive, depth along each view
+        and the signs read (``ref``: the reference, from which the odometry's drift
+        grows). Its doors are ``look_doors``: the belief weighs them over all its looks."""
         travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
-        sigma = sight_sigma(travelled)
         here = apply_many(tfs, (g.odom.x, g.odom.y))
         self.floor.stand(logw, here)
         if g.blocked is not None:  # the corridor must end (or turn) just ahead
             logw += self.floor.blocked_log(tfs, (g.odom.x, g.odom.y), g.blocked)
         for yaw, free in g.free:
             self.floor.depth_ray(logw, tfs, here, g.odom, yaw, free, travelled, True)
-        self.doors.weigh(
-            logw, self.floor, g.doors, g.door_views, tfs, here,
-            P_DOOR_MISS, P_DOOR_SPURIOUS, sigma,
-        )  # fmt: skip
         near, _ = self.signs.vis.nearest_many(here)
-        self.signs.weigh(logw, g.seen, g.named, tfs, here, near, sigma)
+        self.signs.weigh(logw, g.seen, g.named, tfs, here, near, sight_sigma(travelled))
+
+    def look_doors(self, g: Glimpse, tfs: np.ndarray, ref: Pose2D) -> np.ndarray:
+        """The log-likelihood under each hypothesis of ``tfs`` of the doors a look round
+        ``g`` saw along the walls (and of the map doors in view it did not see), as one
+        scene's (``doors.scene_capped``)."""
+        travelled = math.hypot(g.odom.x - ref.x, g.odom.y - ref.y)
+        here = apply_many(tfs, (g.odom.x, g.odom.y))
+        lw = np.zeros(len(tfs))
+        self.doors.weigh(
+            lw, self.floor, g.doors, g.door_views, tfs, here,
+            P_DOOR_MISS, P_DOOR_SPURIOUS, sight_sigma(travelled),
+        )  # fmt: skip
+        return scene_capped(lw)
 
     def drive_view(self, logw: np.ndarray, r: Glimpse, tfs: np.ndarray, ref: Pose2D) -> None:
         """Add the view ahead while driving ``r`` (``CorridorBelief.observe_ray``): its free
