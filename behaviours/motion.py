@@ -79,6 +79,13 @@ MOVER_REACH_M = 0.5  # what moved this far beyond the thing in the way counts (i
 PERSON_SPACE_M = 0.3
 # The opening check looks this far along the map's floor (beyond what the band can show).
 FLOOR_RUN_MOST_M = 10.0
+# A way the opening check finds shut is looked at again, this many looks in all this many
+# clock seconds apart, before the turn or fork is given up: people walk the corridors'
+# centre lines and cut across junctions and lobbies, and someone crossing (1 m/s) clears
+# the view in two seconds, or stands still (the drive that follows waits for them). A
+# wall where the map has the way shows the same in every look. Waiting costs no action.
+OPENING_LOOKS = 3
+OPENING_LOOK_AGAIN_S = 3.0
 
 
 class DriveTo(PmNavBehaviour):
@@ -626,14 +633,20 @@ class CheckOpening(PmNavBehaviour):
     The paper's check: floor in the lower-central band (``is_opening``). That band sees
     the floor only from some metres out; where the map's floor along the plan's way out
     of the target ends sooner (``floor_run``), depth decides instead (``is_open_way``).
-    Reads ``target``, ``plan``, ``map_T_odom``. FAILURE (TARGET_NOT_FOUND) when a wall
-    fills the way ahead.
+    A look that finds the way shut is taken again (``OPENING_LOOKS`` looks,
+    ``OPENING_LOOK_AGAIN_S`` apart): someone crossing the junction hides a way that is
+    there. Reads ``target``, ``plan``, ``map_T_odom``. FAILURE (TARGET_NOT_FOUND) when
+    every look shows the way filled.
     """
 
     READS = ("target", "plan", "map_T_odom")
     JOBS = ("_job",)
 
     def initialise(self) -> None:
+        self._looks = 0
+        self._look()
+
+    def _look(self) -> None:
         base, grounder = self.ctx.base, self.ctx.grounder
         t = self.get("target")
         est = map_pose(self.get("map_T_odom"), base.pose())
@@ -645,9 +658,15 @@ class CheckOpening(PmNavBehaviour):
             run = floor_run(ctx, t.position, heading, est)  # the map's floor: not in a tick
             return mask_ratios(obs, grounder), free, band_reach(obs), run
 
+        self._looks += 1
+        self._again_at = None
         self._job = self.ctx.worker.submit(look)
 
     def update(self) -> Status:
+        if self._again_at is not None:
+            if self.ctx.now() < self._again_at:
+                return Status.RUNNING
+            self._look()
         status, seen = self.poll(self._job, "checking the way ahead")
         if status is not None:
             return status
@@ -655,10 +674,17 @@ class CheckOpening(PmNavBehaviour):
         t = self.get("target")
         depth = "" if free is None else f"; depth {free:.1f} m free, the map {run:.1f} m"
         if not is_open_way(ratios, free, run, reach):
+            if self._looks < OPENING_LOOKS:
+                self._job, self._again_at = None, self.ctx.now() + OPENING_LOOK_AGAIN_S
+                self.feedback_message = (
+                    f"no way ahead at {t.landmark} in look {self._looks} of {OPENING_LOOKS} "
+                    f"(floor {ratios.floor:.2f}{depth}): someone in the way? looking again"
+                )
+                return Status.RUNNING
             return self.fail(
                 FailureCode.TARGET_NOT_FOUND,
-                f"no corridor to take at {t.landmark} (floor {ratios.floor:.2f}, "
-                f"wall {ratios.wall:.2f}{depth})",
+                f"no corridor to take at {t.landmark} in {OPENING_LOOKS} looks (floor "
+                f"{ratios.floor:.2f}, wall {ratios.wall:.2f}{depth})",
             )
         self.feedback_message = f"open (floor {ratios.floor:.2f}{depth})"
         return Status.SUCCESS

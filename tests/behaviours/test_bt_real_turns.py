@@ -69,11 +69,12 @@ def test_a_short_leg_across_open_floor_is_taken_and_a_wall_just_ahead_is_not(
             assert 2.0 < run < 4.0  # the map's floor ends before the band shows any
             check = CheckOpening("ForkChoice", ctx)
             check.setup_with_descendants()
-            for _ in range(50):
+            for _ in range(200):  # a way found shut is looked at again, seconds later
                 check.tick_once()
                 if check.status != Status.RUNNING:
                     break
                 ctx.worker.drain()
+                base.clock.wait(0.1)
             failure = bb.get("failure") if not open_ else None
             assert check.status == (Status.SUCCESS if open_ else Status.FAILURE)
             if not open_:

@@ -4,13 +4,19 @@ coarse choice in the worker, typed plan starts and constraints, refinement range
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import pytest
 from py_trees.common import Status
 
 from pmnav_bt.behaviours.capture import CaptureViews
 from pmnav_bt.behaviours.localize import localization_yaws, read_signs
-from pmnav_bt.behaviours.motion import CheckOpening, MoveToward
+from pmnav_bt.behaviours.motion import (
+    OPENING_LOOK_AGAIN_S,
+    OPENING_LOOKS,
+    CheckOpening,
+    MoveToward,
+)
 from pmnav_bt.behaviours.planning import MakePlan
 from pmnav_bt.behaviours.search import CoarseDirection, FineDirection, target_entity
 from pmnav_bt.errors import SensorError, VlmError
@@ -146,12 +152,35 @@ def test_the_way_watch_reports_a_silent_camera_not_an_obstacle(make_rig, pm):
 
 
 def test_check_opening_fails_when_a_wall_fills_the_way(make_rig, pm):
-    for open_ahead, status in ((True, Status.SUCCESS), (False, Status.FAILURE)):
+    for open_ahead, status, looks in ((True, Status.SUCCESS, 1), (False, Status.FAILURE, 3)):
         r = make_rig(EAST, grounder=ScriptedGrounder(pm, open_ahead=open_ahead))
         plan = r.ctx.planner.plan(r.pm, "start", "room13")
         r.set(plan=plan, target=plan.steps[0])
         assert r.run(CheckOpening("ForkChoice", r.ctx))[-1] == status
-        assert r.ctx.grounder.calls == ["surfaces"]
+        assert r.ctx.grounder.calls == ["surfaces"] * looks
+    assert f"in {OPENING_LOOKS} looks" in r.failure.message
+
+
+@dataclass
+class CrossedOnce(ScriptedGrounder):
+    """The way ahead hidden in the first look (someone crossing the junction), open after."""
+
+    def surfaces(self, obs):
+        self.open_ahead = bool(self.calls)
+        return super().surfaces(obs)
+
+
+def test_check_opening_looks_again_when_the_way_was_hidden(make_rig, pm):
+    """Someone crossing in front of the robot at a fork hides the way for a look: the
+    check looks again a few seconds later instead of giving the fork up."""
+    r = make_rig(EAST, grounder=CrossedOnce(pm))
+    plan = r.ctx.planner.plan(r.pm, "start", "room13")
+    r.set(plan=plan, target=plan.steps[0])
+    t0 = r.ctx.now()
+    leaf = CheckOpening("ForkChoice", r.ctx)
+    assert r.run(leaf)[-1] == Status.SUCCESS
+    assert r.ctx.grounder.calls == ["surfaces", "surfaces"]
+    assert r.ctx.now() - t0 >= OPENING_LOOK_AGAIN_S
 
 
 @pytest.mark.parametrize("share", [0.2, 0.8])
