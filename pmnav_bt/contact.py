@@ -86,15 +86,20 @@ Clearance = Callable[[float, float], float]  # metres from an odometry point to 
 def behind_free(pose: Pose2D, distance: float, clearance: Clearance | None) -> float:
     """How far (m, at most ``distance``) the body at ``pose`` (odometry) may reverse: the
     way behind keeps its radius and ``WAY_PAD_M`` from what ``clearance`` (the local
-    costmap) knows."""
+    costmap) knows, except where it is already nearer than that and reversing takes it
+    further away: touching what it felt ahead (which the costmap now holds), each step back
+    gains clearance, and only a step that brings it nearer to something is refused."""
     if clearance is None:
         return distance
+    was = clearance(pose.x, pose.y)
     steps = max(1, int(math.ceil(distance / BEHIND_PROBE_M)))
     for i in range(1, steps + 1):
         s = distance * i / steps
         x, y = pose.x - s * math.cos(pose.yaw), pose.y - s * math.sin(pose.yaw)
-        if clearance(x, y) < CREATE3_RADIUS_M + WAY_PAD_M:
+        here = clearance(x, y)
+        if here < CREATE3_RADIUS_M + WAY_PAD_M and here < was:
             return distance * (i - 1) / steps
+        was = here
     return distance
 
 

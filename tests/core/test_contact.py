@@ -88,6 +88,21 @@ def test_backing_off_stops_where_the_body_refuses_and_never_into_what_is_behind(
     assert run(boxed, start) == start and boxed.why == "something behind"
 
 
+def test_the_item_felt_ahead_and_marked_does_not_hold_the_body_that_backs_off_it():
+    """The costmap holds the item the body touched (``felt_item``, at its rim): reversing
+    straight away from it is free, and something behind still stops it short."""
+    start = Pose2D(0.0, 0.0, 0.0)
+    ahead = (CREATE3_RADIUS_M, 0.0)
+    touched = marks(*felt_item(start, ahead))
+    backed = BackOff(ahead, start, 0.0, clearance=touched)
+    end = run(backed, start)
+    assert end.x == pytest.approx(-BACK_OFF_M, abs=0.02) and backed.why == ""
+    both = marks(*felt_item(start, ahead), (-0.3, 0.0))
+    end = run(BackOff(ahead, start, 0.0, clearance=both), start)
+    assert -BACK_OFF_M + 0.02 < end.x < -0.03
+    assert both(end.x, end.y) >= CREATE3_RADIUS_M + WAY_PAD_M - 1e-9
+
+
 def test_a_bump_marks_an_item_behind_the_contact_away_from_the_body():
     pose = Pose2D(0.0, 0.0, 0.0)
     pts = felt_item(pose, (CREATE3_RADIUS_M, 0.0))
