@@ -52,6 +52,8 @@ KEYS = (
     "level",  # str: the level the robot is on, after a lift ride (the site's level name)
     "lift_full_seen",  # int: lifts that came full on this ride so far
     "cabin_way",  # (bearing rad, metres): the way into the lift's cabin depth showed
+    "boarding_actions",  # int: the odometer's actions when the lift's boarding began
+    "actions_granted",  # int: actions added to the budget (boardings let go: lift full)
     # the map-less baseline (trees/mapless.py)
     "goal_entity",  # Entity: the goal room, from the sign vocabulary
     "grid",  # ExplorationGrid: what it has seen and where it has been (odometry frame)

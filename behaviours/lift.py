@@ -14,6 +14,10 @@ leaves, in the order ``trees/lift.py`` strings them:
   is moved along the wall to put it where the map has it;
 - ``CabinHasRoom``: depth says whether the cabin's floor is free (LIFT_FULL, counted);
 - ``ReleaseLift``: end the session (a full cabin goes on without us; off at the far end);
+- ``BoardingBegins``, ``BoardAgainAllowed``: a boarding let go because the lift came full
+  is the building's delay, not the robot's search: its actions are added to the budget;
+- ``SeeItLeave``: after letting a full lift go, wait until it has shut its doors, so that
+  the next call is answered by the lift's next arrival, not by the same full cabin;
 - ``DriveThrough``: straight through the doorway, into the cabin's middle or out to the
   lobby, on odometry (the doorway is 1.6 m wide, the robot 0.34 m);
 - ``StartLevel``: the mission's first leaf: the level it starts on;
@@ -510,6 +514,72 @@ class CabinHasRoom(PmNavBehaviour):
             f"{r.name} came full to level {r.from_level} ({seen} of {self.tries} times: "
             "no room in it for the robot)",
         )
+
+
+class BoardingBegins(PmNavBehaviour):
+    """A boarding of the lift begins (call, wait, find the doors, look in): note the actions
+    spent so far (``boarding_actions``), for ``BoardAgainAllowed``. SUCCESS.
+
+    Writes ``boarding_actions``."""
+
+    WRITES = ("boarding_actions",)
+
+    def update(self) -> Status:
+        self.bb.set("boarding_actions", self.ctx.odometer.actions)
+        return Status.SUCCESS
+
+
+class BoardAgainAllowed(PmNavBehaviour):
+    """The lift came full and was let go: the boarding just made must be made again. An
+    episode's budget allows each ride one boarding (``RIDE_ACTIONS``); a lift full when
+    it comes is the building's delay, as its call delay is, so the actions this boarding
+    spent (since ``BoardingBegins``: turning to find the doors, stepping before them) are
+    added to the budget (``actions_granted``, which the Monitor adds to the context's
+    budget). Measured, not a constant: a boarding costs what the doors' place made it
+    cost. SUCCESS.
+
+    Reads ``boarding_actions``, ``actions_granted``; writes ``actions_granted``."""
+
+    READS = ("boarding_actions", "actions_granted")
+    WRITES = ("actions_granted",)
+
+    def update(self) -> Status:
+        began = self.get("boarding_actions")
+        spent = max(0, self.ctx.odometer.actions - began) if began is not None else 0
+        granted = (self.get("actions_granted") or 0) + spent
+        self.bb.set("actions_granted", granted)
+        self.ctx.log("budget_granted", "", actions=spent, granted=granted)
+        self.feedback_message = f"{spent} actions of a boarding let go added to the budget"
+        return Status.SUCCESS
+
+
+class SeeItLeave(PmNavBehaviour):
+    """After letting a full lift go: wait, stopped, until the lift says its door at the
+    ride's first level is shut (it is leaving with its load, or gone). A call while that
+    door still stands open, or is closing, is answered as a lift answers it: the doors
+    open again on the same full cabin; only a call after they shut is answered by the
+    lift's next arrival. SUCCESS once shut, or after ``limit_s`` (a lift held open by
+    others: call it anyway)."""
+
+    def __init__(self, name: str, ctx: Context, lift: Lift, ride: Ride, limit_s: float):
+        super().__init__(name, ctx)
+        self.lift, self.ride, self.limit_s = lift, ride, limit_s
+
+    def initialise(self) -> None:
+        self.ctx.base.stop()
+        self._t0 = self.ctx.now()
+
+    def update(self) -> Status:
+        st = self.lift.state(self.ride.lift)
+        waited = self.ctx.now() - self._t0
+        here = st is not None and st.current_level == self.ride.from_level
+        if not here or st.door == LiftDoor.CLOSED or waited >= self.limit_s:
+            self.ctx.log("lift_gone", self.ride.lift, waited=waited, shut=not here or (
+                st.door == LiftDoor.CLOSED))
+            self.feedback_message = f"{self.ride.name} let go after {waited:.0f} s"
+            return Status.SUCCESS
+        self.feedback_message = f"letting the full {self.ride.name} leave ({waited:.0f} s)"
+        return Status.RUNNING
 
 
 class ReleaseLift(PmNavBehaviour):

@@ -331,8 +331,9 @@ class TreeConfig(_Section):
         3, ge=1, le=20, description="lifts that come full let go before giving up (LIFT_FULL)"
     )
     lift_full_wait_s: float = Field(
-        20.0, ge=0.0, le=600.0, description="clock seconds to wait after letting a full lift go, "
-        "before calling it again",
+        60.0, ge=0.0, le=600.0, description="the longest wait, clock seconds, for a full lift "
+        "let go to shut its doors before it is called again (a call before they shut opens "
+        "them on the same cabin); people boarding hold doors open up to a minute",
     )
 
 

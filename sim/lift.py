@@ -13,9 +13,11 @@ the session ends (``release``) the door shuts after ``dwell_s``. The timings
 (``LiftTiming``, by default a hospital bed lift's) are ``pmnav_bt/lift_timing.py``'s,
 the same lift as the simulated lift node's (``hardware/lift_bank.py``).
 
-A call is answered full with probability ``world.lift_full_p``: the cabin opens with a
-cart in it (people with their trolley, ``Cabin.fill``) and, let go, rides off with it to
-another level. A robot standing on the cabin's floor when it leaves rides with it: at
+A call is answered full with probability ``world.lift_full_p``, drawn for each arrival:
+the cabin opens with a cart in it (people with their trolley, ``Cabin.fill``) and, let
+go, rides off with it to another level. A call while its doors are still open or
+shutting opens them again on the same cabin, cart and all (no new arrival, no draw).
+A robot standing on the cabin's floor when it leaves rides with it: at
 the far level the lift hands it to ``rider.carry`` at the same place in that level's
 cabin. Time is the simulation's clock (a clock listener), never wall time.
 """
@@ -122,6 +124,11 @@ class SimLift:
             return  # here already: the door stays open for the session
         car.dest = level
         now = self.clock.now()
+        if call and car.level == level and car.phase == Phase.CLOSING:
+            # The doors shutting here open again on the same cabin, its load and all: a
+            # new arrival (full or not, drawn) answers only a call after they shut.
+            car.phase, car.until = Phase.OPENING, now + self.timing.door_s
+            return
         if call:
             car.full = bool(self.rng.random() < self.full_p)
             self.full_calls += car.full

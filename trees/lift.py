@@ -6,10 +6,12 @@ where the robot is on the new level (issue 40)::
         ToLobby                      to the lobby point, facing the doors
         Board (again while it came full, up to tree.lift_full_tries times)
           BoardOrLetGo
-            BoardOnce: CallLift, WaitForLift (LIFT_NOT_COMING), FindDoors (the doorway
-                       in depth puts the estimate right along the wall), ToLobby again,
-                       CabinHasRoom (LIFT_FULL)
-            LetItGo: it came full -> ReleaseLift, Wait tree.lift_full_wait_s, CallAgain
+            BoardOnce: BoardingBegins, CallLift, WaitForLift (LIFT_NOT_COMING),
+                       FindDoors (the doorway in depth puts the estimate right along the
+                       wall), ToLobby again, CabinHasRoom (LIFT_FULL)
+            LetItGo: it came full -> ReleaseLift, BoardAgainAllowed (the boarding's
+                     actions added to the budget), SeeItLeave (its doors shut, at most
+                     tree.lift_full_wait_s), CallAgain
         IntoCabin, TurnRound         drive into the cabin's middle, face the doors
         AskForLevel, RideToLevel     ask for the level, wait for the door there
         OnNewLevel                   drop the old level's estimate; the lift's word as prior
@@ -41,6 +43,8 @@ from pmnav_bt.behaviours.common import NAMESPACE
 from pmnav_bt.behaviours.context import Context
 from pmnav_bt.behaviours.decorators import RetryWhile
 from pmnav_bt.behaviours.lift import (
+    BoardAgainAllowed,
+    BoardingBegins,
     CabinHasRoom,
     CallLift,
     CheckLevel,
@@ -50,11 +54,12 @@ from pmnav_bt.behaviours.lift import (
     OnNewLevel,
     ReleaseLift,
     Ride,
+    SeeItLeave,
     ToLobby,
     WaitForLift,
     into_cabin,
 )
-from pmnav_bt.behaviours.recovery import FailureIs, Spin, Wait
+from pmnav_bt.behaviours.recovery import FailureIs, Spin
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.map.building import Building
 from pmnav_bt.map.priori_map import PrioriMap
@@ -78,6 +83,7 @@ def lift_subtree(
     cfg = ctx_from.config.tree
     board_once = sequence(
         f"{name}BoardOnce",
+        BoardingBegins(f"{name}BoardingBegins", ctx_from),
         CallLift(f"{name}Call", ctx_from, lift, ride, ride.from_level),
         WaitForLift(f"{name}WaitForDoor", ctx_from, lift, ride, ride.from_level, cfg.lift_wait_s),
         FindDoors(f"{name}FindDoors", ctx_from, ride),
@@ -88,7 +94,8 @@ def lift_subtree(
         f"{name}LetItGo",
         FailureIs(f"{name}CameFull", ctx_from, FailureCode.LIFT_FULL),
         ReleaseLift(f"{name}LetItGoOn", ctx_from, lift, ride),
-        Wait(f"{name}WaitForNext", ctx_from, cfg.lift_full_wait_s),
+        BoardAgainAllowed(f"{name}BoardAgainAllowed", ctx_from),
+        SeeItLeave(f"{name}SeeItLeave", ctx_from, lift, ride, cfg.lift_full_wait_s),
         AlwaysFail(name=f"{name}CallAgain"),
     )
     bb = py_trees.blackboard.Client(name=f"{name}Board", namespace=NAMESPACE)

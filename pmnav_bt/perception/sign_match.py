@@ -226,10 +226,8 @@ class SignMatcher:
     def evidence(self, lines: Sequence[Line]) -> Evidence:
         """What the lines of one sign (top to bottom) say about each entity."""
         tokens = _tokens(lines)
-        code_at, code_ll = self._code_token(tokens)
+        code_at, code_ll, code, scores = self._code_token(tokens)
         words = "".join(t for i, (t, _) in enumerate(tokens) if i not in code_at)
-        code = "".join(tokens[i][0] for i in code_at)
-        scores = [s for i in code_at for s in tokens[i][1]]
         name_null = NAME_WEIGHT * (NAME_NULL - 1.0) if words else 0.0
         unknown = name_null
         if code:
@@ -283,28 +281,52 @@ class SignMatcher:
 
     def _code_token(
         self, tokens: list[tuple[str, list[float]]]
-    ) -> tuple[tuple[int, ...], dict[str, float]]:
+    ) -> tuple[tuple[int, ...], dict[str, float], str, list[float]]:
         """Which tokens (one, or two read apart: "L2 -204") are the plate's code: those
         that look like one of the building's codes and are likelier a misread code than
-        words; the likeliest, with its log-likelihood under each code. () when none."""
+        words; the likeliest, with its log-likelihood under each code, and the code as it
+        was read (its spelling, below) with its characters' confidences. () when none.
+
+        Two tokens are the code's parts either side of a gap the reader put where the
+        code has a separator ("L1-" and "116B" of "L1-116B": the reader cuts a word at a
+        hyphen, and ``_tokens`` trims it off "L1-"), or read apart with nothing between:
+        both are weighed, the separators being the building's own (``NumberingScheme``,
+        parsed from its codes: none in a ``117`` building, ``-`` in an ``L2-204`` one)."""
         codes = {k.code for k in self.known if k.code}
-        best: tuple[tuple[int, ...], dict[str, float]] = ((), {})
+        best: tuple[tuple[int, ...], dict[str, float], str, list[float]] = ((), {}, "", [])
         best_ll = -math.inf
         spans = [(i,) for i in range(len(tokens))]
         spans += [(i, i + 1) for i in range(len(tokens) - 1)]
         for span in spans:
-            text = "".join(tokens[i][0] for i in span)
-            if not codes or not self.scheme.looks_like_code(text):
-                continue
-            sc = [s for i in span for s in tokens[i][1]]
-            lls = {c: self.model.log_likelihood(text, sc, _compact(c)) for c in codes}
-            ll = max(lls.values())
-            has_digit = any(c.isdigit() for c in text)
-            if not has_digit and ll < math.log(P_UNKNOWN) + self.model.log_read_right(text, sc):
-                continue  # a word, more likely than a misread code
-            if ll > best_ll:
-                best, best_ll = (span, lls), ll
+            for text, sc in self._spellings([tokens[i] for i in span]):
+                if not codes or not self.scheme.looks_like_code(text):
+                    continue
+                lls = {c: self.model.log_likelihood(text, sc, _compact(c)) for c in codes}
+                ll = max(lls.values())
+                has_digit = any(c.isdigit() for c in text)
+                unknown = math.log(P_UNKNOWN) + self.model.log_read_right(text, sc)
+                if not has_digit and ll < unknown:
+                    continue  # a word, more likely than a misread code
+                if ll > best_ll:
+                    best, best_ll = (span, lls, text, sc), ll
         return best
+
+    def _spellings(
+        self, parts: list[tuple[str, list[float]]]
+    ) -> list[tuple[str, list[float]]]:
+        """The code ``parts`` (one token, or two read apart) may spell, with the characters'
+        confidences: one token as read; two joined, and joined by each separator of the
+        building's scheme (the separator, not read, at the confidence of its neighbours:
+        the reader saw a gap there)."""
+        text = "".join(t for t, _ in parts)
+        sc = [s for _, scores in parts for s in scores]
+        if len(parts) == 1:
+            return [(text, sc)]
+        (a, sa), (b, sb) = parts
+        gap = min(sa[-1:] + sb[:1], default=0.9)
+        return [(text, sc)] + [
+            (a + sep + b, [*sa, gap, *sb]) for sep in sorted(self.scheme.separators)
+        ]
 
 
 def _compact(text: str) -> str:

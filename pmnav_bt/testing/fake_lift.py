@@ -37,6 +37,7 @@ class FakeLift:
     come_s: float = 10.0
     never: bool = False
     full_times: int = 0
+    leave_s: float = 0.0
     wrong_level: str | None = None
     base: FakeBase | None = None
     doorway: Doorway | None = None
@@ -57,6 +58,7 @@ class FakeLift:
         self._calls = 0
         self._riding = False  # the request in hand moves the robot with the cabin
         self._crowd: list[FakeObstacle] = []
+        self._shuts: float | None = None  # a cabin let go: when its door shuts
         self.clock.on_wait(self._advance)
 
     # -- seams.Lift --------------------------------------------------------------------------
@@ -67,7 +69,8 @@ class FakeLift:
             raise ValueError(f"{self.name} does not serve level {level!r}")
         self.requests.append((self.clock.now(), level, session))
         here = self._said == level and self._door == LiftDoor.OPEN
-        if here and self._session == session:
+        if here and (self._session == session or self._shuts is not None):
+            self._session, self._shuts = session, None  # the same cabin, held again
             return
         self._riding = self._session == session and self._door == LiftDoor.OPEN
         if self._session != session:
@@ -87,9 +90,17 @@ class FakeLift:
         if session != self._session:
             return
         self._session = ""
-        self._door = LiftDoor.CLOSED
         self._due = None
         self._motion = LiftMotion.STOPPED
+        if self._door == LiftDoor.OPEN and self.leave_s > 0.0:
+            self._shuts = self.clock.now() + self.leave_s
+            return
+        self._leave()
+
+    def _leave(self) -> None:
+        """The door shuts; the people of a full cabin leave with it."""
+        self._door = LiftDoor.CLOSED
+        self._shuts = None
         for person in self._crowd:
             self.base.obstacles.remove(person)
         self._crowd = []
@@ -114,6 +125,8 @@ class FakeLift:
             raise ValueError(f"no lift {lift!r} here (this is {self.name!r})")
 
     def _advance(self, dt: float) -> None:
+        if self._shuts is not None and self.clock.now() + dt >= self._shuts:
+            self._leave()
         if self._due is None or self.clock.now() + dt < self._due:
             return
         self._due = None

@@ -47,6 +47,19 @@ def test_monitor_fails_budget_exceeded_once_the_odometer_passes_the_budget(make_
     assert rig.stopped()
 
 
+def test_actions_granted_on_the_way_raise_the_budget(make_rig):
+    """A boarding let go because the lift came full (``BoardAgainAllowed``) adds its
+    actions to the budget: the Monitor fails only past the budget and the grant."""
+    rig = make_rig(SOUTH_AT_28, budget=5)
+    rig.set(actions_granted=3)
+    monitor = Monitor("Monitor", rig.ctx)
+    rig.body.set_velocity(0.3, 0.0)
+    seen = rig.run(monitor, max_ticks=200)
+    rig.expect(seen, Status.FAILURE)
+    assert rig.failure.message == "9 actions used of 8"
+    assert rig.ctx.odometer.actions == 9
+
+
 def test_monitor_counts_turning_too(make_rig):
     rig = make_rig(SOUTH_AT_28, budget=5)
     monitor = Monitor("Monitor", rig.ctx)

@@ -10,7 +10,7 @@ import pytest
 from building_kit import as_floor
 from py_trees.common import Status
 
-from pmnav_bt.behaviours.lift import Ride
+from pmnav_bt.behaviours.lift import BoardAgainAllowed, BoardingBegins, Ride
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.map.catalogue import load_building
 from pmnav_bt.map.lift_doorway import doorway
@@ -110,6 +110,53 @@ def test_a_lift_full_once_is_let_go_and_the_next_one_taken(make_rig, levels):
     assert [r[1] for r in lift.requests] == ["L3", "L3", "L4"]
     assert [e.kind for e in rig.ctx.trace].count("lift_full") == 1
     assert rig.get("level") == "L4"
+
+
+def test_a_full_lift_let_go_is_called_again_once_its_doors_have_shut(make_rig, levels):
+    """People still board the full cabin for half a minute after the robot lets it go: a
+    call before its doors shut would open them on the same full cabin. The robot calls
+    again when the lift says they shut, not after a fixed wait."""
+    rig, tree, lift, _ = ride_rig(
+        make_rig, levels, full_times=1, leave_s=30.0, overrides=("tree.lift_full_wait_s=90",)
+    )
+    rig.expect(rig.run(tree, MAX_TICKS), Status.SUCCESS)
+    assert [r[1] for r in lift.requests] == ["L3", "L3", "L4"]
+    assert [e.kind for e in rig.ctx.trace].count("lift_full") == 1
+    let_go = lift.releases[0][0]
+    assert let_go + 30.0 <= lift.requests[1][0] < let_go + 32.0
+
+
+def test_a_lift_called_back_before_its_doors_shut_is_the_same_full_cabin(make_rig, levels):
+    """The double keeps a let-go cabin as a lift does: the people stay in it."""
+    rig, _, lift, ride = ride_rig(make_rig, levels, full_times=1, leave_s=30.0)
+    lift.request(ride.lift, "L3", ride.session)
+    rig.base.clock.wait(lift.come_s + 1.0)
+    assert lift.state(ride.lift).door == LiftDoor.OPEN and len(rig.body.obstacles) == 5
+    lift.release(ride.lift, ride.session)
+    rig.base.clock.wait(10.0)
+    lift.request(ride.lift, "L3", ride.session)  # the doors open again on the same crowd
+    assert lift.state(ride.lift).door == LiftDoor.OPEN and len(rig.body.obstacles) == 5
+    lift.release(ride.lift, ride.session)
+    rig.base.clock.wait(31.0)
+    assert lift.state(ride.lift).door == LiftDoor.CLOSED and not rig.body.obstacles
+
+
+def test_a_boarding_let_go_adds_its_actions_to_the_budget(make_rig, levels):
+    rig, *_ = ride_rig(make_rig, levels)
+    begins = BoardingBegins("Begins", rig.ctx)
+    allowed = BoardAgainAllowed("Allowed", rig.ctx)
+    rig.set(actions_granted=4)
+    rig.ctx.odometer.update(rig.base.pose())  # as the Monitor does each tick
+    rig.expect([rig.tick(begins)], Status.SUCCESS)
+    rig.body.set_velocity(0.0, 1.0)  # turning to find the doors: 30 deg an action
+    for _ in range(30):
+        rig.wait()
+        rig.ctx.odometer.update(rig.base.pose())
+    rig.body.set_velocity(0.0, 0.0)
+    spent = rig.ctx.odometer.actions - rig.get("boarding_actions")
+    assert spent >= 5
+    rig.expect([rig.tick(allowed)], Status.SUCCESS)
+    assert rig.get("actions_granted") == 4 + spent
 
 
 def test_signs_of_another_level_on_arrival_fail_wrong_level(make_rig, levels):

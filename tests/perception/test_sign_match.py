@@ -113,6 +113,18 @@ def test_lettered_room_numbers_and_their_wing_letter_read_as_a_digit():
     assert m.match(read("D109")) is None
 
 
+def test_a_code_read_in_two_words_at_its_separator_is_the_code():
+    """The reader cuts "L1-116B" at its hyphen ("L1-" "116B", "L1 116B"): the parts joined
+    by the building's own separator (parsed from its codes) are the code."""
+    m = SignMatcher(corridor("L1-114B", "L1-116A", "L1-116B", "L1-118"))
+    assert m.scheme.separators == frozenset("-")
+    for text in ("L1- 116B", "L1 116B", "L1-116B"):
+        found = m.match(read(text))
+        assert found is not None and found.entity == Entity.room("r2"), text
+    assert m.match(read("L1 116")) is None  # 116A or 116B: the suffix not read
+    assert m.match(read("L2 116B")) is None  # another level's plate
+
+
 def test_decide_needs_the_margin_over_the_runner_up_and_the_unknown_plate():
     m = SignMatcher(corridor("2.04", "2.40"))
     ev = m.evidence(read("2.04"))

@@ -125,6 +125,47 @@ def test_a_full_cabin_comes_with_its_cart_and_rides_off_with_it_when_let_go():
     assert robot.level == "L1" and not robot.carried  # the robot stayed in the lobby
 
 
+def test_calls_after_a_full_cabin_has_shut_its_doors_are_independent_arrivals():
+    """The tree lets a full cabin go and calls again once its doors have shut
+    (``SeeItLeave``): each such call is a new arrival, full with probability p whatever
+    the last one was (three full ones in a row are p cubed, not p)."""
+    p, after_full = 0.3, []
+    for seed in range(150):
+        robot = Robot("L1", Pose2D(10.0, 0.0, 0.0))
+        clock, lift, cabins = system(robot, full_p=p, seed=seed)
+        was_full = None
+        for _ in range(4):
+            lift.request("lift1", "L1", "s")
+            wait_open(clock, lift, "L1")
+            full = cabins["L1"].cart is not None
+            if was_full:
+                after_full.append(full)
+            was_full = full
+            lift.release("lift1", "s")
+            while lift.state("lift1").door != LiftDoor.CLOSED:
+                clock.wait(0.5)
+    assert len(after_full) > 100
+    assert abs(np.mean(after_full) - p) < 0.1
+
+
+def test_a_call_before_a_full_cabins_doors_shut_opens_them_on_it_again():
+    robot = Robot("L1", Pose2D(10.0, 0.0, 0.0))
+    clock, lift, cabins = system(robot, full_p=1.0)
+    lift.request("lift1", "L1", "s")
+    wait_open(clock, lift, "L1")
+    assert cabins["L1"].cart is not None
+    lift.full_p = 0.0  # were the next call a new arrival, it would come empty
+    lift.release("lift1", "s")
+    clock.wait(T.dwell_s + 1.0)  # its doors closing
+    lift.request("lift1", "L1", "s")
+    assert wait_open(clock, lift, "L1") <= T.door_s + 0.5  # at once: no call delay
+    assert cabins["L1"].cart is not None and lift.full_calls == 1
+    lift.release("lift1", "s")  # let go again: now it leaves, cart and all
+    clock.wait(T.dwell_s + 2 * T.door_s + 1.0)
+    assert cabins["L1"].cart is None and lift.state("lift1").current_level == "L1"
+    assert lift.state("lift1").motion != LiftMotion.STOPPED
+
+
 def test_a_robot_left_in_the_lobby_is_not_carried():
     robot = Robot("L1", Pose2D(10.0, 0.0, 0.0))
     clock, lift, _ = system(robot)
