@@ -296,9 +296,7 @@ class DriveTo(PmNavBehaviour):
                     elif not steer.plans_round:
                         g = se2_apply(se2_inverse(tf or (0.0, 0.0, 0.0)), toward)
                         g = (float(g[0]), float(g[1]))
-                        found["round"] = keep_round(
-                            steer, obs.pose, g, inside, round_from, ahead
-                        )
+                        found["round"] = keep_round(steer, obs.pose, g, inside, round_from)
                     return obs, blocked, found
 
                 self._watch_job = self.ctx.worker.submit(watch)
@@ -411,16 +409,13 @@ def inside_walls(tf, walls: DetourCheck | None) -> Callable[[tuple[float, float]
     return inside
 
 
-def keep_round(
-    steer, pose, goal, inside, current, seen_free: float | None = None
-) -> tuple[float, float] | None:
+def keep_round(steer, pose, goal, inside, current) -> tuple[float, float] | None:
     """The point (odometry) to drive by round what the steering's costmap holds on the
-    straight way from ``pose`` to ``goal`` (``Steering.way_round``, which leaves what
-    depth still sees ``seen_free`` m ahead to the depth rules): ``current``, the one in
-    force, while the straight way to it stays clear (a way round chosen anew each frame
-    would swing from side to side as the robot turns), else a new one; None when the way
-    is clear or has no way round inside the walls."""
-    point = steer.way_round(pose, goal, inside, seen_free)
+    straight way from ``pose`` to ``goal`` (``Steering.way_round``): ``current``, the one
+    in force, while the straight way to it stays clear (a way round chosen anew each
+    frame would swing from side to side as the robot turns), else a new one; None when
+    the way is clear or has no way round inside the walls."""
+    point = steer.way_round(pose, goal, inside)
     if point is None or current is None:
         return point
     return current if way_clear((pose.x, pose.y), current, steer.clearance) else point

@@ -52,7 +52,7 @@ from pmnav_bt.contact import felt_item
 from pmnav_bt.control import Limits, goto_command
 from pmnav_bt.geometry import se2_apply, se2_inverse, wrap_angle
 from pmnav_bt.hazards import Hazard, HazardKind
-from pmnav_bt.local_planner.clear_way import PROBE_M, Inside, blocked_at, point_round
+from pmnav_bt.local_planner.clear_way import Inside, blocked_at, point_round
 from pmnav_bt.local_planner.costmap import LocalCostmap
 from pmnav_bt.local_planner.dwa import Dynamics, Navigation, choose, navigation, passable
 from pmnav_bt.registry import Named
@@ -98,8 +98,7 @@ class Steering(Protocol):
     def clearance(self, x: float, y: float) -> float: ...
 
     def way_round(
-        self, pose: Pose2D, goal: tuple[float, float], inside: Inside | None = None,
-        seen_free: float | None = None,
+        self, pose: Pose2D, goal: tuple[float, float], inside: Inside | None = None
     ) -> tuple[float, float] | None: ...  # fmt: skip
 
 
@@ -130,18 +129,13 @@ class _Remembers:
         return float(self.costmap.snapshot().clearance(np.array([x]), np.array([y]))[0])
 
     def way_round(
-        self, pose: Pose2D, goal: tuple[float, float], inside: Inside | None = None,
-        seen_free: float | None = None,
+        self, pose: Pose2D, goal: tuple[float, float], inside: Inside | None = None
     ) -> tuple[float, float] | None:
         """A point (odometry) to drive to first on the straight way from ``pose`` to
         ``goal`` (odometry), round what the costmap holds on its first ``JUDGE_M``; None
         when that way is clear, or when marks leave no way round in the window that
         stays ``inside`` (the caller's walls; the drive then goes on as depth and the
-        bumper say). ``seen_free``: how far depth shows the way free in this frame
-        (None: not judged); what depth still sees where the costmap blocks is left to
-        the caller's depth rules (a person in view is waited for, not gone round), and
-        only what the view has lost (below it up close, beside it) is gone round here.
-        Worker only (``clear_way``)."""
+        bumper say). Worker only (``clear_way``)."""
         grid = self.costmap.snapshot()
         here = (pose.x, pose.y)
         d = math.dist(here, goal)
@@ -149,11 +143,8 @@ class _Remembers:
             return None
         k = min(1.0, JUDGE_M / d)
         end = (here[0] + k * (goal[0] - here[0]), here[1] + k * (goal[1] - here[1]))
-        block = blocked_at(grid, here, end)
-        if block is None:
+        if blocked_at(grid, here, end) is None:
             return None
-        if seen_free is not None and seen_free <= block + grid.lethal_m + PROBE_M:
-            return None  # in view: depth stops at what the costmap marks
         return point_round(grid, here, goal, inside)
 
 

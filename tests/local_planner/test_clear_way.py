@@ -62,18 +62,3 @@ def test_standing_beside_a_mark_the_way_off_it_is_open():
     assert blocked_at(grid, (0.0, 0.0), (-2.0, 0.0)) is None
     s = blocked_at(grid, (0.0, 0.0), (2.0, 0.0))
     assert s is not None and s < 0.1
-
-
-def test_what_depth_still_sees_is_left_to_the_depth_rules_and_what_it_lost_is_gone_round():
-    """A box marked 2 m ahead on the line: while depth stops at it (``seen_free`` 1.9 m), it
-    is in view and the drive's depth rules judge it (a person is waited for); once depth
-    shows the floor free past it (lost below the view), the steering goes round it."""
-    from pmnav_bt.local_planner.steering import DirectSteering
-    from pmnav_bt.seams import Pose2D
-
-    steer = DirectSteering()
-    steer.costmap.mark(disc(2.0, 0.0, 0.15), now=0.0)
-    here = Pose2D(0.0, 0.0, 0.0)
-    assert steer.way_round(here, (4.0, 0.0), seen_free=1.85) is None
-    assert steer.way_round(here, (4.0, 0.0), seen_free=4.0) is not None
-    assert steer.way_round(here, (4.0, 0.0)) is not None
