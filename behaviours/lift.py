@@ -193,7 +193,23 @@ class CallLift(PmNavBehaviour):
         return Status.SUCCESS
 
 
-class WaitForLift(PmNavBehaviour):
+class _WaitsOnLift(PmNavBehaviour):
+    """A wait, stopped, on what the ride's lift says: ``watch()`` gives its state (None:
+    not heard) and the seconds of the tree's clock waited so far."""
+
+    def __init__(self, name: str, ctx: Context, lift: Lift, ride: Ride):
+        super().__init__(name, ctx)
+        self.lift, self.ride = lift, ride
+
+    def initialise(self) -> None:
+        self.ctx.base.stop()
+        self._t0 = self.ctx.now()
+
+    def watch(self):
+        return self.lift.state(self.ride.lift), self.ctx.now() - self._t0
+
+
+class WaitForLift(_WaitsOnLift):
     """Wait, stopped, until the lift says it stands at ``level`` with its door open for the
     ride's session; FAILURE (LIFT_NOT_COMING) after ``timeout_s`` seconds of the tree's
     clock."""
@@ -201,16 +217,11 @@ class WaitForLift(PmNavBehaviour):
     def __init__(
         self, name: str, ctx: Context, lift: Lift, ride: Ride, level: str, timeout_s: float
     ):
-        super().__init__(name, ctx)
-        self.lift, self.ride, self.level, self.timeout_s = lift, ride, level, timeout_s
-
-    def initialise(self) -> None:
-        self.ctx.base.stop()
-        self._t0 = self.ctx.now()
+        super().__init__(name, ctx, lift, ride)
+        self.level, self.timeout_s = level, timeout_s
 
     def update(self) -> Status:
-        st = self.lift.state(self.ride.lift)
-        waited = self.ctx.now() - self._t0
+        st, waited = self.watch()
         if (
             st is not None
             and st.current_level == self.level
@@ -553,7 +564,7 @@ class BoardAgainAllowed(PmNavBehaviour):
         return Status.SUCCESS
 
 
-class SeeItLeave(PmNavBehaviour):
+class SeeItLeave(_WaitsOnLift):
     """After letting a full lift go: wait, stopped, until the lift says its door at the
     ride's first level is shut (it is leaving with its load, or gone). A call while that
     door still stands open, or is closing, is answered as a lift answers it: the doors
@@ -562,16 +573,11 @@ class SeeItLeave(PmNavBehaviour):
     others: call it anyway)."""
 
     def __init__(self, name: str, ctx: Context, lift: Lift, ride: Ride, limit_s: float):
-        super().__init__(name, ctx)
-        self.lift, self.ride, self.limit_s = lift, ride, limit_s
-
-    def initialise(self) -> None:
-        self.ctx.base.stop()
-        self._t0 = self.ctx.now()
+        super().__init__(name, ctx, lift, ride)
+        self.limit_s = limit_s
 
     def update(self) -> Status:
-        st = self.lift.state(self.ride.lift)
-        waited = self.ctx.now() - self._t0
+        st, waited = self.watch()
         here = st is not None and st.current_level == self.ride.from_level
         if not here or st.door == LiftDoor.CLOSED or waited >= self.limit_s:
             self.ctx.log("lift_gone", self.ride.lift, waited=waited, shut=not here or (
