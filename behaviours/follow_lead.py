@@ -31,8 +31,7 @@ from py_trees.common import Status
 from pmnav_bt.behaviours.belief import DriveEnd, doors_in_odom, wall_mask
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context
-from pmnav_bt.contact import felt_contact, way_clear
-from pmnav_bt.hazards import Hazard, HazardKind
+from pmnav_bt.contact import as_bump, felt_contact, way_clear
 from pmnav_bt.perception.geometry import free_distance, target_point
 from pmnav_bt.pose.belief import CorridorBelief
 from pmnav_bt.pose.odometry import TRACK_FREE_M, CalibratedBase
@@ -185,7 +184,7 @@ def mark_contact(ctx: Context, pose: Pose2D) -> None:
     now = ctx.now()
     contact = felt_contact(ctx.base, now)
     ctx.log("contact", "", x=contact.point[0], y=contact.point[1], n=1)
-    ctx.steering.feel([Hazard(HazardKind.BUMP, "", contact.point, now)], pose, now)
+    ctx.steering.feel([as_bump(contact)], pose, now)
 
 
 class ChooseLead(PmNavBehaviour):

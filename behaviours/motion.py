@@ -24,7 +24,7 @@ from py_trees.common import Status
 from pmnav_bt.behaviours.common import PmNavBehaviour
 from pmnav_bt.behaviours.context import Context, heading_error, map_pose
 from pmnav_bt.behaviours.pose import axis_correction, keep_on_axis, measure_walls
-from pmnav_bt.contact import BackOff, Contact, felt_contact, round_contact, way_clear
+from pmnav_bt.contact import BackOff, Contact, as_bump, felt_contact, round_contact, way_clear
 from pmnav_bt.failures import FailureCode
 from pmnav_bt.geometry import (
     Action,
@@ -34,7 +34,7 @@ from pmnav_bt.geometry import (
     se2_inverse,
     wrap_angle,
 )
-from pmnav_bt.hazards import Hazard, HazardKind, body_hazards
+from pmnav_bt.hazards import body_hazards
 from pmnav_bt.map.wording import shut_way_words
 from pmnav_bt.perception.corner import band_reach, is_corner, is_open_way, mask_ratios
 from pmnav_bt.perception.geometry import free_distance
@@ -220,7 +220,7 @@ class DriveTo(PmNavBehaviour):
         if self._contacts >= MAX_CONTACTS:
             return self.fail(FailureCode.BLOCKED, f"{self._contacts} collisions on the way")
         pose = base.pose()
-        steer.feel([Hazard(HazardKind.BUMP, "", contact.point, now)], pose, now)  # the item
+        steer.feel([as_bump(contact)], pose, now)  # the item
         self._backing = (BackOff(contact.point, pose, now, clearance=steer.clearance), contact)
         self._hold = None
         self.feedback_message = f"backing off: {contact.words}"

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 from pmnav_bt.control import Limits, rotate_command
 from pmnav_bt.geometry import heading, wrap_angle
-from pmnav_bt.hazards import body_blocked_by
+from pmnav_bt.hazards import Hazard, HazardKind, body_blocked_by
 from pmnav_bt.seams import CREATE3_BACKUP_LIMIT_M, CREATE3_RADIUS_M, Pose2D
 
 # Reverse this far off a contact: most of the Create 3's 0.15 m backup buffer, which a
@@ -78,6 +78,11 @@ def felt_contact(base, now: float) -> Contact:
     p = base.pose()
     rim = (p.x + CREATE3_RADIUS_M * math.cos(p.yaw), p.y + CREATE3_RADIUS_M * math.sin(p.yaw))
     return Contact(rim, now, f"touched something ahead at ({rim[0]:.2f}, {rim[1]:.2f})")
+
+
+def as_bump(contact: Contact) -> Hazard:
+    """``contact`` as the bump hazard a steering's ``feel`` marks (``felt_item``)."""
+    return Hazard(HazardKind.BUMP, "", contact.point, contact.stamp)
 
 
 Clearance = Callable[[float, float], float]  # metres from an odometry point to what is known
